@@ -1,0 +1,1 @@
+"""The Blender side of Bounce: capture, Blender's gpu backend, viewport, bake, images."""

@@ -1,0 +1,1 @@
+"""Sub-commands of `python -m addon`, one module each (discovered by addon/cli.py)."""

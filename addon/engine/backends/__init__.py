@@ -1,0 +1,1 @@
+"""GPU backends: one narrow interface (base.py), implemented on moderngl and on Blender's gpu module."""

@@ -1,0 +1,229 @@
+"""ModernGLBackend: a standalone OpenGL 4.3+ context (EGL headless; Mesa llvmpipe without a GPU).
+
+Used by tests, CI, the CLI and bakes outside Blender. Never shares Blender's context: inside a windowed
+Blender every call runs with this backend's own context entered.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import ctypes.util
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import BackendUnavailable, ShaderCompileError
+from ..shader_source import load
+from . import glsl_header
+from .base import FORMATS, Backend, Mesh, Program, ShaderSpec, Target, Texture
+
+_DTYPE = {"RGBA32F": "f4", "RGBA16F": "f2", "R32F": "f4", "RG32F": "f4"}
+_GL_FRAMEBUFFER = 0x8D40
+_GL_COLOR_ATTACHMENT0 = 0x8CE0
+
+
+@dataclass
+class _Tex(Texture):
+    size: tuple[int, ...]
+    format: str
+    gl: Any
+
+
+@dataclass
+class _Prog(Program):
+    spec: ShaderSpec
+    gl: Any
+
+
+@dataclass
+class _Mesh(Mesh):
+    primitive: str
+    count: int
+    vao: Any
+    buffers: list
+
+
+@dataclass
+class _Target(Target):
+    fbo: Any
+    size: tuple[int, int]
+    layers: list  # (attachment index, 3D texture, layer) bound with glFramebufferTextureLayer
+
+
+def _gl_library():
+    """libGL entry points for the one call moderngl lacks: attaching a 3D-texture layer to an FBO."""
+    for name in ("GL", "OpenGL"):
+        path = ctypes.util.find_library(name)
+        if path:
+            return ctypes.CDLL(path)
+    raise BackendUnavailable("libGL not found: cannot draw into 3D-texture layers")
+
+
+class ModernGLBackend(Backend):
+    name = "moderngl"
+
+    def __init__(self, ctx=None):
+        try:
+            import moderngl
+        except ImportError as exc:  # pragma: no cover - the venv always has it
+            raise BackendUnavailable(f"moderngl is not installed: {exc}") from exc
+        self._mgl = moderngl
+        if ctx is None:
+            try:
+                ctx = moderngl.create_standalone_context(backend="egl", require=430)
+            except Exception as exc:
+                raise BackendUnavailable(f"no EGL OpenGL 4.3 context: {exc}") from exc
+        self.ctx = ctx
+        self._programs: dict[ShaderSpec, _Prog] = {}
+        self._gl = _gl_library()
+        self._gl.glFramebufferTextureLayer.argtypes = [ctypes.c_uint, ctypes.c_uint, ctypes.c_uint, ctypes.c_int, ctypes.c_int]
+
+    @property
+    def renderer(self) -> str:
+        info = self.ctx.info
+        return f"OpenGL {info['GL_VERSION']} / {info['GL_RENDERER']} (moderngl)"
+
+    # -- textures -----------------------------------------------------------------------------------
+    def texture(self, size, fmt="RGBA32F", data=None) -> _Tex:
+        comps = FORMATS[fmt]
+        dtype = _DTYPE[fmt]
+        if len(size) == 3:
+            gl = self.ctx.texture3d(tuple(size), comps, dtype=dtype)
+        else:
+            gl = self.ctx.texture(tuple(size), comps, dtype=dtype)
+        gl.filter = (self._mgl.LINEAR, self._mgl.LINEAR)
+        gl.repeat_x = gl.repeat_y = False
+        if len(size) == 3:
+            gl.repeat_z = False
+        tex = _Tex(tuple(size), fmt, gl)
+        self.write(tex, np.zeros(tuple(reversed(size)) + (comps,), np.float32) if data is None else data)
+        return tex
+
+    def depth_texture(self, size) -> _Tex:
+        gl = self.ctx.depth_texture(tuple(size))
+        return _Tex(tuple(size), "DEPTH32F", gl)
+
+    def write(self, tex: _Tex, data) -> None:
+        arr = np.ascontiguousarray(data, dtype=np.float32)
+        expected = tuple(reversed(tex.size)) + (tex.channels,)
+        if arr.size != int(np.prod(expected)):
+            raise ValueError(f"write: data of shape {arr.shape} does not fit a texture of shape {expected}")
+        tex.gl.write(arr.astype(_DTYPE[tex.format]).tobytes())
+
+    def read(self, tex: _Tex) -> np.ndarray:
+        self.ctx.memory_barrier()
+        raw = np.frombuffer(tex.gl.read(), dtype=_DTYPE[tex.format])
+        return raw.astype(np.float32).reshape(tuple(reversed(tex.size)) + (tex.channels,))
+
+    # -- programs -----------------------------------------------------------------------------------
+    def program(self, spec: ShaderSpec) -> _Prog:
+        cached = self._programs.get(spec)
+        if cached is not None:
+            return cached
+        if spec.is_compute:
+            src = load(spec.compute)
+            text = glsl_header.compute_header(spec) + src.text
+            try:
+                gl = self.ctx.compute_shader(text)
+            except Exception as exc:
+                raise ShaderCompileError(f"{spec.name}: {src.map_error(str(exc))}") from None
+        else:
+            vs, fs = load(spec.vertex), load(spec.fragment)
+            try:
+                gl = self.ctx.program(
+                    vertex_shader=glsl_header.vertex_header(spec) + vs.text,
+                    fragment_shader=glsl_header.fragment_header(spec) + fs.text,
+                )
+            except Exception as exc:
+                log = str(exc)
+                which = vs if "vertex_shader" in log or "GL_VERTEX_SHADER" in log else fs
+                raise ShaderCompileError(f"{spec.name}: {which.map_error(log)}") from None
+        prog = _Prog(spec, gl)
+        self._programs[spec] = prog
+        return prog
+
+    def _set_uniforms(self, prog: _Prog, uniforms: dict[str, Any] | None) -> None:
+        for name, value in (uniforms or {}).items():
+            if name not in prog.gl:
+                continue  # declared but optimised out by the compiler
+            arr = np.asarray(value)
+            if arr.shape == (4, 4):  # numpy row-major maths -> GLSL column-major
+                prog.gl[name].write(np.ascontiguousarray(arr.T, dtype=np.float32).tobytes())
+            elif arr.ndim == 0:
+                prog.gl[name].value = arr.item()
+            else:
+                prog.gl[name].value = tuple(arr.tolist())
+
+    def _bind_samplers(self, prog: _Prog, samplers: dict[str, Texture] | None) -> None:
+        for unit, s in enumerate(prog.spec.samplers):
+            (samplers or {})[s.name].gl.use(location=unit)
+
+    def dispatch(self, program, groups, uniforms=None, samplers=None, images=None) -> None:
+        self._set_uniforms(program, uniforms)
+        self._bind_samplers(program, samplers)
+        for unit, img in enumerate(program.spec.images):
+            tex = (images or {})[img.name]
+            tex.gl.bind_to_image(unit, read=img.access != "write", write=img.access != "read")
+        program.gl.run(*groups)
+        self.ctx.memory_barrier()
+
+    # -- drawing ------------------------------------------------------------------------------------
+    def mesh(self, program, attributes, primitive) -> _Mesh:
+        buffers, content, count = [], [], None
+        for var in program.spec.attributes:
+            arr = np.ascontiguousarray(attributes[var.name], dtype=np.float32)
+            arr = arr.reshape(arr.shape[0], -1)
+            count = arr.shape[0] if count is None else count
+            if arr.shape[0] != count:
+                raise ValueError(f"mesh: attribute {var.name} has {arr.shape[0]} vertices, expected {count}")
+            buf = self.ctx.buffer(arr.tobytes())
+            buffers.append(buf)
+            content.append((buf, f"{arr.shape[1]}f", var.name))
+        vao = self.ctx.vertex_array(program.gl, content)
+        return _Mesh(primitive, int(count or 0), vao, buffers)
+
+    def target(self, color, depth=None) -> _Target:
+        attachments, layers, size = [], [], None
+        for i, entry in enumerate(color):
+            tex, layer = entry if isinstance(entry, tuple) else (entry, None)
+            size = tex.size[:2]
+            if layer is None:
+                attachments.append(tex.gl)
+            else:  # placeholder of the right size, replaced below by the 3D layer
+                attachments.append(self.ctx.texture(tuple(size), 4, dtype="f4"))
+                layers.append((i, tex, layer))
+        fbo = self.ctx.framebuffer(color_attachments=attachments, depth_attachment=depth.gl if depth else None)
+        if layers:
+            fbo.use()
+            for i, tex, layer in layers:
+                self._gl.glFramebufferTextureLayer(_GL_FRAMEBUFFER, _GL_COLOR_ATTACHMENT0 + i, tex.gl.glo, 0, layer)
+        return _Target(fbo, tuple(size), layers)
+
+    def clear(self, target, color=(0, 0, 0, 0), depth=None) -> None:
+        target.fbo.use()
+        self.ctx.viewport = (0, 0, *target.size)
+        if color is not None:
+            target.fbo.clear(*color, depth=1.0 if depth is None else depth)
+        elif depth is not None:
+            self.ctx.clear(depth=depth)
+
+    def draw(self, program, target, mesh, uniforms=None, samplers=None, blend="none", depth_test=False) -> None:
+        mgl = self._mgl
+        target.fbo.use()
+        self.ctx.viewport = (0, 0, *target.size)
+        flags = mgl.DEPTH_TEST if depth_test else mgl.NOTHING
+        if blend == "add":
+            flags |= mgl.BLEND
+            self.ctx.blend_func = (mgl.ONE, mgl.ONE)
+            self.ctx.blend_equation = mgl.FUNC_ADD
+        self.ctx.enable_only(flags)
+        self.ctx.point_size = 1.0
+        self._set_uniforms(program, uniforms)
+        self._bind_samplers(program, samplers)
+        mesh.vao.render(mgl.POINTS if mesh.primitive == "points" else mgl.TRIANGLES)
+        self.ctx.enable_only(mgl.NOTHING)
+
+    def finish(self) -> None:
+        self.ctx.finish()
+

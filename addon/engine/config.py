@@ -1,0 +1,84 @@
+"""Frozen, validated configuration dataclasses.
+
+Every field declares its allowed range (or choices) in its metadata; `__post_init__` checks them and
+raises `ConfigError` naming the field and the range. Blender properties mirror these fields (same
+names, defaults and limits); a test keeps the two in step.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import Any
+
+from .errors import ConfigError
+
+METHODS = ("direct", "rsm")
+
+
+def _num(default, lo, hi, doc):
+    return field(default=default, metadata={"min": lo, "max": hi, "doc": doc})
+
+
+def _choice(default, choices, doc):
+    return field(default=default, metadata={"choices": tuple(choices), "doc": doc})
+
+
+class _Validated:
+    """Mixin: range/choice validation from field metadata, and construction from a dict."""
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            meta = f.metadata
+            where = f"{type(self).__name__}.{f.name}"
+            if "choices" in meta:
+                if value not in meta["choices"]:
+                    raise ConfigError(f"{where} = {value!r}: must be one of {', '.join(meta['choices'])}")
+            elif "min" in meta:
+                expected = type(f.default)
+                if isinstance(value, bool) or not isinstance(value, (int, float)):
+                    raise ConfigError(f"{where} = {value!r}: must be a number in [{meta['min']}, {meta['max']}]")
+                if expected is int and not float(value).is_integer():
+                    raise ConfigError(f"{where} = {value!r}: must be an integer in [{meta['min']}, {meta['max']}]")
+                if not (meta["min"] <= value <= meta["max"]):  # also rejects NaN
+                    raise ConfigError(f"{where} = {value!r}: out of range [{meta['min']}, {meta['max']}]")
+                object.__setattr__(self, f.name, expected(value))
+
+    @classmethod
+    def from_dict(cls, values: dict[str, Any]):
+        names = {f.name for f in dataclasses.fields(cls)}
+        unknown = sorted(set(values) - names)
+        if unknown:
+            raise ConfigError(f"{cls.__name__}: unknown field(s) {', '.join(unknown)}; known: {', '.join(sorted(names))}")
+        return cls(**values)
+
+    def to_dict(self) -> dict[str, Any]:
+        return dataclasses.asdict(self)
+
+
+@dataclass(frozen=True)
+class RsmConfig(_Validated):
+    """Reflective shadow maps: one per light (six faces for a point light)."""
+
+    resolution: int = _num(256, 16, 4096, "RSM side in texels (per face for point lights)")
+    vpl_samples: int = _num(256, 1, 4096, "VPLs gathered per pixel by the `rsm` method")
+    depth_bias_m: float = _num(0.01, 0.0, 1.0, "shadow-map depth bias in metres")
+
+
+@dataclass(frozen=True)
+class GIConfig(_Validated):
+    """What to compute and at which output resolution."""
+
+    method: str = _choice("direct", METHODS, "GI method")
+    bounces: int = _num(1, 1, 8, "indirect diffuse bounces (Cycles diffuse_bounces)")
+    resolution: int = _num(256, 8, 8192, "long side of the output image in pixels")
+    seed: int = _num(0, 0, 2**31 - 1, "seed of every stochastic choice")
+
+
+def limits(cls) -> dict[str, dict[str, Any]]:
+    """Field name -> {'default', 'min'/'max' or 'choices', 'doc'}: what Blender properties mirror."""
+    out = {}
+    for f in dataclasses.fields(cls):
+        out[f.name] = {"default": f.default, **dict(f.metadata)}
+    return out

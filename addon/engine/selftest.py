@@ -1,0 +1,54 @@
+"""The backend self-test passes: the same small compute pass and additive point splat, run on any backend.
+
+Used by the cross-backend tests (moderngl vs Blender gpu) and by `python -m addon doctor`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
+
+SCALE_OFFSET = ShaderSpec(
+    name="selftest_scale_offset",
+    compute="selftest/scale_offset.comp.glsl",
+    local_size=(4, 4, 4),
+    samplers=(Sampler("src", "3D"),),
+    images=(Image("dst", "3D", "RGBA32F", "write"),),
+    uniforms=(Var("scale", "float"), Var("size_cells", "ivec3")),
+)
+
+SPLAT = ShaderSpec(
+    name="selftest_splat",
+    vertex="selftest/splat.vert.glsl",
+    fragment="selftest/splat.frag.glsl",
+    attributes=(Var("pos_ndc", "vec2"), Var("value", "vec4")),
+    varyings=(Var("v_value", "vec4"),),
+)
+
+
+def run_scale_offset(backend: Backend, src: np.ndarray, scale: float) -> np.ndarray:
+    """src (d, h, w, 4) -> src * scale + (x, y, z, pi) per texel, computed on the GPU."""
+    d, h, w, _ = src.shape
+    a = backend.texture((w, h, d), "RGBA32F", src)
+    b = backend.texture((w, h, d), "RGBA32F")
+    prog = backend.program(SCALE_OFFSET)
+    backend.dispatch(prog, group_count((w, h, d), SCALE_OFFSET.local_size),
+                     uniforms={"scale": scale, "size_cells": (w, h, d)}, samplers={"src": a}, images={"dst": b})
+    return backend.read(b)
+
+
+def run_splat(backend: Backend, size: tuple[int, int, int], voxels: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Additively splat values (n, 4) at integer voxels (n, 3) into a zeroed volume; returns (d, h, w, 4)."""
+    w, h, d = size
+    vol = backend.texture(size, "RGBA32F")
+    prog = backend.program(SPLAT)
+    for z in range(d):
+        sel = voxels[:, 2] == z
+        if not np.any(sel):
+            continue
+        ndc = (voxels[sel, :2] + 0.5) / np.array([w, h]) * 2.0 - 1.0
+        mesh = backend.mesh(prog, {"pos_ndc": ndc, "value": values[sel]}, "points")
+        target = backend.target([(vol, z)])
+        backend.draw(prog, target, mesh, blend="add")
+    return backend.read(vol)

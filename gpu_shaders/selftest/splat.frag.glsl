@@ -1,0 +1,3 @@
+void main() {
+    frag_color = v_value;
+}
