@@ -30,10 +30,10 @@ def gl_backend():
 
 @pytest.fixture
 def gl(gl_backend):
-    """The session backend, asserting that the test left no GL error behind."""
-    assert gl_backend.ctx.error == "GL_NO_ERROR"
+    """The session backend, asserting that the test left no GL error behind (in its own context)."""
+    assert gl_backend.gl_error() == "GL_NO_ERROR"
     yield gl_backend
-    assert gl_backend.ctx.error == "GL_NO_ERROR"
+    assert gl_backend.gl_error() == "GL_NO_ERROR"
 
 
 @pytest.fixture(scope="session")

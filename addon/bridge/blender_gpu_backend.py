@@ -7,6 +7,9 @@ them at 128 bytes for Vulkan). 3D textures are read back through a 2D atlas (see
 
 from __future__ import annotations
 
+import contextlib
+import os
+import tempfile
 from dataclasses import dataclass
 from typing import Any
 
@@ -16,7 +19,7 @@ from gpu_extras.batch import batch_for_shader
 
 from ..engine.backends.base import FORMATS, Backend, Image, Mesh, Program, Sampler, ShaderSpec, Target, Texture, group_count
 from ..engine.errors import ShaderCompileError
-from ..engine.shader_source import load
+from ..engine.shader_source import load, load_stages
 from .gpu_init import ensure_gpu
 
 _ACCESS = {"read": {"READ"}, "write": {"WRITE"}, "read_write": {"READ", "WRITE"}}
@@ -54,6 +57,24 @@ class _Mesh(Mesh):
 class _Target(Target):
     fbo: Any
     size: tuple[int, int]
+
+
+@contextlib.contextmanager
+def _captured_output(result: list[str]):
+    """Append to `result` what C code writes on file descriptors 1 and 2 meanwhile: Blender's logger
+    prints the shader compiler's log there, and the Python exception carries none of it."""
+    with tempfile.TemporaryFile(mode="w+") as log:
+        saved = [os.dup(1), os.dup(2)]
+        try:
+            for fd in (1, 2):
+                os.dup2(log.fileno(), fd)
+            yield
+        finally:
+            for fd, old in zip((1, 2), saved, strict=True):
+                os.dup2(old, fd)
+                os.close(old)
+            log.seek(0)
+            result.append(log.read())
 
 
 def _flat(arr: np.ndarray) -> np.ndarray:
@@ -129,7 +150,7 @@ class BlenderGPUBackend(Backend):
                 info.image(slot, img.format, f"FLOAT_{img.dim}", img.name, qualifiers=_ACCESS[img.access])
             info.compute_source(sources[0].text)
         else:
-            sources = [load(spec.vertex), load(spec.fragment)]
+            sources = load_stages(spec.vertex, spec.fragment)
             for slot, a in enumerate(spec.attributes):
                 info.vertex_in(slot, a.type.upper(), a.name)
             if spec.varyings:
@@ -141,12 +162,16 @@ class BlenderGPUBackend(Backend):
                 info.fragment_out(slot, o.type.upper(), o.name)
             info.vertex_source(sources[0].text)
             info.fragment_source(sources[1].text)
-        try:
-            shader = gpu.shader.create_from_info(info)
-        except Exception as exc:
-            # Blender prints the compiler log to stderr; the exception only says that it failed.
-            files = ", ".join(f"gpu_shaders/{s.files[1]}" for s in sources)
-            raise ShaderCompileError(f"{spec.name}: Blender could not compile {files}: {exc} (log on stderr)") from None
+        log: list[str] = []
+        failed = None
+        with _captured_output(log):
+            try:
+                shader = gpu.shader.create_from_info(info)
+            except Exception as exc:
+                failed = exc
+        if failed is not None:
+            mapped = sources[-1].map_error(log[0])
+            raise ShaderCompileError(f"{spec.name}: {failed}\n{mapped.strip()}") from None
         prog = _Prog(spec, shader)
         self._programs[spec] = prog
         return prog

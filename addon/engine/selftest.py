@@ -52,3 +52,29 @@ def run_splat(backend: Backend, size: tuple[int, int, int], voxels: np.ndarray, 
         target = backend.target([(vol, z)])
         backend.draw(prog, target, mesh, blend="add")
     return backend.read(vol)
+
+SH_EVAL = ShaderSpec(
+    name="selftest_sh_eval",
+    compute="selftest/sh_eval.comp.glsl",
+    local_size=(8, 8, 1),
+    samplers=(Sampler("dirs", "2D"), Sampler("coeffs", "2D")),
+    images=(
+        Image("basis_out", "2D", "RGBA32F", "write"),
+        Image("lobe_out", "2D", "RGBA32F", "write"),
+        Image("scalar_out", "2D", "RGBA32F", "write"),
+    ),
+)
+
+
+def run_sh_eval(backend: Backend, dirs: np.ndarray, coeffs: np.ndarray) -> dict[str, np.ndarray]:
+    """sh.glsl evaluated on the GPU for n directions (n, 3) and coefficient sets (n, 4)."""
+    n = len(dirs)
+    pad = np.zeros((n, 4), np.float32)
+    pad[:, :3] = dirs
+    tex_dirs = backend.texture((n, 1), "RGBA32F", pad.reshape(1, n, 4))
+    tex_coeffs = backend.texture((n, 1), "RGBA32F", np.asarray(coeffs, np.float32).reshape(1, n, 4))
+    outs = {name: backend.texture((n, 1), "RGBA32F") for name in ("basis_out", "lobe_out", "scalar_out")}
+    prog = backend.program(SH_EVAL)
+    backend.dispatch(prog, group_count((n, 1), SH_EVAL.local_size),
+                     samplers={"dirs": tex_dirs, "coeffs": tex_coeffs}, images=outs)
+    return {name: backend.read(tex).reshape(n, 4) for name, tex in outs.items()}

@@ -1,8 +1,10 @@
 """Loads GLSL bodies from gpu_shaders/, resolves `#include "path"`, maps compile errors to file:line.
 
-Each included file is wrapped in `#line <n> <file-index>` directives, so any GLSL compiler reports
-errors as `<file-index>:<line>`; `map_compile_error` rewrites those to `gpu_shaders/<file>:<line>`.
-This works for every backend, including Blender's, which prepends its own declarations.
+Each included file is wrapped in `#line` directives whose line number carries the file too:
+`#line <file-index * LINE_STRIDE + n>`. Compilers differ in whether they print the source-string number
+of `#line` (Mesa always prints 0), but all print the line, so the file is decoded from the line alone;
+`map_compile_error` rewrites such locations to `gpu_shaders/<file>:<line>`. This works for every
+backend, including Blender's, which prepends its own declarations.
 """
 
 from __future__ import annotations
@@ -15,18 +17,21 @@ from .errors import ShaderCompileError
 
 SHADER_ROOT = Path(__file__).resolve().parents[2] / "gpu_shaders"
 
+LINE_STRIDE = 100_000  # no shader file comes near this many lines
 _INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"\s*$')
-# Mesa: "1:12(3): error: ..."; NVIDIA: "1(12) : error ..."; AMD/Intel: "ERROR: 1:12: ..."
+# Mesa: "0:12(3): error: ..."; NVIDIA: "0(12) : error ..."; AMD/Intel: "ERROR: 0:12: ...";
+# Blender's own log: ":12:3: Error: ...". Group "line" is the (encoded) line number.
 _LOCATIONS = (
-    re.compile(r"\b(\d+):(\d+)\((\d+)\)"),
-    re.compile(r"\b(\d+)\((\d+)\)"),
-    re.compile(r"\b(\d+):(\d+)\b"),
+    re.compile(r"\b\d+:(?P<line>\d+)\(\d+\)"),
+    re.compile(r"\b\d+\((?P<line>\d+)\)"),
+    re.compile(r"(?<![\w:]):(?P<line>\d+):\d+:"),
+    re.compile(r"\b\d+:(?P<line>\d+)\b"),
 )
 
 
 @dataclass(frozen=True)
 class ShaderSource:
-    """An assembled GLSL body and the files its `#line` indices refer to (index 0 = generated header)."""
+    """An assembled GLSL body and the files its `#line` numbers refer to (index 0 = generated header)."""
 
     text: str
     files: tuple[str, ...]
@@ -35,12 +40,22 @@ class ShaderSource:
         return map_compile_error(log, self.files)
 
 
-def load(relpath: str, root: Path = SHADER_ROOT) -> ShaderSource:
+def load(relpath: str, root: Path | None = None) -> ShaderSource:
     """Read gpu_shaders/<relpath> with its includes resolved (each file included once, cycles refused)."""
+    return load_stages(relpath, root=root)[0]
+
+
+def load_stages(*relpaths: str, root: Path | None = None) -> list[ShaderSource]:
+    """Load the stages of one program (vertex, fragment) with one shared file table, so a location in
+    any stage's compiler log maps to the right file. Every returned source carries the whole table."""
+    root = SHADER_ROOT if root is None else root
     files: list[str] = ["<generated>"]
-    out: list[str] = []
-    _expand(relpath, root, files, out, stack=(), done=set())
-    return ShaderSource("\n".join(out) + "\n", tuple(files))
+    texts = []
+    for relpath in relpaths:
+        out: list[str] = []
+        _expand(relpath, root, files, out, stack=(), done=set())
+        texts.append("\n".join(out) + "\n")
+    return [ShaderSource(text, tuple(files)) for text in texts]
 
 
 def _expand(relpath: str, root: Path, files: list[str], out: list[str], stack: tuple[str, ...], done: set[str]):
@@ -56,31 +71,26 @@ def _expand(relpath: str, root: Path, files: list[str], out: list[str], stack: t
     done.add(relpath)
     index = len(files)
     files.append(relpath)
-    out.append(f"#line 1 {index}")
+    out.append(f"#line {index * LINE_STRIDE + 1}")
     for lineno, line in enumerate(path.read_text().splitlines(), start=1):
         m = _INCLUDE.match(line)
         if m:
             _expand(m.group(1), root, files, out, (*stack, relpath), done)
-            out.append(f"#line {lineno + 1} {index}")
+            out.append(f"#line {index * LINE_STRIDE + lineno + 1}")
         else:
             out.append(line)
 
 
 def map_compile_error(log: str, files: tuple[str, ...]) -> str:
-    """Rewrite `<index>:<line>` locations in a compiler log to `gpu_shaders/<file>:<line>`."""
-
-    def name(index: str) -> str | None:
-        i = int(index)
-        if 0 < i < len(files):
-            return f"gpu_shaders/{files[i]}"
-        return None
-
+    """Rewrite compiler locations whose line encodes a file (see module doc) to `gpu_shaders/<file>:<line>`."""
     mapped = []
     for line in log.splitlines():
         for pattern in _LOCATIONS:
             m = pattern.search(line)
-            if m and name(m.group(1)):
-                line = line[: m.start()] + f"{name(m.group(1))}:{m.group(2)}" + line[m.end() :]
+            if m:
+                index, lineno = divmod(int(m.group("line")), LINE_STRIDE)
+                if 0 < index < len(files):
+                    line = line[: m.start()] + f"gpu_shaders/{files[index]}:{lineno}" + line[m.end() :]
                 break
         mapped.append(line)
     return "\n".join(mapped)

@@ -7,6 +7,7 @@ Blender every call runs with this backend's own context entered.
 from __future__ import annotations
 
 import ctypes
+import functools
 import ctypes.util
 from dataclasses import dataclass
 from typing import Any
@@ -14,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import BackendUnavailable, ShaderCompileError
-from ..shader_source import load
+from ..shader_source import load, load_stages
 from . import glsl_header
 from .base import FORMATS, Backend, Mesh, Program, ShaderSpec, Target, Texture
 
@@ -60,6 +61,52 @@ def _gl_library():
     raise BackendUnavailable("libGL not found: cannot draw into 3D-texture layers")
 
 
+class _EglCurrent:
+    """Saves and restores the thread's current EGL context. glcontext's `with ctx:` releases the
+    context on exit instead of restoring the previous one, which would leave Blender's gpu module
+    (also on EGL in background mode) without its context."""
+
+    _EGL_DRAW, _EGL_READ = 0x3059, 0x305A
+
+    def __init__(self):
+        path = ctypes.util.find_library("EGL")
+        self._egl = ctypes.CDLL(path) if path else None
+        if self._egl:
+            for fn in ("eglGetCurrentDisplay", "eglGetCurrentContext", "eglGetCurrentSurface"):
+                getattr(self._egl, fn).restype = ctypes.c_void_p
+            self._egl.eglGetCurrentSurface.argtypes = [ctypes.c_int]
+            self._egl.eglMakeCurrent.argtypes = [ctypes.c_void_p] * 4
+
+    def save(self):
+        if not self._egl:
+            return None
+        e = self._egl
+        return (e.eglGetCurrentDisplay(), e.eglGetCurrentSurface(self._EGL_DRAW),
+                e.eglGetCurrentSurface(self._EGL_READ), e.eglGetCurrentContext())
+
+    def restore(self, saved) -> None:
+        if saved and saved[3]:
+            self._egl.eglMakeCurrent(*saved)
+
+
+def _in_own_context(method):
+    """Run a backend call with this backend's context current, restoring the caller's afterwards:
+    in a process that also runs Blender's gpu module, whichever context is current gets the GL calls."""
+
+    @functools.wraps(method)
+    def wrapper(self, *args, **kwargs):
+        saved = self._egl.save()
+        if saved and saved[3] == self._own_context:
+            return method(self, *args, **kwargs)
+        try:
+            with self.ctx:
+                return method(self, *args, **kwargs)
+        finally:
+            self._egl.restore(saved)
+
+    return wrapper
+
+
 class ModernGLBackend(Backend):
     name = "moderngl"
 
@@ -75,6 +122,10 @@ class ModernGLBackend(Backend):
             except Exception as exc:
                 raise BackendUnavailable(f"no EGL OpenGL 4.3 context: {exc}") from exc
         self.ctx = ctx
+        self._egl = _EglCurrent()
+        with ctx:
+            current = self._egl.save()
+        self._own_context = current[3] if current else None
         self._programs: dict[ShaderSpec, _Prog] = {}
         self._gl = _gl_library()
         self._gl.glFramebufferTextureLayer.argtypes = [ctypes.c_uint, ctypes.c_uint, ctypes.c_uint, ctypes.c_int, ctypes.c_int]
@@ -85,6 +136,7 @@ class ModernGLBackend(Backend):
         return f"OpenGL {info['GL_VERSION']} / {info['GL_RENDERER']} (moderngl)"
 
     # -- textures -----------------------------------------------------------------------------------
+    @_in_own_context
     def texture(self, size, fmt="RGBA32F", data=None) -> _Tex:
         comps = FORMATS[fmt]
         dtype = _DTYPE[fmt]
@@ -100,10 +152,12 @@ class ModernGLBackend(Backend):
         self.write(tex, np.zeros(tuple(reversed(size)) + (comps,), np.float32) if data is None else data)
         return tex
 
+    @_in_own_context
     def depth_texture(self, size) -> _Tex:
         gl = self.ctx.depth_texture(tuple(size))
         return _Tex(tuple(size), "DEPTH32F", gl)
 
+    @_in_own_context
     def write(self, tex: _Tex, data) -> None:
         arr = np.ascontiguousarray(data, dtype=np.float32)
         expected = tuple(reversed(tex.size)) + (tex.channels,)
@@ -111,12 +165,14 @@ class ModernGLBackend(Backend):
             raise ValueError(f"write: data of shape {arr.shape} does not fit a texture of shape {expected}")
         tex.gl.write(arr.astype(_DTYPE[tex.format]).tobytes())
 
+    @_in_own_context
     def read(self, tex: _Tex) -> np.ndarray:
         self.ctx.memory_barrier()
         raw = np.frombuffer(tex.gl.read(), dtype=_DTYPE[tex.format])
         return raw.astype(np.float32).reshape(tuple(reversed(tex.size)) + (tex.channels,))
 
     # -- programs -----------------------------------------------------------------------------------
+    @_in_own_context
     def program(self, spec: ShaderSpec) -> _Prog:
         cached = self._programs.get(spec)
         if cached is not None:
@@ -129,16 +185,14 @@ class ModernGLBackend(Backend):
             except Exception as exc:
                 raise ShaderCompileError(f"{spec.name}: {src.map_error(str(exc))}") from None
         else:
-            vs, fs = load(spec.vertex), load(spec.fragment)
+            vs, fs = load_stages(spec.vertex, spec.fragment)
             try:
                 gl = self.ctx.program(
                     vertex_shader=glsl_header.vertex_header(spec) + vs.text,
                     fragment_shader=glsl_header.fragment_header(spec) + fs.text,
                 )
             except Exception as exc:
-                log = str(exc)
-                which = vs if "vertex_shader" in log or "GL_VERTEX_SHADER" in log else fs
-                raise ShaderCompileError(f"{spec.name}: {which.map_error(log)}") from None
+                raise ShaderCompileError(f"{spec.name}: {fs.map_error(str(exc))}") from None
         prog = _Prog(spec, gl)
         self._programs[spec] = prog
         return prog
@@ -159,6 +213,7 @@ class ModernGLBackend(Backend):
         for unit, s in enumerate(prog.spec.samplers):
             (samplers or {})[s.name].gl.use(location=unit)
 
+    @_in_own_context
     def dispatch(self, program, groups, uniforms=None, samplers=None, images=None) -> None:
         self._set_uniforms(program, uniforms)
         self._bind_samplers(program, samplers)
@@ -169,6 +224,7 @@ class ModernGLBackend(Backend):
         self.ctx.memory_barrier()
 
     # -- drawing ------------------------------------------------------------------------------------
+    @_in_own_context
     def mesh(self, program, attributes, primitive) -> _Mesh:
         buffers, content, count = [], [], None
         for var in program.spec.attributes:
@@ -183,6 +239,7 @@ class ModernGLBackend(Backend):
         vao = self.ctx.vertex_array(program.gl, content)
         return _Mesh(primitive, int(count or 0), vao, buffers)
 
+    @_in_own_context
     def target(self, color, depth=None) -> _Target:
         attachments, layers, size = [], [], None
         for i, entry in enumerate(color):
@@ -200,6 +257,7 @@ class ModernGLBackend(Backend):
                 self._gl.glFramebufferTextureLayer(_GL_FRAMEBUFFER, _GL_COLOR_ATTACHMENT0 + i, tex.gl.glo, 0, layer)
         return _Target(fbo, tuple(size), layers)
 
+    @_in_own_context
     def clear(self, target, color=(0, 0, 0, 0), depth=None) -> None:
         target.fbo.use()
         self.ctx.viewport = (0, 0, *target.size)
@@ -208,6 +266,7 @@ class ModernGLBackend(Backend):
         elif depth is not None:
             self.ctx.clear(depth=depth)
 
+    @_in_own_context
     def draw(self, program, target, mesh, uniforms=None, samplers=None, blend="none", depth_test=False) -> None:
         mgl = self._mgl
         target.fbo.use()
@@ -224,6 +283,12 @@ class ModernGLBackend(Backend):
         mesh.vao.render(mgl.POINTS if mesh.primitive == "points" else mgl.TRIANGLES)
         self.ctx.enable_only(mgl.NOTHING)
 
+    @_in_own_context
     def finish(self) -> None:
         self.ctx.finish()
+
+    @_in_own_context
+    def gl_error(self) -> str:
+        """The context's pending GL error ("GL_NO_ERROR" when none); tests check it around each test."""
+        return self.ctx.error
 
