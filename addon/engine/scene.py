@@ -1,0 +1,93 @@
+"""The Scene the pipeline consumes: numpy arrays in world space, metres, Cycles' light units.
+
+Built from Blender by addon/bridge/capture.py, or by hand in tests. Triangles are flat arrays so a
+pass uploads them once; per-triangle material values keep grids and VPLs cheap (bakes sample textures
+per texel separately).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+LIGHT_KINDS = ("POINT", "SPOT", "SUN", "AREA")
+AREA_SHAPES = ("SQUARE", "RECTANGLE", "DISK", "ELLIPSE")
+
+
+@dataclass
+class Light:
+    """A lamp, in Cycles' units.
+
+    POINT/SPOT: radiant intensity power_w / (4 pi) * color W/sr (a spot masks it by its cone);
+    SUN: irradiance strength * color W/m^2 on a surface facing it; AREA: one-sided Lambertian emitter of
+    total power power_w (radiance power_w / (area * pi)). `direction` is where the light points (its -Z).
+    """
+
+    kind: str
+    position_m: np.ndarray
+    direction: np.ndarray
+    color: np.ndarray
+    power_w: float = 0.0
+    spot_size_rad: float = np.pi
+    spot_blend: float = 0.0
+    sun_strength: float = 0.0
+    sun_angle_rad: float = 0.0
+    area_shape: str = "SQUARE"
+    size_x_m: float = 0.0
+    size_y_m: float = 0.0
+    axis_x: np.ndarray = field(default_factory=lambda: np.array([1.0, 0.0, 0.0]))  # area light's local X
+    name: str = ""
+
+    def __post_init__(self):
+        if self.kind not in LIGHT_KINDS:
+            raise ValueError(f"light kind {self.kind!r} not in {LIGHT_KINDS}")
+        self.position_m = np.asarray(self.position_m, np.float64)
+        d = np.asarray(self.direction, np.float64)
+        self.direction = d / max(np.linalg.norm(d), 1e-30)
+        self.color = np.asarray(self.color, np.float64)
+
+
+@dataclass
+class Camera:
+    """World -> view (4x4) and an OpenGL-style projection (4x4), numpy row-major; image size in pixels."""
+
+    view: np.ndarray
+    projection: np.ndarray
+    width: int
+    height: int
+
+    @property
+    def view_projection(self) -> np.ndarray:
+        return self.projection @ self.view
+
+    @property
+    def position_m(self) -> np.ndarray:
+        return np.linalg.inv(self.view)[:3, 3]
+
+
+@dataclass
+class Scene:
+    """Triangles (n, 3 corners, 3) with per-corner normals, per-triangle diffuse albedo and emitted
+    radiance (W/m^2/sr, emission colour x strength), lights, the world colour (constant radiance) and
+    the camera. Empty scenes are valid: zero triangles, zero lights."""
+
+    positions_m: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 3), np.float32))
+    normals: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 3), np.float32))
+    albedo: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
+    emission: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
+    lights: list[Light] = field(default_factory=list)
+    world_color: np.ndarray = field(default_factory=lambda: np.zeros(3, np.float32))
+    camera: Camera | None = None
+    warnings: list[str] = field(default_factory=list)
+
+    @property
+    def triangle_count(self) -> int:
+        return int(self.positions_m.shape[0])
+
+    def bounds_m(self) -> tuple[np.ndarray, np.ndarray]:
+        """Axis-aligned bounds of the geometry; a unit box at the origin for an empty scene."""
+        if self.triangle_count == 0:
+            return np.full(3, -0.5), np.full(3, 0.5)
+        pts = self.positions_m.reshape(-1, 3)
+        return pts.min(axis=0).astype(np.float64), pts.max(axis=0).astype(np.float64)
