@@ -22,9 +22,11 @@ import numpy as np
 from ..errors import ConfigError
 
 FORMATS = {"RGBA32F": 4, "RGBA16F": 4, "R32F": 1, "RG32F": 2}
-UNIFORM_BYTES = {
-    "float": 4, "int": 4, "vec2": 8, "vec3": 12, "vec4": 16,
-    "ivec2": 8, "ivec3": 12, "ivec4": 16, "mat4": 64,
+# (size, alignment) in bytes under std430, the layout of Vulkan push constants: a vec3 is aligned
+# like a vec4 but a scalar declared after it fills its fourth slot, so declare vec3 + scalar pairs.
+UNIFORM_LAYOUT = {
+    "float": (4, 4), "int": (4, 4), "vec2": (8, 8), "vec3": (12, 16), "vec4": (16, 16),
+    "ivec2": (8, 8), "ivec3": (12, 16), "ivec4": (16, 16), "mat4": (64, 16),
 }
 # Vulkan caps push constants at 128 bytes; Blender maps our uniforms to push constants.
 PUSH_CONSTANT_LIMIT_BYTES = 128
@@ -56,6 +58,15 @@ class Var:
     type: str
 
 
+def push_constant_bytes(uniforms: tuple[Var, ...]) -> int:
+    """Bytes the uniforms take as std430 push constants, in declaration order."""
+    offset = 0
+    for u in uniforms:
+        size, align = UNIFORM_LAYOUT[u.type]
+        offset = -(-offset // align) * align + size
+    return offset
+
+
 @dataclass(frozen=True)
 class ShaderSpec:
     """A program: resources declared here, bodies read from gpu_shaders/ (paths relative to it).
@@ -79,7 +90,7 @@ class ShaderSpec:
     def __post_init__(self):
         if (self.compute is None) == (self.vertex is None or self.fragment is None):
             raise ConfigError(f"ShaderSpec {self.name}: give either compute or vertex + fragment")
-        size = sum(UNIFORM_BYTES[u.type] for u in self.uniforms)
+        size = push_constant_bytes(self.uniforms)
         if size > PUSH_CONSTANT_LIMIT_BYTES:
             raise ConfigError(
                 f"ShaderSpec {self.name}: {size} bytes of uniforms exceed the portable "

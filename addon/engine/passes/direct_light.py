@@ -1,0 +1,38 @@
+"""Direct-light pass: shadow-mapped direct diffuse light of one light face at every G-buffer pixel.
+
+Inputs: G-buffer position and normal, the face's RSM position (shadow test), LightView uniforms.
+Output: `direct` (RGBA32F, camera resolution), accumulated over faces and lights, in the unit of
+Cycles' Diffuse Direct pass: irradiance / pi. Point-light faces split directions by major axis, so
+each pixel is shaded by exactly one face.
+"""
+
+from __future__ import annotations
+
+from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
+from .light_views import LightView
+
+SPEC = ShaderSpec(
+    name="direct_shade",
+    compute="direct/shade.comp.glsl",
+    local_size=(8, 8, 1),
+    samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("rsm_position", "2D")),
+    images=(Image("direct", "2D", "RGBA32F", "read_write"),),
+    uniforms=(
+        Var("light_view_projection", "mat4"),
+        Var("light_pos_ws", "vec3"), Var("texel_scale", "float"),
+        Var("emit_axis", "vec3"), Var("light_kind", "int"),
+        Var("light_color_intensity", "vec3"), Var("face_index", "int"),
+        Var("spot_cos_half", "float"), Var("spot_blend", "float"), Var("depth_bias_m", "float"),
+    ),
+)
+
+
+def run(backend: Backend, gbuf_position, gbuf_normal, rsm_position, direct, view: LightView,
+        depth_bias_m: float) -> None:
+    names = {u.name for u in SPEC.uniforms}
+    uniforms = {k: v for k, v in view.uniforms.items() if k in names}
+    uniforms["depth_bias_m"] = depth_bias_m
+    backend.dispatch(backend.program(SPEC), group_count(direct.size, SPEC.local_size), uniforms=uniforms,
+                     samplers={"gbuf_position": gbuf_position, "gbuf_normal": gbuf_normal,
+                               "rsm_position": rsm_position},
+                     images={"direct": direct})

@@ -1,0 +1,29 @@
+"""G-buffer pass: rasterize the scene from the camera.
+
+Inputs: the scene's triangles (mesh attributes pos_ws, normal_ws, albedo). Uniforms: view_projection,
+camera_pos_ws. Outputs (RGBA32F, camera resolution, GL row 0 = bottom): position (world, m; w = 1 where
+geometry), normal (world, unit, flipped towards the camera), albedo (diffuse, linear). Depth: 32F.
+"""
+
+from __future__ import annotations
+
+from ..backends.base import Backend, ShaderSpec, Var
+from ..scene import Camera
+
+SPEC = ShaderSpec(
+    name="gbuffer",
+    vertex="gbuffer/gbuffer.vert.glsl",
+    fragment="gbuffer/gbuffer.frag.glsl",
+    uniforms=(Var("view_projection", "mat4"), Var("camera_pos_ws", "vec3")),
+    attributes=(Var("pos_ws", "vec3"), Var("normal_ws", "vec3"), Var("albedo", "vec3")),
+    varyings=(Var("v_pos_ws", "vec3"), Var("v_normal_ws", "vec3"), Var("v_albedo", "vec3")),
+    outputs=(Var("out_position", "vec4"), Var("out_normal", "vec4"), Var("out_albedo", "vec4")),
+)
+
+
+def run(backend: Backend, target, mesh, camera: Camera) -> None:
+    backend.clear(target, color=(0, 0, 0, 0), depth=1.0)
+    if mesh is not None:
+        backend.draw(backend.program(SPEC), target, mesh,
+                     uniforms={"view_projection": camera.view_projection, "camera_pos_ws": camera.position_m},
+                     depth_test=True)

@@ -1,0 +1,96 @@
+"""Where each light's RSM looks from: one perspective face for a spot, six cube faces for a point or
+area light, one orthographic view fitted to the scene bounds for a sun. Pure numpy.
+
+Area lights are modelled as a Lambertian point emitter at their centre, I(w) = P / pi * cos (exact
+far from the light, too bright close to a large one); ARCHITECTURE.md allows this "cosine-weighted
+spot" until polygonal area lights land.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..scene import Light
+from ..transforms import box_corners, look_along, orthographic, perspective
+
+KIND_CODE = {"POINT": 0, "SPOT": 0, "SUN": 1, "AREA": 2}
+CUBE_AXES = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], np.float64)
+SINGLE_FACE_MAX_SPOT_RAD = np.radians(120.0)  # wider spots use cube faces (a 90-degree face each)
+
+
+@dataclass(frozen=True)
+class LightView:
+    """One RSM face of one light, with what the RSM and direct-light shaders need as uniforms."""
+
+    light_index: int
+    view_projection: np.ndarray
+    position_m: np.ndarray
+    face_axis: np.ndarray
+    face_index: int  # 0..5 for cube faces (major-axis partition), -1 otherwise
+    texel_scale: float  # perspective: texel solid angle at the face axis (sr); sun: texel area (m^2)
+    uniforms: dict
+
+
+def light_intensity(light: Light) -> np.ndarray:
+    """Per-channel radiant intensity (W/sr) at the peak, or the sun's irradiance (W/m^2)."""
+    if light.kind == "SUN":
+        return light.color * light.sun_strength
+    if light.kind == "AREA":
+        return light.color * light.power_w / np.pi
+    return light.color * light.power_w / (4.0 * np.pi)
+
+
+def views_for(light: Light, index: int, bounds: tuple[np.ndarray, np.ndarray], resolution: int) -> list[LightView]:
+    lo, hi = bounds
+    corners = box_corners(lo, hi)
+    if light.kind == "SUN":
+        return [_sun_view(light, index, corners, resolution)]
+    far = float(np.max(np.linalg.norm(corners - light.position_m, axis=1))) * 1.01 + 1e-3
+    near = max(far * 1e-5, 1e-5)
+    if light.kind == "SPOT" and light.spot_size_rad <= SINGLE_FACE_MAX_SPOT_RAD:
+        fov = min(light.spot_size_rad * 1.02, SINGLE_FACE_MAX_SPOT_RAD)
+        return [_perspective_view(light, index, light.direction, -1, fov, near, far, resolution)]
+    views = []
+    for face, axis in enumerate(CUBE_AXES):
+        if light.kind == "AREA" and np.dot(axis, light.direction) < -0.5:
+            continue  # the face behind a one-sided emitter receives nothing
+        views.append(_perspective_view(light, index, axis, face, np.pi / 2.0, near, far, resolution))
+    return views
+
+
+def _common_uniforms(light: Light, emit_axis: np.ndarray, texel_scale: float) -> dict:
+    spot = light.kind == "SPOT"
+    return {
+        "light_pos_ws": light.position_m,
+        "texel_scale": texel_scale,
+        "emit_axis": emit_axis,
+        "light_kind": KIND_CODE[light.kind],
+        "light_color_intensity": light_intensity(light),
+        "spot_cos_half": float(np.cos(light.spot_size_rad / 2.0)) if spot else -1.0,
+        "spot_blend": float(light.spot_blend) if spot else 0.0,
+    }
+
+
+def _perspective_view(light, index, axis, face, fov, near, far, resolution) -> LightView:
+    view = look_along(light.position_m, axis)
+    vp = perspective(fov, near, far) @ view
+    texel_scale = (2.0 * np.tan(fov / 2.0) / resolution) ** 2
+    uniforms = {"light_view_projection": vp, "face_axis": axis, "face_index": face,
+                **_common_uniforms(light, light.direction, texel_scale)}
+    return LightView(index, vp, light.position_m, np.asarray(axis, np.float64), face, texel_scale, uniforms)
+
+
+def _sun_view(light, index, corners, resolution) -> LightView:
+    center = corners.mean(axis=0)
+    view = look_along(center, light.direction)
+    local = (view @ np.c_[corners, np.ones(8)].T).T[:, :3]
+    (x0, y0, z0), (x1, y1, z1) = local.min(axis=0), local.max(axis=0)
+    pad = 1e-3 * max(x1 - x0, y1 - y0, z1 - z0, 1e-3)
+    proj = orthographic(x0 - pad, x1 + pad, y0 - pad, y1 + pad, -z1 - pad, -z0 + pad)
+    vp = proj @ view
+    texel_scale = (x1 - x0 + 2 * pad) * (y1 - y0 + 2 * pad) / resolution**2
+    uniforms = {"light_view_projection": vp, "face_axis": light.direction, "face_index": -1,
+                **_common_uniforms(light, light.direction, texel_scale)}
+    return LightView(index, vp, center, light.direction, -1, texel_scale, uniforms)

@@ -1,0 +1,37 @@
+"""Reflective shadow map pass (Dachsbacher & Stamminger 2005): the scene seen from one light face.
+
+Inputs: scene triangles (pos_ws, normal_ws, albedo), a LightView (light_views.py). Outputs (RGBA32F,
+resolution^2, GL row 0 = bottom): position (world, m; w = 1 where geometry), normal (world, facing the
+light), flux (W reflected by the texel's surfel: albedo x I(w) x texel solid angle, or albedo x sun
+irradiance x texel area). The flux sums to the light's reflected power (tested against the analytic
+cone integral).
+"""
+
+from __future__ import annotations
+
+from ..backends.base import Backend, ShaderSpec, Var
+from .light_views import LightView
+
+SPEC = ShaderSpec(
+    name="rsm",
+    vertex="rsm/rsm.vert.glsl",
+    fragment="rsm/rsm.frag.glsl",
+    uniforms=(
+        Var("light_view_projection", "mat4"),
+        Var("light_pos_ws", "vec3"), Var("texel_scale", "float"),
+        Var("face_axis", "vec3"), Var("light_kind", "int"),
+        Var("emit_axis", "vec3"), Var("spot_cos_half", "float"),
+        Var("light_color_intensity", "vec3"), Var("spot_blend", "float"),
+    ),
+    attributes=(Var("pos_ws", "vec3"), Var("normal_ws", "vec3"), Var("albedo", "vec3")),
+    varyings=(Var("v_pos_ws", "vec3"), Var("v_normal_ws", "vec3"), Var("v_albedo", "vec3")),
+    outputs=(Var("out_position", "vec4"), Var("out_normal", "vec4"), Var("out_flux", "vec4")),
+)
+
+
+def run(backend: Backend, target, mesh, view: LightView) -> None:
+    backend.clear(target, color=(0, 0, 0, 0), depth=1.0)
+    if mesh is not None:
+        names = {u.name for u in SPEC.uniforms}
+        backend.draw(backend.program(SPEC), target, mesh,
+                     uniforms={k: v for k, v in view.uniforms.items() if k in names}, depth_test=True)

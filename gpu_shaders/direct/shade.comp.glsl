@@ -1,0 +1,71 @@
+// Shadow-mapped direct diffuse light of one light face at every G-buffer pixel, added to `direct`.
+// Output unit: Cycles' Diffuse Direct pass = irradiance / pi (W/m^2/sr per unit albedo).
+#include "common/light.glsl"
+
+const float PI = 3.14159265;
+
+// Point-light faces partition directions by their major axis; face = 2 * axis + (negative ? 1 : 0).
+int cube_face(vec3 d) {
+    vec3 a = abs(d);
+    if (a.x >= a.y && a.x >= a.z) {
+        return d.x >= 0.0 ? 0 : 1;
+    }
+    if (a.y >= a.z) {
+        return d.y >= 0.0 ? 2 : 3;
+    }
+    return d.z >= 0.0 ? 4 : 5;
+}
+
+void main() {
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(px, textureSize(gbuf_position, 0)))) {
+        return;
+    }
+    vec4 pos = texelFetch(gbuf_position, px, 0);
+    if (pos.w == 0.0) {
+        return;
+    }
+    vec3 p = pos.xyz;
+    vec3 n = texelFetch(gbuf_normal, px, 0).xyz;
+    vec3 irradiance;
+    vec3 to_light;
+    float dist = 0.0;
+    float texel_m;
+    if (light_kind == LIGHT_SUN) {
+        to_light = -emit_axis;
+        irradiance = light_color_intensity * max(dot(n, to_light), 0.0);
+        texel_m = sqrt(texel_scale);
+    } else {
+        vec3 d = p - light_pos_ws;
+        if (face_index >= 0 && cube_face(d) != face_index) {
+            return;  // another face of this point light shades this pixel
+        }
+        dist = length(d);
+        vec3 w = d / max(dist, 1e-9);
+        to_light = -w;
+        vec3 intensity = light_intensity(light_kind, w, emit_axis, light_color_intensity, spot_cos_half, spot_blend);
+        irradiance = intensity * max(dot(n, to_light), 0.0) / max(dist * dist, 1e-12);
+        texel_m = sqrt(texel_scale) * dist;
+    }
+    if (all(equal(irradiance, vec3(0.0)))) {
+        return;
+    }
+    // Shadow test against the RSM's stored positions. The receiver is pushed off its surface by about
+    // one RSM texel along its normal (normal-offset bias) so it does not shadow itself.
+    vec3 p_test = p + n * (1.5 * texel_m + depth_bias_m);
+    vec4 clip = light_view_projection * vec4(p_test, 1.0);
+    vec3 ndc = clip.xyz / clip.w;
+    float lit = 1.0;
+    if (clip.w > 0.0 && all(lessThanEqual(abs(ndc.xy), vec2(1.0)))) {
+        ivec2 size = textureSize(rsm_position, 0);
+        ivec2 texel = clamp(ivec2((ndc.xy * 0.5 + 0.5) * vec2(size)), ivec2(0), size - 1);
+        vec4 occ = texelFetch(rsm_position, texel, 0);
+        if (occ.w > 0.0) {
+            float receiver = light_kind == LIGHT_SUN ? dot(p_test, emit_axis) : length(p_test - light_pos_ws);
+            float occluder = light_kind == LIGHT_SUN ? dot(occ.xyz, emit_axis) : length(occ.xyz - light_pos_ws);
+            lit = receiver <= occluder + depth_bias_m ? 1.0 : 0.0;
+        }
+    }
+    vec4 acc = imageLoad(direct, px);
+    imageStore(direct, px, acc + vec4(irradiance * (lit / PI), 0.0));
+}

@@ -1,0 +1,7 @@
+// Camera G-buffer: world-space position, normal and diffuse albedo per pixel.
+void main() {
+    gl_Position = view_projection * vec4(pos_ws, 1.0);
+    v_pos_ws = pos_ws;
+    v_normal_ws = normal_ws;
+    v_albedo = albedo;
+}

@@ -1,0 +1,7 @@
+// Reflective shadow map (Dachsbacher & Stamminger 2005): the scene seen from one light face.
+void main() {
+    gl_Position = light_view_projection * vec4(pos_ws, 1.0);
+    v_pos_ws = pos_ws;
+    v_normal_ws = normal_ws;
+    v_albedo = albedo;
+}
