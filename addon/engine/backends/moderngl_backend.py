@@ -132,6 +132,10 @@ class ModernGLBackend(Backend):
 
     @property
     def renderer(self) -> str:
+        return self._renderer()
+
+    @_in_own_context
+    def _renderer(self) -> str:
         info = self.ctx.info
         return f"OpenGL {info['GL_VERSION']} / {info['GL_RENDERER']} (moderngl)"
 

@@ -40,7 +40,7 @@ def triangle_attributes(scene: Scene) -> dict[str, np.ndarray] | None:
 
 class DirectMethod:
     name = "direct"
-    products = ("direct",)
+    products = ("direct", "albedo")
 
     def __init__(self, backend: Backend, gi: GIConfig, rsm_config: RsmConfig):
         self.backend, self.gi, self.rsm_config = backend, gi, rsm_config
@@ -90,6 +90,7 @@ class DirectMethod:
                                      self.direct, view, self.rsm_config.depth_bias_m)
             with be.timed(timings, "readback"):
                 direct = be.read(self.direct)
-                coverage = be.read(self.gbuf["position"])[..., 3]
-        direct[..., 3] = coverage
-        return Result({"direct": np.ascontiguousarray(direct[::-1])}, timings)
+                albedo = be.read(self.gbuf["albedo"])  # alpha = coverage
+        direct[..., 3] = albedo[..., 3]
+        return Result({"direct": np.ascontiguousarray(direct[::-1]), "albedo": np.ascontiguousarray(albedo[::-1])},
+                      timings)

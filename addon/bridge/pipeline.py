@@ -1,0 +1,79 @@
+"""Runs a method on a .blend headless: open, capture, run, write EXRs and stats.json.
+
+Shared by `python -m addon render`, the demo and the benchmark. Outside Blender's UI the GPU work runs
+on the moderngl backend (EGL), as ARCHITECTURE.md section 2 says.
+"""
+
+from __future__ import annotations
+
+import json
+import statistics
+from pathlib import Path
+
+import bpy
+
+from ..engine import methods
+from ..engine.backends.moderngl_backend import ModernGLBackend
+from ..engine.config import GIConfig, RsmConfig
+from ..engine.errors import SceneError
+from . import images
+from .capture import SceneCache, image_size
+
+_backend = None
+
+
+def backend() -> ModernGLBackend:
+    """One moderngl context per process: contexts are expensive and programs are cached on it."""
+    global _backend
+    if _backend is None:
+        _backend = ModernGLBackend()
+    return _backend
+
+
+def open_blend(path: Path) -> None:
+    try:
+        bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
+    except RuntimeError as exc:
+        raise SceneError(f"cannot open {path}: {str(exc).strip().splitlines()[-1]}") from None
+
+
+def render_file(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, repeat: int = 3) -> dict:
+    """Render `blend` with gi.method; write <product>.exr for each product and stats.json; return stats.
+
+    The timing is the median of `repeat` full updates after one warm-up (programs compiled, geometry
+    uploaded): what a user waits for when a light moves.
+    """
+    open_blend(blend)
+    scene = bpy.context.scene
+    if scene.camera is None:
+        raise SceneError(f"{blend}: the scene has no camera")
+    width, height = image_size(scene, gi.resolution)
+    captured = SceneCache().update(bpy.context.evaluated_depsgraph_get(), width, height)
+    be = backend()
+    method = methods.get(gi.method)(be, gi, rsm)
+    method.set_scene(captured)
+    method.run()  # warm-up
+    runs = [method.run() for _ in range(repeat)]
+    result = runs[-1]
+    for name, pixels in result.images.items():
+        images.write_exr(out_dir / f"{name}.exr", pixels)
+    notes = list(captured.warnings)
+    if captured.triangle_count == 0:
+        notes.append("the scene has no geometry: all light is zero")
+    if not captured.lights and not captured.emission.any():
+        notes.append("the scene has no light sources: all light is zero")
+    stats = {
+        "method": gi.method,
+        "config": {"gi": gi.to_dict(), "rsm": rsm.to_dict()},
+        "image_size": [width, height],
+        "triangles": captured.triangle_count,
+        "lights": len(captured.lights),
+        "timings_ms": {k: statistics.median(r.timings_ms[k] for r in runs) for k in result.timings_ms},
+        "total_ms": statistics.median(r.timings_ms["total"] for r in runs),
+        "runs": repeat,
+        "renderer": be.renderer,
+        "blender_version": bpy.app.version_string,
+        "notes": notes,
+    }
+    (out_dir / "stats.json").write_text(json.dumps(stats, indent=2))
+    return stats

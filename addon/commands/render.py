@@ -1,0 +1,34 @@
+"""`python -m addon render F.blend --method M --out DIR [--res N]`: run a method headless."""
+
+from __future__ import annotations
+
+import json
+
+from ..engine.config import GIConfig, RsmConfig
+from ._args import existing_blend, output_dir
+
+NAME = "render"
+HELP = "render a .blend with a Bounce method: DIR/direct.exr, DIR/indirect.exr (indirect methods), stats.json"
+
+
+def add_arguments(p) -> None:
+    p.add_argument("blend", help=".blend file with a camera")
+    p.add_argument("--method", default="direct", help="GI method (direct, rsm, ...)")
+    p.add_argument("--out", required=True, help="output directory")
+    p.add_argument("--res", type=int, default=256, help="long side of the image in pixels (camera aspect kept)")
+    p.add_argument("--bounces", type=int, default=1)
+    p.add_argument("--rsm-res", type=int, default=256, help="RSM side in texels")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--repeat", type=int, default=3, help="timed runs after a warm-up (median reported)")
+
+
+def run(args) -> int:
+    gi = GIConfig(method=args.method, bounces=args.bounces, resolution=args.res, seed=args.seed)
+    rsm = RsmConfig(resolution=args.rsm_res)
+    blend = existing_blend(args.blend)
+    out = output_dir(args.out)
+    from ..bridge.pipeline import render_file  # imports bpy: only when actually rendering
+
+    stats = render_file(blend, out, gi, rsm, repeat=max(1, args.repeat))
+    print(json.dumps({"out": str(out), "total_ms": round(stats["total_ms"], 2), "notes": stats["notes"]}))
+    return 0
