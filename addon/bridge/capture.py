@@ -1,0 +1,426 @@
+"""Blender depsgraph -> engine Scene (numpy, world space, metres, Cycles' light units).
+
+What is captured, and why:
+- Geometry comes from the *evaluated* depsgraph (`depsgraph.object_instances`), so modifiers,
+  collection instances and geometry-nodes instances appear as Cycles renders them. Objects hidden from
+  render (`hide_render`, or every collection holding them hidden from render) and holdout objects are
+  left out; objects with `visible_camera` off are kept: Cycles still bounces light off them.
+- Triangles from `mesh.loop_triangles`; corner normals (`mesh.corner_normals`, which includes custom and
+  split normals) go to world space by the inverse transpose. Triangles with NaN/Inf corners or zero area
+  (after the transform) are dropped and counted in one warning.
+- Albedo is what Cycles' *Diffuse Color* pass shows: base colour x (1 - metallic) x (1 - transmission)
+  x the dielectric specular layer's attenuation (see `specular_layer_factor`). Emission is radiance
+  W/m^2/sr (colour x strength). Node setups we cannot read give albedo 0.8 and a warning, never silence.
+- Lengths are multiplied by `scene.unit_settings.scale_length` (Blender units -> metres). Light power
+  (W) and sun strength (W/m^2) are taken as they are: Cycles does not rescale them with the unit scale.
+- `SceneCache` keeps object-space triangles per instance, so an update that moves a light re-reads no
+  mesh and one that moves an object only re-applies its matrix.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import bpy
+import numpy as np
+
+from ..engine.scene import AREA_SHAPES, Camera, Light, Scene
+
+NEUTRAL_ALBEDO = 0.8  # Cycles' own fallback surface is a 0.8 grey diffuse
+
+# Dielectric layer attenuation of the diffuse lobe at normal incidence, measured on Cycles 5.0.1 (Diffuse
+# Color pass of a plane seen head-on, 1 spp): factor = 1 - F0 * K(roughness), F0 = ((ior-1)/(ior+1))^2
+# x 2 x Specular IOR Level. K is within 1 % for IOR 1.33-1.5 and levels 0.25-1 below roughness 0.6,
+# within 4-10 % at roughness 0.8-1 for high F0. Index = roughness 0, 0.1, ..., 1.
+_K_ROUGHNESS = np.array([1.0, 1.0, 0.9989, 0.9938, 0.9766, 0.9346, 0.8551, 0.7380, 0.5997, 0.4628, 0.3447])
+
+
+def specular_layer_factor(level: float, ior: float = 1.5, roughness: float = 0.5) -> float:
+    """How much Principled BSDF's dielectric layer scales the diffuse albedo (Cycles' Diffuse Color pass).
+
+    Exact 1 at level 0 (no layer). Measured at normal incidence: 0.9626 at the defaults (level 0.5,
+    IOR 1.5, roughness 0.5), 0.9254 at level 1. Cycles evaluates it per view direction: at 60 degrees
+    from the normal the default gives 0.932, at 75 degrees 0.878, at 85 degrees 0.813 (rougher: flatter,
+    smoother: steeper). A per-triangle albedo cannot hold that, so we keep the head-on value.
+    """
+    f0 = ((ior - 1.0) / (ior + 1.0)) ** 2 * 2.0 * max(level, 0.0)
+    k = float(np.interp(min(max(roughness, 0.0), 1.0), np.linspace(0.0, 1.0, 11), _K_ROUGHNESS))
+    return float(1.0 - min(f0, 1.0) * k)
+
+
+def _np(matrix) -> np.ndarray:
+    """mathutils.Matrix -> numpy row-major float64 (mathutils indexes [row][col] too)."""
+    return np.array([list(row) for row in matrix], dtype=np.float64)
+
+
+def _scale_matrix(s: float) -> np.ndarray:
+    return np.diag([s, s, s, 1.0])
+
+
+def image_size(scene, long_side: int) -> tuple[int, int]:
+    """(w, h) with the render's aspect ratio and the longer side `long_side` pixels."""
+    rx, ry = scene.render.resolution_x, scene.render.resolution_y
+    if rx >= ry:
+        return int(long_side), max(1, round(long_side * ry / rx))
+    return max(1, round(long_side * rx / ry)), int(long_side)
+
+
+def camera_for(scene_obj_camera, depsgraph, width: int, height: int) -> Camera:
+    """The camera object's view and OpenGL-style projection for a width x height image, in metres.
+
+    Lengths are scaled by the unit scale s, so view_m = S V S^-1 (rigid, translation in metres) and
+    projection_m = P S^-1 (clip planes in metres): view_projection of a point in metres equals Blender's
+    of the same point in Blender units.
+    """
+    cam = scene_obj_camera.evaluated_get(depsgraph)
+    r = depsgraph.scene.render
+    proj = _np(cam.calc_matrix_camera(depsgraph, x=int(width), y=int(height),
+                                      scale_x=r.pixel_aspect_x, scale_y=r.pixel_aspect_y))
+    view = _np(cam.matrix_world.inverted())
+    s = depsgraph.scene.unit_settings.scale_length or 1.0
+    S, S_inv = _scale_matrix(s), _scale_matrix(1.0 / s)
+    return Camera(view=S @ view @ S_inv, projection=proj @ S_inv, width=int(width), height=int(height))
+
+
+# --------------------------------------------------------------------------------------------- materials
+
+def _srgb_to_linear(c: np.ndarray) -> np.ndarray:
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+def _image_average(image) -> np.ndarray | None:
+    """Mean linear RGB of an image's pixels (byte sRGB images are linearised per pixel first)."""
+    w, h = image.size
+    if w * h == 0 or image.channels < 3:
+        return None
+    px = np.empty(w * h * image.channels, np.float32)
+    image.pixels.foreach_get(px)
+    rgb = px.reshape(-1, image.channels)[:, :3].astype(np.float64)
+    # Image.pixels of a byte image holds the file's encoded values; float buffers are already linear.
+    if not image.is_float and image.colorspace_settings.name.lower().startswith("srgb"):
+        rgb = _srgb_to_linear(rgb)
+    return rgb.mean(axis=0)
+
+
+def _input_color(node, name: str, problems: list[str], images: dict) -> np.ndarray:
+    """A colour input's value: its constant, an RGB node, or an Image Texture's average colour."""
+    sock = node.inputs[name]
+    if not sock.is_linked:
+        return np.array(sock.default_value[:3], np.float64)
+    src = sock.links[0].from_node
+    if src.type == "RGB":
+        return np.array(src.outputs[0].default_value[:3], np.float64)
+    if src.type in ("TEX_IMAGE", "TEX_ENVIRONMENT") and src.image is not None:
+        key = src.image.name
+        if key not in images:
+            images[key] = _image_average(src.image)
+        if images[key] is not None:
+            return images[key].copy()
+    problems.append(f"{name} <- {src.bl_idname} (constant used)")
+    return np.array(sock.default_value[:3], np.float64)
+
+
+def _input_float(node, name: str, problems: list[str]) -> float:
+    sock = node.inputs[name]
+    if sock.is_linked:
+        problems.append(f"{name} is linked (constant used)")
+    return float(sock.default_value)
+
+
+def _surface_node(tree, output_type: str, input_name: str):
+    """The node feeding the active output's `input_name`, or None."""
+    outs = [n for n in tree.nodes if n.type == output_type]
+    active = [n for n in outs if getattr(n, "is_active_output", False)] or outs
+    cycles = [n for n in active if getattr(n, "target", "ALL") in ("ALL", "CYCLES")] or active
+    if not cycles or not cycles[0].inputs[input_name].is_linked:
+        return None
+    return cycles[0].inputs[input_name].links[0].from_node
+
+
+def material_values(mat, images: dict | None = None) -> tuple[np.ndarray, np.ndarray, str | None]:
+    """(albedo, emission, warning or None) of a material, as Cycles' Diffuse Color pass and emission see it."""
+    images = {} if images is None else images
+    if mat is None:
+        return np.full(3, NEUTRAL_ALBEDO), np.zeros(3), None  # Cycles' default surface
+    if mat.node_tree is None:
+        return np.array(mat.diffuse_color[:3], np.float64), np.zeros(3), None
+    node = _surface_node(mat.node_tree, "OUTPUT_MATERIAL", "Surface")
+    problems: list[str] = []
+    if node is not None and node.type == "BSDF_PRINCIPLED":
+        base = _input_color(node, "Base Color", problems, images)
+        metallic = _input_float(node, "Metallic", problems)
+        transmission = _input_float(node, "Transmission Weight", problems)
+        level = _input_float(node, "Specular IOR Level", problems)
+        ior = _input_float(node, "IOR", problems)
+        rough = _input_float(node, "Roughness", problems)
+        albedo = base * (1 - metallic) * (1 - transmission) * specular_layer_factor(level, ior, rough)
+        for layer in ("Coat Weight", "Sheen Weight", "Subsurface Weight"):
+            if _input_float(node, layer, problems) > 0:
+                problems.append(f"{layer} > 0 ignored")
+        emission = _input_color(node, "Emission Color", problems, images) * _input_float(
+            node, "Emission Strength", problems)
+    elif node is not None and node.type == "EMISSION":
+        albedo = np.zeros(3)
+        emission = _input_color(node, "Color", problems, images) * _input_float(node, "Strength", problems)
+    elif node is not None and node.type == "BSDF_DIFFUSE":
+        albedo, emission = _input_color(node, "Color", problems, images), np.zeros(3)
+    else:
+        kind = "no surface" if node is None else node.bl_idname
+        return np.full(3, NEUTRAL_ALBEDO), np.zeros(3), (
+            f"material {mat.name!r}: unsupported surface ({kind}); albedo {NEUTRAL_ALBEDO} used")
+    warn = f"material {mat.name!r}: " + "; ".join(problems) if problems else None
+    return np.clip(albedo, 0.0, 1.0), np.maximum(emission, 0.0), warn
+
+
+def world_color(world, warnings: list[str]) -> np.ndarray:
+    """Constant world radiance: Background colour x strength (textures -> their average + a warning)."""
+    if world is None:
+        return np.zeros(3)
+    if world.node_tree is None:
+        return np.array(world.color[:3], np.float64)
+    node = _surface_node(world.node_tree, "OUTPUT_WORLD", "Surface")
+    if node is None:
+        return np.zeros(3)
+    if node.type != "BACKGROUND":
+        warnings.append(f"world {world.name!r}: unsupported surface ({node.bl_idname}); black used")
+        return np.zeros(3)
+    problems: list[str] = []
+    color = _input_color(node, "Color", problems, {}) * _input_float(node, "Strength", problems)
+    if node.inputs["Color"].is_linked:  # an average stands in for any texture: say so
+        problems.append("textured background replaced by its average colour")
+    if problems:
+        warnings.append(f"world {world.name!r}: " + "; ".join(problems))
+    return np.maximum(color, 0.0)
+
+
+# ----------------------------------------------------------------------------------------------- geometry
+
+@dataclass
+class _Block:
+    """One instance's triangles in object space, plus what is needed to put them in the world."""
+
+    local_pos: np.ndarray      # (n, 3, 3) float64, Blender units, object space
+    local_nrm: np.ndarray      # (n, 3, 3) float64, object space
+    mat_index: np.ndarray      # (n,) int, material slot per triangle
+    source: str                # name of the object whose geometry this is (for update tagging)
+    instancer: str             # name of the instancing object ("" for a plain object)
+    fingerprint: tuple = ()    # identity of the evaluated geometry (see _fingerprint)
+    matrix: np.ndarray | None = None
+    world: tuple | None = None  # cached (positions_m, normals, keep mask, dropped count)
+
+
+def _read_local(obj) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """Object-space triangles, corner normals and material indices of an evaluated object."""
+    mesh, tmp = None, False
+    if obj.type == "MESH":
+        mesh = obj.data
+    elif obj.type in ("CURVE", "FONT", "SURFACE", "META"):
+        mesh, tmp = obj.to_mesh(), True
+    if mesh is None:
+        return None
+    try:
+        mesh.calc_loop_triangles()
+        nt, nv, nl = len(mesh.loop_triangles), len(mesh.vertices), len(mesh.loops)
+        co = np.empty(nv * 3, np.float64)
+        mesh.vertices.foreach_get("co", co)
+        tri_v = np.empty(nt * 3, np.int64)
+        tri_l = np.empty(nt * 3, np.int64)
+        mi = np.empty(nt, np.int64)
+        mesh.loop_triangles.foreach_get("vertices", tri_v)
+        mesh.loop_triangles.foreach_get("loops", tri_l)
+        mesh.loop_triangles.foreach_get("material_index", mi)
+        cn = np.empty(nl * 3, np.float64)
+        mesh.corner_normals.foreach_get("vector", cn)  # 4.1+: custom/split normals included
+    finally:
+        if tmp:
+            obj.to_mesh_clear()
+    pos = co.reshape(-1, 3)[tri_v].reshape(nt, 3, 3)
+    nrm = cn.reshape(-1, 3)[tri_l].reshape(nt, 3, 3)
+    return pos, nrm, mi
+
+
+def _fingerprint(obj) -> tuple:
+    """Identity of an evaluated object's geometry. Re-evaluating geometry (a modifier or mesh change
+    under modifiers) gives a new evaluated mesh with a new session_uid/pointer; a transform does not.
+    A safety net for calls outside depsgraph_update_post, where depsgraph.updates is empty."""
+    data = obj.data
+    if data is None:
+        return ()
+    counts = (len(data.vertices), len(data.polygons)) if obj.type == "MESH" else ()
+    return (data.session_uid, data.as_pointer(), *counts)
+
+
+def _to_world(block: _Block, scale: float) -> tuple:
+    """World positions (metres) and normals of a block; drops NaN/Inf and zero-area triangles."""
+    m = block.matrix
+    pos = (block.local_pos @ m[:3, :3].T + m[:3, 3]) * scale
+    nrm = block.local_nrm @ np.linalg.inv(m[:3, :3])  # row vectors: n^T M^-1 = (M^-T n)^T
+    nrm /= np.maximum(np.linalg.norm(nrm, axis=-1, keepdims=True), 1e-30)
+    if np.linalg.det(m[:3, :3]) < 0:  # a mirror flips winding: keep it consistent with the normals
+        pos, nrm = pos[:, [0, 2, 1]], nrm[:, [0, 2, 1]]
+    area2 = np.linalg.norm(np.cross(pos[:, 1] - pos[:, 0], pos[:, 2] - pos[:, 0]), axis=-1)
+    keep = np.isfinite(pos).all(axis=(1, 2)) & np.isfinite(nrm).all(axis=(1, 2)) & (area2 > 0)
+    keep &= np.isfinite(area2)
+    return pos[keep].astype(np.float32), nrm[keep].astype(np.float32), keep, int((~keep).sum())
+
+
+def _render_hidden(obj) -> bool:
+    """Left out of a final render: hide_render, holdout, or all its collections hidden from render."""
+    o = obj.original
+    if o.hide_render or getattr(o, "is_holdout", False):
+        return True
+    cols = o.users_collection
+    return bool(cols) and all(c.hide_render for c in cols)
+
+
+def _light(obj, m: np.ndarray, scale: float, warnings: list[str]) -> Light | None:
+    """A Light from an evaluated lamp object and its world matrix (Blender units)."""
+    ld = obj.data
+    kind = ld.type
+    if kind not in ("POINT", "SPOT", "SUN", "AREA"):
+        warnings.append(f"light {obj.name!r}: type {kind} not supported, left out")
+        return None
+    axis_len = np.linalg.norm(m[:3, :3], axis=0)  # world length of local X, Y, Z
+    kw = dict(kind=kind, position_m=m[:3, 3] * scale, direction=-m[:3, 2], color=np.array(ld.color[:3]),
+              axis_x=m[:3, 0] / max(axis_len[0], 1e-30), name=obj.name)
+    if kind == "SUN":
+        kw.update(sun_strength=float(ld.energy), sun_angle_rad=float(ld.angle))
+    else:
+        kw["power_w"] = float(ld.energy)
+    if kind == "SPOT":
+        kw.update(spot_size_rad=float(ld.spot_size), spot_blend=float(ld.spot_blend))
+    if kind in ("POINT", "SPOT") and ld.shadow_soft_size > 0:
+        warnings.append(f"light {obj.name!r}: radius {ld.shadow_soft_size:g} treated as a point light")
+    if kind == "AREA":
+        shape = ld.shape if ld.shape in AREA_SHAPES else "SQUARE"
+        sy = ld.size_y if shape in ("RECTANGLE", "ELLIPSE") else ld.size
+        # Cycles sizes an area light by its object scale too.
+        kw.update(area_shape=shape, size_x_m=float(ld.size * axis_len[0] * scale),
+                  size_y_m=float(sy * axis_len[1] * scale))
+    return Light(**kw)
+
+
+class SceneCache:
+    """Incremental capture: object-space triangles per instance survive between updates.
+
+    `update(depsgraph)` re-triangulates only instances that are new, whose object (or instancer) a
+    depsgraph update tagged with is_updated_geometry, or whose evaluated mesh is a new one (fingerprint);
+    a transform-only change re-applies the matrix to the cached object-space arrays. Call it from
+    bpy.app.handlers.depsgraph_update_post: outside it depsgraph.updates is empty, and only the
+    fingerprint sees changes (it misses in-place vertex edits of a mesh without modifiers).
+    Lights, camera, world and materials are re-read every time (cheap;
+    image averages are cached until an Image update). `geometry_reads` counts re-triangulated meshes.
+    """
+
+    def __init__(self):
+        self.blocks: dict[tuple, _Block] = {}
+        self.images: dict[str, np.ndarray | None] = {}
+        self.geometry_reads = 0
+        self.scene: Scene | None = None
+        self._dirty: set[str] = set()
+
+    def note(self, depsgraph) -> None:
+        """Remember what a depsgraph update tagged. `update` calls it itself; call it from every
+        depsgraph_update_post whose update you skip (throttling), or edits made then are missed.
+        depsgraph.updates is only filled inside that handler."""
+        for u in depsgraph.updates:
+            if isinstance(u.id, bpy.types.Object) and u.is_updated_geometry:
+                self._dirty.add(u.id.original.name)
+            elif isinstance(u.id, bpy.types.Image):
+                self.images.pop(u.id.original.name, None)
+
+    def invalidate(self) -> None:
+        """Forget everything: the next update re-reads every mesh."""
+        self.blocks.clear()
+        self.images.clear()
+
+    def update(self, depsgraph, width: int | None = None, height: int | None = None) -> Scene:
+        scene_bl = depsgraph.scene
+        scale = scene_bl.unit_settings.scale_length or 1.0
+        self.note(depsgraph)
+        dirty, self._dirty = self._dirty, set()
+        out = Scene()
+        seen: dict[tuple, _Block] = {}
+        lights: list[Light] = []
+        mats: dict[str, tuple] = {}
+        parts: list[tuple] = []
+        for inst in depsgraph.object_instances:
+            obj = inst.object
+            if inst.is_instance:
+                # An instanced object's own hide_render counts; its collection's does not (instancing
+                # collections are usually hidden or excluded themselves).
+                if _render_hidden(inst.parent) or obj.original.hide_render:
+                    continue
+            elif not inst.show_self or _render_hidden(obj):
+                continue
+            m = _np(inst.matrix_world)
+            if obj.type == "LIGHT":
+                light = _light(obj, m, scale, out.warnings)
+                if light is not None:
+                    lights.append(light)
+                continue
+            if obj.type not in ("MESH", "CURVE", "FONT", "SURFACE", "META"):
+                continue
+            source = obj.original.name
+            instancer = inst.parent.original.name if inst.is_instance else ""
+            key = (source, instancer, tuple(inst.persistent_id) if inst.is_instance else ())
+            block = self.blocks.get(key)
+            fp = _fingerprint(obj)
+            if block is None or source in dirty or instancer in dirty or block.fingerprint != fp:
+                local = _read_local(obj)
+                self.geometry_reads += 1
+                if local is None:
+                    continue
+                block = _Block(*local, source=source, instancer=instancer, fingerprint=fp)
+            if block.matrix is None or block.world is None or not np.array_equal(block.matrix, m):
+                block.matrix, block.world = m, None
+            if block.world is None:
+                block.world = _to_world(block, scale)
+            slots = [s.material for s in obj.material_slots]
+            seen[key] = block
+            parts.append(self._material_arrays(block, slots, mats))
+        self.blocks = seen
+        out.lights = lights
+        dropped = sum(b.world[3] for b in seen.values())
+        if dropped:
+            out.warnings.append(f"{dropped} triangles with NaN/Inf corners or zero area dropped")
+        for _, _, warn in mats.values():
+            if warn:
+                out.warnings.append(warn)
+        out.world_color = world_color(scene_bl.world, out.warnings).astype(np.float32)
+        if scene_bl.camera is not None:
+            if width is None or height is None:
+                pct = scene_bl.render.resolution_percentage / 100.0
+                width = max(1, round(scene_bl.render.resolution_x * pct))
+                height = max(1, round(scene_bl.render.resolution_y * pct))
+            out.camera = camera_for(scene_bl.camera, depsgraph, width, height)
+        if parts:
+            out.positions_m = np.concatenate([p[0] for p in parts])
+            out.normals = np.concatenate([p[1] for p in parts])
+            out.albedo = np.concatenate([p[2] for p in parts]).astype(np.float32)
+            out.emission = np.concatenate([p[3] for p in parts]).astype(np.float32)
+        self.scene = out
+        return out
+
+    def _material_arrays(self, block: _Block, slots: list, mats: dict) -> tuple:
+        """A block's world triangles with per-triangle albedo/emission looked up from its material slots."""
+        pos, nrm, keep, _ = block.world
+        table_a, table_e = [], []
+        for mat in slots or [None]:
+            key = mat.name if mat is not None else None
+            if key not in mats:
+                mats[key] = material_values(mat, self.images)
+            table_a.append(mats[key][0])
+            table_e.append(mats[key][1])
+        idx = np.clip(block.mat_index[keep], 0, len(table_a) - 1)  # Cycles clamps the index too
+        return pos, nrm, np.asarray(table_a).reshape(-1, 3)[idx], np.asarray(table_e).reshape(-1, 3)[idx]
+
+
+def capture(depsgraph, width: int | None = None, height: int | None = None) -> Scene:
+    """The whole scene of an evaluated depsgraph (see the module docstring); width/height: image size
+    for the camera (default: render resolution x percentage). No camera -> Scene.camera is None."""
+    return SceneCache().update(depsgraph, width, height)
+
+
+__all__ = ["capture", "camera_for", "image_size", "SceneCache", "material_values", "specular_layer_factor",
+           "world_color", "NEUTRAL_ALBEDO"]

@@ -1,0 +1,107 @@
+"""EXR input/output with OpenImageIO only (no bpy), so references can be read outside Blender.
+
+Arrays are float32 (h, w, c) with row 0 = the TOP of the image (EXR order; GL read-backs must be
+flipped before writing). Channels are R, G, B[, A]. Pixels are written as 32-bit FLOAT: half floats
+lose ~3 decimal digits, which is more than the noise floor we want to measure.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import OpenImageIO as oiio
+
+from ..engine.errors import SceneError
+
+_CHANNELS = {3: ("R", "G", "B"), 4: ("R", "G", "B", "A")}
+
+
+def write_exr(path, pixels) -> None:
+    """Write float32 (h, w, 3|4) pixels, row 0 = top, as a single-part FLOAT EXR."""
+    px = np.ascontiguousarray(pixels, dtype=np.float32)
+    if px.ndim != 3 or px.shape[2] not in _CHANNELS:
+        raise ValueError(f"write_exr wants (h, w, 3|4) pixels, got shape {px.shape}")
+    h, w, c = px.shape
+    spec = oiio.ImageSpec(w, h, c, oiio.FLOAT)
+    spec.channelnames = _CHANNELS[c]
+    if c == 4:
+        spec.alpha_channel = 3
+    spec.attribute("compression", "zip")  # lossless
+    out = oiio.ImageOutput.create(str(path))
+    if out is None or not out.open(str(path), spec):
+        raise SceneError(f"cannot write {path}: {oiio.geterror() or (out and out.geterror())}")
+    try:
+        if not out.write_image(px):
+            raise SceneError(f"cannot write {path}: {out.geterror()}")
+    finally:
+        out.close()
+
+
+def _open(path) -> oiio.ImageInput:
+    if not Path(path).is_file():
+        raise SceneError(f"no such image: {path}")
+    inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        raise SceneError(f"cannot read image {path}: {oiio.geterror()}")
+    return inp
+
+
+def _read_subimage(inp: oiio.ImageInput, sub: int, path) -> tuple[np.ndarray, list[str]]:
+    """Pixels and channel names of one subimage. Name the subimage explicitly: in OIIO 3.0 the
+    short read_image(chbegin, chend, format) form leaves inp.spec() pointing at subimage 0."""
+    if not inp.seek_subimage(sub, 0):
+        raise SceneError(f"cannot read image {path}: no subimage {sub}")
+    spec = inp.spec()
+    names = list(spec.channelnames)
+    px = inp.read_image(sub, 0, 0, spec.nchannels, oiio.FLOAT)
+    if px is None:
+        raise SceneError(f"cannot read image {path}: {inp.geterror()}")
+    return np.asarray(px, dtype=np.float32).reshape(spec.height, spec.width, spec.nchannels), names
+
+
+def read_exr(path) -> np.ndarray:
+    """The first subimage of an image file as float32 (h, w, c), row 0 = top."""
+    inp = _open(path)
+    try:
+        return _read_subimage(inp, 0, path)[0]
+    finally:
+        inp.close()
+
+
+def read_multilayer(path) -> dict[str, np.ndarray]:
+    """Blender's multi-layer EXR as {pass name: float32 (h, w, c)}.
+
+    Blender 5.0 writes each pass as its own subimage (part) with channels "<view layer>.<pass>.<chan>",
+    e.g. "ViewLayer.Diffuse Indirect.R"; Combined is "ViewLayer.Combined.R/G/B/A". Channels are put
+    in R, G, B, A (or X, Y, Z, ...) order as Blender wrote them; a subimage holding several passes
+    (older writers put all passes in one part) is split by pass name. Only the first view layer found
+    is kept under the bare pass name; others (rare in our scenes) are keyed "<layer>.<pass>".
+    """
+    inp = _open(path)
+    passes: dict[str, np.ndarray] = {}
+    first_layer = None
+    try:
+        sub = 0
+        while inp.seek_subimage(sub, 0):
+            px, names = _read_subimage(inp, sub, path)
+            groups: dict[str, list[int]] = {}
+            for i, name in enumerate(names):
+                parts = name.split(".")
+                if len(parts) >= 3:  # layer.pass.channel (pass names may not contain dots in Blender)
+                    layer, pname = parts[0], ".".join(parts[1:-1])
+                elif len(parts) == 2:  # pass.channel without a layer
+                    layer, pname = "", parts[0]
+                else:
+                    layer, pname = "", "Combined"
+                first_layer = layer if first_layer is None else first_layer
+                key = pname if layer == first_layer else f"{layer}.{pname}"
+                groups.setdefault(key, []).append(i)
+            for key, idx in groups.items():
+                passes[key] = np.ascontiguousarray(px[:, :, idx])
+            sub += 1
+    finally:
+        inp.close()
+    if not passes:
+        raise SceneError(f"no passes in {path}")
+    return passes

@@ -1,0 +1,231 @@
+"""Cycles reference renders (ARCHITECTURE.md section 6): the ground truth every method is measured by.
+
+Cycles is configured so that its Diffuse Direct / Indirect / Color passes are an unbiased, per-pixel
+(point-sampled) estimate of exactly what a Bounce method computes: `bounces` diffuse bounces and
+nothing else, no clamping, no denoising, no adaptive sampling, a 0.01 px pixel filter, and a
+transparent film so that Combined alpha is the geometry mask.
+
+Output of render_reference(): out_dir/indirect.exr, direct.exr, albedo.exr, each RGBA float32 with
+A = Combined alpha (geometry mask; `compare` uses it when the file is the reference), and stats.json.
+"""
+
+from __future__ import annotations
+
+import json
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ..engine.errors import ConfigError, SceneError
+from ..engine.metrics import compare
+from . import images
+
+PASSES = {"indirect": "Diffuse Indirect", "direct": "Diffuse Direct", "albedo": "Diffuse Color"}
+
+
+def check_settings(spp: int, bounces: int, res: int) -> None:
+    """Raise ConfigError (CLI: exit 2, one line) for values outside what a reference can be."""
+    if spp < 1:
+        raise ConfigError(f"--spp must be >= 1, got {spp}")
+    if not 1 <= bounces <= 8:
+        raise ConfigError(f"--bounces must be in 1..8, got {bounces}")
+    if not 8 <= res <= 8192:
+        raise ConfigError(f"--res must be in 8..8192, got {res}")
+
+
+def image_size(res_x: int, res_y: int, res: int) -> tuple[int, int]:
+    """(width, height) with the long side = res and the scene's aspect res_x:res_y kept."""
+    if res_x >= res_y:
+        return res, max(1, round(res * res_y / res_x))
+    return max(1, round(res * res_x / res_y)), res
+
+
+def _open_blend(blend_path):
+    import bpy
+
+    p = Path(blend_path)
+    if not p.is_file():
+        raise SceneError(f"no such file: {blend_path}")
+    try:
+        bpy.ops.wm.open_mainfile(filepath=str(p), load_ui=False)
+    except RuntimeError as exc:  # bpy reports unreadable files as RuntimeError
+        raise SceneError(f"cannot open {blend_path}: {str(exc).strip().splitlines()[-1]}") from None
+    scene = bpy.context.scene
+    if scene.camera is None:
+        raise SceneError(f"{blend_path}: the scene has no camera")
+    return bpy, scene
+
+
+def _use_gpu_if_any(bpy, scene) -> str:
+    """Pick a Cycles GPU device when Cycles reports one, else CPU. Returns a description."""
+    scene.cycles.device = "CPU"
+    try:
+        prefs = bpy.context.preferences.addons["cycles"].preferences
+        available = {t[0] for t in prefs.get_device_types(bpy.context)}
+        for kind in ("OPTIX", "CUDA", "HIP", "METAL", "ONEAPI"):
+            if kind not in available:
+                continue
+            gpus = [d for d in prefs.get_devices_for_type(kind) if d.type == kind]
+            if gpus:
+                prefs.compute_device_type = kind
+                for d in prefs.get_devices_for_type(kind):
+                    d.use = d.type == kind  # GPU only: CPU+GPU mixing changes timings run to run
+                scene.cycles.device = "GPU"
+                return f"{kind}: " + ", ".join(d.name for d in gpus)
+    except (KeyError, AttributeError, TypeError):
+        pass  # no cycles preferences (should not happen): CPU is always correct
+    return "CPU"
+
+
+def _configure(bpy, scene, spp, bounces, width, height, seed, exr_path) -> dict:
+    r, c = scene.render, scene.cycles
+    r.engine = "CYCLES"
+    r.resolution_x, r.resolution_y, r.resolution_percentage = width, height, 100
+    r.use_border = False
+    r.film_transparent = True  # Combined alpha = geometry mask
+    r.filter_size = 0.01  # Workbench/EEVEE's filter; Cycles reads cycles.filter_width (set below)
+    r.use_motion_blur = False
+    r.use_compositing = False  # the passes must come straight from the renderer
+    r.use_sequencer = False
+    r.use_single_layer = True
+    r.use_persistent_data = False
+    c.samples = spp
+    c.use_adaptive_sampling = False  # adaptive sampling stops early where the estimate looks converged
+    c.use_denoising = False
+    c.seed, c.use_animated_seed = seed, False
+    c.diffuse_bounces = c.max_bounces = bounces
+    c.glossy_bounces = c.transmission_bounces = c.volume_bounces = c.transparent_max_bounces = 0
+    c.caustics_reflective = c.caustics_refractive = False
+    c.sample_clamp_indirect = 0.0  # default 10 clips bright indirect paths: a bias
+    c.sample_clamp_direct = 0.0
+    c.time_limit = 0.0
+    c.filter_width = 0.01  # point-sampled pixel centres, as a G-buffer sees them
+    device = _use_gpu_if_any(bpy, scene)
+    vl = bpy.context.view_layer
+    vl.use_pass_combined = True
+    vl.use_pass_diffuse_direct = vl.use_pass_diffuse_indirect = vl.use_pass_diffuse_color = True
+    im = r.image_settings
+    im.media_type = "MULTI_LAYER_IMAGE"  # 5.0: must come before the file format (FACTS.md)
+    im.file_format = "OPEN_EXR_MULTILAYER"
+    im.color_depth = "32"
+    im.exr_codec = "ZIP"
+    r.filepath = str(exr_path)
+    r.use_file_extension = False
+    settings = {
+        k: getattr(c, k)
+        for k in (
+            "samples", "seed", "diffuse_bounces", "max_bounces", "glossy_bounces", "transmission_bounces",
+            "volume_bounces", "transparent_max_bounces", "caustics_reflective", "caustics_refractive",
+            "sample_clamp_direct", "sample_clamp_indirect", "filter_width", "use_adaptive_sampling",
+            "use_denoising", "use_light_tree", "use_guiding", "pixel_filter_type",
+        )
+    }
+    settings["film_transparent"] = r.film_transparent
+    return {"device": device, "cycles": settings}
+
+
+def _render(bpy, exr_path) -> float:
+    """Render and save the multi-layer EXR; returns the render call's wall time in seconds.
+
+    The time covers what a user waits for in Cycles: scene sync, BVH build and sampling. The EXR is
+    written after the timed call (Image.save_render), so file I/O is not counted.
+    """
+    t0 = time.perf_counter()
+    bpy.ops.render.render(write_still=False)
+    elapsed = time.perf_counter() - t0
+    bpy.data.images["Render Result"].save_render(filepath=str(exr_path))
+    if not Path(exr_path).is_file():
+        raise SceneError("Cycles wrote no image (render cancelled or failed)")
+    return elapsed
+
+
+def render_reference(blend_path, out_dir, spp: int = 1024, bounces: int = 1, res: int = 256,
+                     seed: int = 0) -> dict:
+    """Render the Cycles reference of `blend_path` into `out_dir` (see module docstring).
+
+    Returns the stats dict also written to out_dir/stats.json. Raises ConfigError for values out of
+    range and SceneError for a missing/unreadable file or a scene without a camera. Opens the file in
+    the running Blender session (the current file is replaced).
+    """
+    check_settings(spp, bounces, res)
+    bpy, scene = _open_blend(blend_path)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    width, height = image_size(scene.render.resolution_x, scene.render.resolution_y, res)
+    with tempfile.TemporaryDirectory(prefix="bounce_ref_") as tmp:
+        exr = Path(tmp) / "passes.exr"
+        info = _configure(bpy, scene, spp, bounces, width, height, seed, exr)
+        render_time = _render(bpy, exr)
+        layers = images.read_multilayer(exr)
+    missing = [p for p in (*PASSES.values(), "Combined") if p not in layers]
+    if missing:
+        raise SceneError(f"the render has no {', '.join(missing)} pass (found {sorted(layers)})")
+    alpha = layers["Combined"][:, :, 3:4]
+    for name, pass_name in PASSES.items():
+        images.write_exr(out / f"{name}.exr", np.concatenate([layers[pass_name][:, :, :3], alpha], axis=2))
+    stats = {
+        "renderer": "cycles",
+        "blend": str(Path(blend_path).resolve()),
+        "render_time_s": render_time,
+        "spp": spp,
+        "bounces": bounces,
+        "res": res,
+        "width": width,
+        "height": height,
+        "seed": seed,
+        "blender_version": bpy.app.version_string,
+        **info,
+    }
+    (out / "stats.json").write_text(json.dumps(stats, indent=2))
+    return stats
+
+
+def _masked_compare(test_dir, ref_dir, name="indirect") -> dict:
+    a = images.read_exr(Path(test_dir) / f"{name}.exr")
+    b = images.read_exr(Path(ref_dir) / f"{name}.exr")
+    return compare(a[:, :, :3], b[:, :, :3], b[:, :, 3] > 0.5)
+
+
+def noise_floor(blend, spp: int, bounces: int = 1, res: int = 256, seeds=(0, 1)) -> dict:
+    """compare() of two references that differ only in seed: the error the reference itself carries.
+
+    Indirect pass, seeds[1] measured against seeds[0], masked by seeds[0]'s alpha. Extra keys: spp,
+    seeds, time_s (the render times). For a reference of N spp, the error of that reference against
+    the (unknown) exact image is about this value / sqrt(2).
+    """
+    with tempfile.TemporaryDirectory(prefix="bounce_noise_") as tmp:
+        dirs = [Path(tmp) / f"seed{s}" for s in seeds[:2]]
+        times = [render_reference(blend, d, spp, bounces, res, s)["render_time_s"]
+                 for d, s in zip(dirs, seeds[:2], strict=True)]
+        result = _masked_compare(dirs[1], dirs[0])
+    return {**result, "spp": spp, "seeds": list(seeds[:2]), "time_s": times}
+
+
+def cycles_curve(blend, spp_list, bounces: int, res: int, reference_dir) -> list[dict]:
+    """Cycles' error-vs-time curve: one render per spp, measured against reference_dir/indirect.exr.
+
+    The renders use seed = reference seed + 1: with the reference's own seed the first N samples
+    would be the reference's first N samples and the error would be under-estimated. The reference
+    must have the same bounces and res (checked via its stats.json when present).
+    """
+    ref = Path(reference_dir)
+    if not (ref / "indirect.exr").is_file():
+        raise SceneError(f"no reference at {ref}/indirect.exr")
+    ref_seed = 0
+    if (ref / "stats.json").is_file():
+        st = json.loads((ref / "stats.json").read_text())
+        ref_seed = int(st.get("seed", 0))
+        if st.get("bounces", bounces) != bounces or st.get("res", res) != res:
+            raise ConfigError(f"reference {ref} has bounces={st.get('bounces')} res={st.get('res')}, "
+                              f"asked for bounces={bounces} res={res}")
+    curve = []
+    with tempfile.TemporaryDirectory(prefix="bounce_curve_") as tmp:
+        for spp in sorted(spp_list):
+            d = Path(tmp) / f"spp{spp}"
+            stats = render_reference(blend, d, spp, bounces, res, ref_seed + 1)
+            m = _masked_compare(d, ref)
+            curve.append({"spp": spp, "time_s": stats["render_time_s"], "rel_rmse": m["rel_rmse"],
+                          "rel_rmse_8": m["rel_rmse_8"], "bias": m["bias"]})
+    return curve

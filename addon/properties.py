@@ -1,0 +1,92 @@
+"""Scene settings: `scene.bounce`, generated from the engine's config dataclasses.
+
+GIConfig and RsmConfig both have a `resolution`, so each config gets its own group
+(`scene.bounce.gi.resolution`, `scene.bounce.rsm.resolution`) and keeps the dataclass's field names.
+Names, defaults, limits and enum items come from `config.limits()`, so the UI cannot drift from what
+the engine validates.
+"""
+
+from __future__ import annotations
+
+import bpy
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
+
+from .engine import config
+
+# Group attribute on scene.bounce -> the config it mirrors.
+CONFIGS = {"gi": config.GIConfig, "rsm": config.RsmConfig}
+
+
+_ACRONYMS = {"vpl", "rsm", "lpv", "vct", "sh"}
+_UNITS = {"m": "m", "mb": "MB", "ms": "ms"}
+
+
+def _label(name: str) -> str:
+    # Config names carry their unit as a suffix (`depth_bias_m`); the UI shows "Depth Bias (m)".
+    words = name.split("_")
+    unit = _UNITS.get(words[-1]) if len(words) > 1 else None
+    if unit:
+        words = words[:-1]
+    label = " ".join(w.upper() if w in _ACRONYMS else w.title() for w in words)
+    return f"{label} ({unit})" if unit else label
+
+
+def _property(name: str, spec: dict):
+    label = _label(name)
+    doc = spec.get("doc", "")
+    if "choices" in spec:
+        items = [(c, c.replace("-", " ").title(), "") for c in spec["choices"]]
+        return EnumProperty(name=label, description=doc, items=items, default=spec["default"])
+    default = spec["default"]
+    if isinstance(default, int) and not isinstance(default, bool):
+        return IntProperty(name=label, description=doc, default=default, min=spec["min"], max=spec["max"])
+    if isinstance(default, float):
+        return FloatProperty(
+            name=label, description=doc, default=default, min=spec["min"], max=spec["max"], precision=4
+        )
+    raise TypeError(f"no Blender property for config field {name!r} (default {default!r}): add one here")
+
+
+def _group(attr: str, cls) -> type:
+    annotations = {name: _property(name, spec) for name, spec in config.limits(cls).items()}
+    return type(f"BOUNCE_PG_{attr}", (bpy.types.PropertyGroup,), {"__annotations__": annotations})
+
+
+_GROUPS = {attr: _group(attr, cls) for attr, cls in CONFIGS.items()}
+
+
+class BOUNCE_PG_settings(bpy.types.PropertyGroup):
+    __annotations__ = {
+        "enabled": BoolProperty(name="Enabled", description="Show Bounce's indirect light", default=False),
+        **{attr: PointerProperty(type=group) for attr, group in _GROUPS.items()},
+    }
+
+
+classes = (*_GROUPS.values(), BOUNCE_PG_settings)
+
+
+def _from_blender(value):
+    # Blender stores floats in 32 bits: 0.01 comes back as 0.0099999998; 7 significant digits is
+    # what float32 holds, and restores the value the user typed.
+    return float(f"{value:.7g}") if isinstance(value, float) else value
+
+
+def to_config(settings) -> tuple[config.GIConfig, config.RsmConfig]:
+    """scene.bounce -> (GIConfig, RsmConfig); raises ConfigError as the engine would."""
+    configs = []
+    for attr, cls in CONFIGS.items():
+        group = getattr(settings, attr)
+        configs.append(cls(**{name: _from_blender(getattr(group, name)) for name in config.limits(cls)}))
+    return tuple(configs)
+
+
+def register() -> None:
+    for cls in classes:
+        bpy.utils.register_class(cls)
+    bpy.types.Scene.bounce = PointerProperty(type=BOUNCE_PG_settings)
+
+
+def unregister() -> None:
+    del bpy.types.Scene.bounce
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,32 @@
+"""BOUNCE_PT_main: Properties > Render > Bounce. Draws scene.bounce; no logic."""
+
+from __future__ import annotations
+
+import bpy
+
+from ..addon.properties import CONFIGS
+
+
+class BOUNCE_PT_main(bpy.types.Panel):
+    bl_label = "Bounce"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "render"
+
+    def draw_header(self, context):
+        self.layout.prop(context.scene.bounce, "enabled", text="")
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        settings = context.scene.bounce
+        layout.active = settings.enabled
+        # Every field of each group, in the config's order: a new config field appears without edits here.
+        for attr in CONFIGS:
+            group = getattr(settings, attr)
+            column = layout.column(heading=attr.upper())
+            for name in group.bl_rna.properties.keys():
+                if name not in {"rna_type", "name"}:
+                    column.prop(group, name)
+        layout.operator("bounce.report_renderer", icon="INFO")

@@ -1,0 +1,199 @@
+"""Registering the repository as a Blender add-on: round trips leave nothing behind, settings mirror the
+engine's configs and survive a save and reload.
+
+The repository root is imported as a package named `bounce` (through a symlink), as Blender imports it:
+that is what makes the relative imports between addon/, operators/ and panels/ resolve.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+import sys
+from pathlib import Path
+
+import pytest
+
+bpy = pytest.importorskip("bpy")
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def bounce(tmp_path_factory):
+    link_dir = tmp_path_factory.mktemp("pkg")
+    (link_dir / "bounce").symlink_to(ROOT, target_is_directory=True)
+    sys.path.insert(0, str(link_dir))
+    try:
+        yield importlib.import_module("bounce")
+    finally:
+        sys.path.remove(str(link_dir))
+
+
+@pytest.fixture
+def registered(bounce, fresh_blend):
+    bounce.register()
+    yield bounce
+    bounce.unregister()
+
+
+def _handler_counts() -> dict[str, int]:
+    handlers = bpy.app.handlers
+    return {name: len(getattr(handlers, name)) for name in dir(handlers) if isinstance(getattr(handlers, name), list)}
+
+
+def _operator_registered() -> bool:
+    try:
+        bpy.ops.bounce.report_renderer.get_rna_type()
+    except KeyError:
+        return False
+    return True
+
+
+def _all_classes(bounce) -> list[type]:
+    from bounce.addon import preferences, properties
+
+    return [*properties.classes, preferences.BOUNCE_AP_preferences, *bounce.operators.classes, *bounce.panels.classes]
+
+
+def test_register_unregister_twice_leaves_nothing_behind(bounce, fresh_blend):
+    before = _handler_counts()
+    assert "load_post" in before and "depsgraph_update_post" in before
+    classes = _all_classes(bounce)
+    assert len(classes) == 6
+    for _ in range(2):
+        bounce.register()
+        try:
+            assert isinstance(bpy.context.scene.bounce, bpy.types.PropertyGroup)
+            assert _operator_registered()
+            assert all(cls.is_registered for cls in classes)
+        finally:
+            bounce.unregister()
+        assert not hasattr(bpy.types.Scene, "bounce")
+        assert not _operator_registered()
+        assert not any(cls.is_registered for cls in classes)
+        assert _handler_counts() == before
+
+
+def test_preferences_idname_is_the_package_name(registered):
+    from bounce.addon.preferences import BOUNCE_AP_preferences
+
+    assert BOUNCE_AP_preferences.bl_idname == "bounce"
+    rna = BOUNCE_AP_preferences.bl_rna.properties
+    assert [item.identifier for item in rna["backend"].enum_items] == ["BLENDER", "MODERNGL"]
+    assert rna["backend"].default == "BLENDER"
+    budget = rna["memory_budget_mb"]
+    assert (budget.default, budget.hard_min, budget.hard_max) == (1024, 64, 16384)
+
+
+def test_report_renderer_operator_finishes(registered, capfd):
+    assert bpy.ops.bounce.report_renderer() == {"FINISHED"}
+    # Background Blender prints reports to stdout as "Info: <message>".
+    lines = [line for line in capfd.readouterr().out.splitlines() if line.startswith("Info: ")]
+    assert lines and len(lines[-1]) > len("Info: ")
+
+
+def _mismatches(group_rna, config_cls, limits_fn) -> list[str]:
+    """What differs between a PropertyGroup's RNA and a config dataclass's fields."""
+    problems = []
+    for name, spec in limits_fn(config_cls).items():
+        if name not in group_rna.properties:
+            problems.append(f"{name}: no property")
+            continue
+        prop = group_rna.properties[name]
+        if "choices" in spec:
+            got = (prop.type, [i.identifier for i in prop.enum_items], prop.default)
+            want = ("ENUM", list(spec["choices"]), spec["default"])
+        else:
+            # Blender floats are 32-bit: compare to float32 precision (rel 1e-6), ints exactly.
+            got = (prop.type, prop.default, prop.hard_min, prop.hard_max)
+            want = ("INT" if isinstance(spec["default"], int) else "FLOAT", spec["default"], spec["min"], spec["max"])
+            if got[0] == "FLOAT" == want[0]:
+                got = (got[0], *(round(v, 6) for v in got[1:]))
+                want = (want[0], *(round(v, 6) for v in want[1:]))
+        if got != want:
+            problems.append(f"{name}: property {got} != config {want}")
+    return problems
+
+
+def test_properties_mirror_every_config_field(registered):
+    from bounce.addon.engine import config
+    from bounce.addon.properties import CONFIGS
+
+    assert set(CONFIGS.values()) >= {config.GIConfig, config.RsmConfig}
+    for attr, cls in CONFIGS.items():
+        group_rna = getattr(bpy.context.scene.bounce, attr).bl_rna
+        assert _mismatches(group_rna, cls, config.limits) == []
+
+
+def test_mirror_check_catches_a_config_change(registered):
+    from bounce.addon.engine import config
+
+    @dataclasses.dataclass(frozen=True)
+    class Drifted(config.GIConfig):
+        bounces: int = dataclasses.field(default=2, metadata={"min": 1, "max": 16})
+        depth_m: float = dataclasses.field(default=0.5, metadata={"min": 0.0, "max": 1.0})
+
+    problems = _mismatches(bpy.context.scene.bounce.gi.bl_rna, Drifted, config.limits)
+    assert problems == [
+        "bounces: property ('INT', 1, 1, 8) != config ('INT', 2, 1, 16)",
+        "depth_m: no property",
+    ]
+
+
+def test_defaults_give_default_configs(registered):
+    from bounce.addon.engine import config
+    from bounce.addon.properties import to_config
+
+    assert to_config(bpy.context.scene.bounce) == (config.GIConfig(), config.RsmConfig())
+
+
+def test_settings_survive_save_and_reload(registered, tmp_path):
+    from bounce.addon.properties import to_config
+
+    settings = bpy.context.scene.bounce
+    settings.enabled = True
+    settings.gi.method = "rsm"
+    settings.gi.bounces = 3
+    settings.rsm.resolution = 512
+    settings.rsm.depth_bias_m = 0.05
+    path = tmp_path / "settings.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    assert bpy.context.scene.bounce.gi.bounces == 1
+
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    settings = bpy.context.scene.bounce
+    assert settings.enabled
+    gi, rsm = to_config(settings)
+    assert (gi.method, gi.bounces, rsm.resolution) == ("rsm", 3, 512)
+    assert rsm.depth_bias_m == 0.05  # exactly: to_config undoes Blender's float32 rounding
+
+
+class _RecordingLayout:
+    """Stands in for UILayout (there is no UI in background mode): records what a panel draws."""
+
+    def __init__(self, drawn):
+        self.drawn = drawn
+
+    def column(self, **_kwargs):
+        return self
+
+    def prop(self, data, name, **_kwargs):
+        assert name in data.bl_rna.properties, name
+        self.drawn.append(name)
+
+    def operator(self, idname, **_kwargs):
+        self.drawn.append(idname)
+
+
+def test_panel_draws_every_setting(registered):
+    from bounce.addon.engine import config
+    from bounce.panels.main import BOUNCE_PT_main
+
+    drawn = []
+    panel = type("Panel", (), {"layout": _RecordingLayout(drawn)})()
+    BOUNCE_PT_main.draw_header(panel, bpy.context)
+    BOUNCE_PT_main.draw(panel, bpy.context)
+    fields = [*config.limits(config.GIConfig), *config.limits(config.RsmConfig)]
+    assert drawn == ["enabled", *fields, "bounce.report_renderer"]
