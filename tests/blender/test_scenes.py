@@ -214,11 +214,14 @@ def test_cornell_closed_except_front(fresh_blend, origin):
 
 def test_cornell_sun_hole(fresh_blend):
     scenes.build("cornell-sun")
-    assert not _cast((0.0, 0.0, 1.0), (0, 0, 1))[0]  # up through the 0.5 m hole
-    assert _cast((0.3, 0.0, 1.0), (0, 0, 1))[0]  # just beside it: ceiling
+    assert not _cast((0.0, 0.0, 1.0), (0, 0, 1))[0]  # up through the 0.8 m hole
+    assert not _cast((0.35, 0.0, 1.0), (0, 0, 1))[0]  # still inside it (hole spans |x| < 0.4)
+    assert _cast((0.45, 0.0, 1.0), (0, 0, 1))[0]  # just beside it: ceiling
+    assert _cast((-1.0, 0.0, 1.9), (-1, 0, 1))[0]  # the overhang closes the wall/ceiling edge
     sun = bpy.data.objects["Sun"]
     assert sun.data.energy == 3.0 and sun.data.angle == 0.0
-    assert np.allclose(np.array(sun.matrix_world)[:3, 2], (0, 0, 1), atol=1e-6)  # shining straight down
+    towards_sun = np.array(sun.matrix_world)[:3, 2]
+    assert np.allclose(towards_sun, np.array([0.0, 0.35, 1.0]) / np.hypot(0.35, 1.0), atol=1e-6)
 
 
 @pytest.mark.parametrize("origin", [(0, 0, 1.25), (1.5, -1.5, 0.3), (-1.2, 1.5, 2.2)])
