@@ -17,7 +17,18 @@ import gpu
 import numpy as np
 from gpu_extras.batch import batch_for_shader
 
-from ..engine.backends.base import FORMATS, Backend, Image, Mesh, Program, Sampler, ShaderSpec, Target, Texture, group_count
+from ..engine.backends.base import (
+    FORMATS,
+    Backend,
+    Image,
+    Mesh,
+    Program,
+    Sampler,
+    ShaderSpec,
+    Target,
+    Texture,
+    group_count,
+)
 from ..engine.errors import ShaderCompileError
 from ..engine.shader_source import load, load_stages
 from .gpu_init import ensure_gpu

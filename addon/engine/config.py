@@ -50,7 +50,8 @@ class _Validated:
         names = {f.name for f in dataclasses.fields(cls)}
         unknown = sorted(set(values) - names)
         if unknown:
-            raise ConfigError(f"{cls.__name__}: unknown field(s) {', '.join(unknown)}; known: {', '.join(sorted(names))}")
+            known = ", ".join(sorted(names))
+            raise ConfigError(f"{cls.__name__}: unknown field(s) {', '.join(unknown)}; known: {known}")
         return cls(**values)
 
     def to_dict(self) -> dict[str, Any]:

@@ -98,7 +98,8 @@ class ShaderSpec:
             )
         for img in self.images:
             if img.format not in FORMATS:
-                raise ConfigError(f"ShaderSpec {self.name}: image {img.name} format {img.format} not in {list(FORMATS)}")
+                raise ConfigError(
+                    f"ShaderSpec {self.name}: image {img.name} format {img.format} not in {list(FORMATS)}")
 
     @property
     def is_compute(self) -> bool:
@@ -131,8 +132,10 @@ class Mesh(abc.ABC):
     count: int
 
 
-class Target(abc.ABC):
-    """Render target: colour textures (a 2D texture or one layer of a 3D texture) and an optional depth."""
+class Target:
+    """Render target: colour textures (a 2D texture or one layer of a 3D texture) and an optional depth.
+
+    A marker type: each backend subclasses it with its own framebuffer handle."""
 
 
 def group_count(size: tuple[int, ...], local: tuple[int, int, int]) -> tuple[int, int, int]:

@@ -7,8 +7,8 @@ Blender every call runs with this backend's own context entered.
 from __future__ import annotations
 
 import ctypes
-import functools
 import ctypes.util
+import functools
 from dataclasses import dataclass
 from typing import Any
 
@@ -128,7 +128,7 @@ class ModernGLBackend(Backend):
         self._own_context = current[3] if current else None
         self._programs: dict[ShaderSpec, _Prog] = {}
         self._gl = _gl_library()
-        self._gl.glFramebufferTextureLayer.argtypes = [ctypes.c_uint, ctypes.c_uint, ctypes.c_uint, ctypes.c_int, ctypes.c_int]
+        self._gl.glFramebufferTextureLayer.argtypes = [ctypes.c_uint] * 3 + [ctypes.c_int] * 2
 
     @property
     def renderer(self) -> str:
