@@ -6,12 +6,5 @@ from .about import BOUNCE_OT_report_renderer
 
 classes = (BOUNCE_OT_report_renderer,)
 
-
-def register():
-    for cls in classes:
-        bpy.utils.register_class(cls)
-
-
-def unregister():
-    for cls in reversed(classes):
-        bpy.utils.unregister_class(cls)
+# Blender's own helper: registers in order, unregisters in reverse.
+register, unregister = bpy.utils.register_classes_factory(classes)
