@@ -6,9 +6,9 @@ from ..errors import ConfigError
 
 
 def get(name: str):
-    from . import direct
+    from . import direct, rsm
 
-    methods = {"direct": direct.DirectMethod}
+    methods = {"direct": direct.DirectMethod, "rsm": rsm.RsmMethod}
     if name not in methods:
         raise ConfigError(f"unknown method {name!r}: known methods are {', '.join(sorted(methods))}")
     return methods[name]

@@ -81,16 +81,27 @@ class DirectMethod:
         with be.timed(timings, "total"):
             with be.timed(timings, "gbuffer"):
                 gbuffer.run(be, self.gbuf_target, self._meshes[gbuffer.SPEC.name], scene.camera)
-            be.clear(self._direct_target)
+            self.clear_products()
             for view in self.light_views():
                 with be.timed(timings, "rsm"):
                     rsm.run(be, self.rsm_target, self._meshes[rsm.SPEC.name], view)
                 with be.timed(timings, "direct_light"):
                     direct_light.run(be, self.gbuf["position"], self.gbuf["normal"], self.rsm["position"],
                                      self.direct, view, self.rsm_config.depth_bias_m)
+                self.per_light_view(view, timings)
             with be.timed(timings, "readback"):
-                direct = be.read(self.direct)
                 albedo = be.read(self.gbuf["albedo"])  # alpha = coverage
-        direct[..., 3] = albedo[..., 3]
-        return Result({"direct": np.ascontiguousarray(direct[::-1]), "albedo": np.ascontiguousarray(albedo[::-1])},
-                      timings)
+                images = {"albedo": albedo}
+                for name, tex in self.product_textures().items():
+                    images[name] = be.read(tex)
+                    images[name][..., 3] = albedo[..., 3]
+        return Result({k: np.ascontiguousarray(v[::-1]) for k, v in images.items()}, timings)
+
+    def clear_products(self) -> None:
+        self.backend.clear(self._direct_target)
+
+    def per_light_view(self, view: LightView, timings: dict[str, float]) -> None:
+        """Hook for methods that add work per RSM face while it is bound (the indirect gathers)."""
+
+    def product_textures(self) -> dict:
+        return {"direct": self.direct}

@@ -1,0 +1,66 @@
+// RSM indirect gather (Dachsbacher & Stamminger 2005), no visibility: every pixel sums the light of
+// VPLs drawn from one RSM face, added to `indirect` in Cycles' Diffuse Indirect unit (E / pi).
+//
+// Sampling: the RSM is split into strata_per_side^2 equal blocks; each pixel draws one texel per block
+// (its own hash, so the estimate is unbiased and the noise is per-pixel, not structured) weighted by
+// the block's texel count. A VPL of flux phi is a Lambertian disk of its surfel area A:
+//     E += phi / pi * cos_vpl * cos_x / (r^2 + A / pi)
+// The A / pi term is the on-axis form factor of a disk: it keeps nearby VPLs from spiking.
+
+const float PI = 3.14159265;
+
+uint hash_u32(uint x) {
+    x ^= x >> 16u;
+    x *= 0x7feb352du;
+    x ^= x >> 15u;
+    x *= 0x846ca68bu;
+    x ^= x >> 16u;
+    return x;
+}
+
+float random01(uint a, uint b, uint c) {
+    return float(hash_u32(a ^ hash_u32(b ^ hash_u32(c))) >> 8u) * (1.0 / 16777216.0);
+}
+
+void main() {
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(px, textureSize(gbuf_position, 0)))) {
+        return;
+    }
+    vec4 pos = texelFetch(gbuf_position, px, 0);
+    if (pos.w == 0.0) {
+        return;
+    }
+    vec3 x = pos.xyz;
+    vec3 n = texelFetch(gbuf_normal, px, 0).xyz;
+    ivec2 rsm_size = textureSize(rsm_flux, 0);
+    vec2 block = vec2(rsm_size) / float(strata_per_side);
+    float weight = block.x * block.y;
+    uint pixel_id = uint(px.y * 65536 + px.x);
+    vec3 irradiance = vec3(0.0);
+    for (int j = 0; j < strata_per_side; ++j) {
+        for (int i = 0; i < strata_per_side; ++i) {
+            uint stratum = uint(j * strata_per_side + i);
+            vec2 u = vec2(random01(pixel_id, stratum, uint(seed) * 2u),
+                          random01(pixel_id, stratum, uint(seed) * 2u + 1u));
+            ivec2 t = min(ivec2((vec2(i, j) + u) * block), rsm_size - 1);
+            vec4 vpl_pos = texelFetch(rsm_position, t, 0);
+            if (vpl_pos.w == 0.0) {
+                continue;
+            }
+            vec4 vpl_normal = texelFetch(rsm_normal, t, 0);
+            vec3 d = vpl_pos.xyz - x;
+            float r2 = dot(d, d);
+            vec3 w = d * inversesqrt(max(r2, 1e-20));
+            float cos_x = dot(n, w);
+            float cos_vpl = -dot(vpl_normal.xyz, w);
+            if (cos_x <= 0.0 || cos_vpl <= 0.0) {
+                continue;
+            }
+            vec3 phi = texelFetch(rsm_flux, t, 0).rgb;
+            irradiance += phi * (weight * cos_x * cos_vpl / (PI * (r2 + vpl_normal.w / PI)));
+        }
+    }
+    vec4 acc = imageLoad(indirect, px);
+    imageStore(indirect, px, acc + vec4(irradiance / PI, 0.0));
+}
