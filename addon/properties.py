@@ -9,7 +9,7 @@ the engine validates.
 from __future__ import annotations
 
 import bpy
-from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
 from .engine import config
 
@@ -55,10 +55,63 @@ def _group(attr: str, cls) -> type:
 _GROUPS = {attr: _group(attr, cls) for attr, cls in CONFIGS.items()}
 
 
+# Quality presets: RSM side and VPLs per pixel. The labels say what they cost and gain; figures in
+# benchmarks/REPORT.md (see panels/viewport.py for where each comes from).
+QUALITY_PRESETS = {
+    "DRAFT": (128, 64),
+    "BALANCED": (256, 256),  # = RsmConfig's defaults
+    "HIGH": (512, 1024),
+}
+QUALITY_LABELS = {
+    "DRAFT": ("Draft", "RSM 128, 64 VPLs per pixel"),
+    "BALANCED": ("Balanced", "RSM 256, 256 VPLs per pixel (the defaults)"),
+    "HIGH": ("High", "RSM 512, 1024 VPLs per pixel"),
+}
+
+
+def _apply_quality(self, _context):
+    self.rsm.resolution, self.rsm.vpl_samples = QUALITY_PRESETS[self.quality]
+
+
+def _enabled_changed(self, _context):
+    # Start from a clean capture (edits made while disabled were not noted) and clear a past error.
+    from .bridge import live
+
+    live.reset()
+    if self.enabled:
+        live.request()
+
+
+def _live_state():
+    from .bridge import live  # imported late: the engine-only tools never load Blender's side
+
+    return live
+
+
 class BOUNCE_PG_settings(bpy.types.PropertyGroup):
     __annotations__ = {
-        "enabled": BoolProperty(name="Enabled", description="Show Bounce's indirect light", default=False),
+        "enabled": BoolProperty(name="Enabled", description="Show Bounce's indirect light", default=False,
+                                update=_enabled_changed),
         **{attr: PointerProperty(type=group) for attr, group in _GROUPS.items()},
+        "view_mode": EnumProperty(
+            name="View", description="Which light the viewport overlay adds",
+            items=[("COMBINED", "Combined", "Direct and indirect light"),
+                   ("INDIRECT", "Indirect", "Indirect light only"),
+                   ("DIRECT", "Direct", "Direct light only")],
+            default="INDIRECT"),
+        "exposure": FloatProperty(name="Exposure", description="Overlay brightness in stops (x 2^exposure)",
+                                  default=0.0, min=-10.0, max=10.0),
+        "strength": FloatProperty(name="Strength", description="Overlay brightness factor",
+                                  default=1.0, min=0.0, max=10.0),
+        "quality": EnumProperty(
+            name="Quality", description="Sets RSM resolution and VPL samples",
+            items=[(k, *QUALITY_LABELS[k]) for k in QUALITY_PRESETS], default="BALANCED",
+            update=_apply_quality),
+        # Read-only: written by the live overlay outside Blender data (a draw callback may not write).
+        "last_update_ms": FloatProperty(name="Last Update (ms)", description="Time of the last overlay update",
+                                        get=lambda _self: _live_state().STATE.last_update_ms, precision=1),
+        "status": StringProperty(name="Status", description="What the overlay did last, or why it stopped",
+                                 get=lambda _self: _live_state().status()),
     }
 
 

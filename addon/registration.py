@@ -1,5 +1,6 @@
 """Registers the Blender side of Bounce. Order matters: properties first (panels and operators read
-scene.bounce), preferences next, then operators and panels; unregister runs the reverse so nothing is
+scene.bounce), preferences next, then operators and panels, then the viewport draw handler and the
+live-update handlers; unregister runs the reverse so nothing is
 left pointing at a class that is gone.
 
 A module that adds a handler (bpy.app.handlers, draw handlers, timers) must remove it in its own
@@ -10,8 +11,10 @@ from __future__ import annotations
 
 from .. import operators, panels
 from . import preferences, properties
+from .bridge import live, viewport
 
-_MODULES = (properties, preferences, operators, panels)
+# Handlers last: they read scene.bounce and draw what the panels configure.
+_MODULES = (properties, preferences, operators, panels, viewport, live)
 
 
 def register() -> None:

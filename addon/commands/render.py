@@ -18,13 +18,17 @@ def add_arguments(p) -> None:
     p.add_argument("--res", type=int, default=256, help="long side of the image in pixels (camera aspect kept)")
     p.add_argument("--bounces", type=int, default=1)
     p.add_argument("--rsm-res", type=int, default=256, help="RSM side in texels")
+    p.add_argument("--vpl-samples", type=int, default=256, help="VPLs gathered per pixel (rsm)")
+    p.add_argument("--visibility", default="none", help="VPL visibility for rsm: none or voxel")
+    p.add_argument("--voxel-cells", type=int, default=64, help="voxel cells along the longest side")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--repeat", type=int, default=3, help="timed runs after a warm-up (median reported)")
 
 
 def run(args) -> int:
     gi = GIConfig(method=args.method, bounces=args.bounces, resolution=args.res, seed=args.seed)
-    rsm = RsmConfig(resolution=args.rsm_res)
+    rsm = RsmConfig(resolution=args.rsm_res, vpl_samples=args.vpl_samples, visibility=args.visibility,
+                    voxel_cells=args.voxel_cells)
     blend = existing_blend(args.blend)
     out = output_dir(args.out)
     from ..bridge.pipeline import render_file  # imports bpy: only when actually rendering

@@ -3,9 +3,13 @@
 //
 // Sampling: the RSM is split into strata_per_side^2 equal blocks; each pixel draws one texel per block
 // (its own hash, so the estimate is unbiased and the noise is per-pixel, not structured) weighted by
-// the block's texel count. A VPL of flux phi is a Lambertian disk of its surfel area A:
+// the block's texel count. One dispatch handles block rows [row_begin, row_end): llvmpipe silently
+// stops a shader after 65,535 loop iterations, so the caller splits long visibility marches. A VPL of flux phi is a Lambertian disk of its surfel area A:
 //     E += phi / pi * cos_vpl * cos_x / (r^2 + A / pi)
 // The A / pi term is the on-axis form factor of a disk: it keeps nearby VPLs from spiking.
+// With VOXEL_VISIBILITY, each VPL counts only if the segment between the receiver and the VPL, both
+// moved `offset_cells` off their surfaces along their normals, crosses no occupied voxel (a march in
+// half-cell steps through the voxelizer's occupancy).
 
 const float PI = 3.14159265;
 
@@ -21,6 +25,23 @@ uint hash_u32(uint x) {
 float random01(uint a, uint b, uint c) {
     return float(hash_u32(a ^ hash_u32(b ^ hash_u32(c))) >> 8u) * (1.0 / 16777216.0);
 }
+
+#ifdef VOXEL_VISIBILITY
+float visible(vec3 from_ws, vec3 to_ws) {
+    vec3 a = (from_ws - grid_origin) / cell_size;
+    vec3 b = (to_ws - grid_origin) / cell_size;
+    float len = length(b - a);
+    int steps = int(ceil(len * 2.0));
+    for (int s = 1; s < steps; ++s) {
+        ivec3 c = ivec3(floor(mix(a, b, float(s) / float(steps))));
+        if (all(greaterThanEqual(c, ivec3(0))) && all(lessThan(c, grid_dims))
+            && texelFetch(occupancy, c, 0).a > 0.5) {
+            return 0.0;
+        }
+    }
+    return 1.0;
+}
+#endif
 
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
@@ -38,7 +59,7 @@ void main() {
     float weight = block.x * block.y;
     uint pixel_id = uint(px.y * 65536 + px.x);
     vec3 irradiance = vec3(0.0);
-    for (int j = 0; j < strata_per_side; ++j) {
+    for (int j = row_begin; j < row_end; ++j) {
         for (int i = 0; i < strata_per_side; ++i) {
             uint stratum = uint(j * strata_per_side + i);
             vec2 u = vec2(random01(pixel_id, stratum, uint(seed) * 2u),
@@ -58,6 +79,12 @@ void main() {
                 continue;
             }
             vec3 phi = texelFetch(rsm_flux, t, 0).rgb;
+#ifdef VOXEL_VISIBILITY
+            float offset_m = offset_cells * cell_size;
+            if (visible(x + n * offset_m, vpl_pos.xyz + vpl_normal.xyz * offset_m) == 0.0) {
+                continue;
+            }
+#endif
             irradiance += phi * (weight * cos_x * cos_vpl / (PI * (r2 + vpl_normal.w / PI)));
         }
     }
