@@ -22,7 +22,7 @@ _UNITS = {"m": "m", "mb": "MB", "ms": "ms"}
 
 
 def _label(name: str) -> str:
-    # Config names carry their unit as a suffix (`depth_bias_m`); the UI shows "Depth Bias (m)".
+    # Config names carry their unit as a suffix (`cell_size_m`); the UI shows "Cell Size (m)".
     words = name.split("_")
     unit = _UNITS.get(words[-1]) if len(words) > 1 else None
     if unit:

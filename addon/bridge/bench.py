@@ -212,9 +212,9 @@ def plot_scene(sc: dict, path: Path) -> None:
         if rs:
             ax.plot([r["total_ms"] / 1000 for r in rs], [r["metrics"]["rel_rmse_8"] for r in rs], "-s",
                     ms=5, label=f"Bounce {method}")
-            for r in rs:
+            for i, r in enumerate(rs):  # alternate above/below: neighbouring settings often overlap
                 ax.annotate(r["setting"], (r["total_ms"] / 1000, r["metrics"]["rel_rmse_8"]), fontsize=7,
-                            xytext=(3, -9), textcoords="offset points")
+                            xytext=(3, -10 if i % 2 == 0 else 4), textcoords="offset points")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("time per image (s)")

@@ -68,6 +68,9 @@ class _Mesh(Mesh):
 class _Target(Target):
     fbo: Any
     size: tuple[int, int]
+    # A GPUFrameBuffer does not keep its attachments alive: without these references a depth texture
+    # made just for the target is freed and the depth test silently stops working.
+    attachments: tuple = ()
 
 
 @contextlib.contextmanager
@@ -224,7 +227,8 @@ class BlenderGPUBackend(Backend):
             size = tex.size[:2]
             slots.append({"texture": tex.gl, "layer": layer} if layer is not None else tex.gl)
         fbo = gpu.types.GPUFrameBuffer(color_slots=tuple(slots), depth_slot=depth.gl if depth else None)
-        return _Target(fbo, tuple(size))
+        attached = tuple(e[0] if isinstance(e, tuple) else e for e in color) + ((depth,) if depth else ())
+        return _Target(fbo, tuple(size), tuple(t.gl for t in attached))
 
     def clear(self, target, color=(0, 0, 0, 0), depth=None) -> None:
         kwargs = {}

@@ -4,7 +4,8 @@ What is captured, and why:
 - Geometry comes from the *evaluated* depsgraph (`depsgraph.object_instances`), so modifiers,
   collection instances and geometry-nodes instances appear as Cycles renders them. Objects hidden from
   render (`hide_render`, or every collection holding them hidden from render) and holdout objects are
-  left out; objects with `visible_camera` off are kept: Cycles still bounces light off them.
+  left out; objects with `visible_camera` off are kept (Cycles still bounces light off them) and marked
+  in `Scene.camera_visible`.
 - Triangles from `mesh.loop_triangles`; corner normals (`mesh.corner_normals`, which includes custom and
   split normals) go to world space by the inverse transpose. Triangles with NaN/Inf corners or zero area
   (after the transform) are dropped and counted in one warning.
@@ -378,7 +379,11 @@ class SceneCache:
                 block.world = _to_world(block, scale)
             slots = [s.material for s in obj.material_slots]
             seen[key] = block
-            parts.append(self._material_arrays(block, slots, mats))
+            # Hidden from the camera (Object > Visibility > Ray Visibility > Camera) but still bouncing
+            # light, as in Cycles: the G-buffer leaves these triangles out, the RSMs keep them.
+            seen_by_camera = obj.original.visible_camera and (
+                not inst.is_instance or inst.parent.original.visible_camera)
+            parts.append((*self._material_arrays(block, slots, mats), seen_by_camera))
         self.blocks = seen
         out.lights = lights
         dropped = sum(b.world[3] for b in seen.values())
@@ -399,6 +404,7 @@ class SceneCache:
             out.normals = np.concatenate([p[1] for p in parts])
             out.albedo = np.concatenate([p[2] for p in parts]).astype(np.float32)
             out.emission = np.concatenate([p[3] for p in parts]).astype(np.float32)
+            out.camera_visible = np.concatenate([np.full(len(p[0]), p[4], bool) for p in parts])
         self.scene = out
         return out
 

@@ -30,7 +30,6 @@ import numpy as np
 
 from ..engine import methods
 from ..engine.backends.base import Sampler, ShaderSpec, Var
-from ..engine.passes import direct_light, gbuffer, rsm
 from ..engine.scene import Camera
 from ..properties import to_config
 from . import live
@@ -95,22 +94,6 @@ def _same_camera(a: Camera | None, b: Camera) -> bool:
 
 # ------------------------------------------------------------------------------------------- computing
 
-def compute(method, run_gbuffer: bool = True) -> float:
-    """The passes of `method.run()` without its read-back (the overlay samples the GPU textures), and
-    without the G-buffer when only lights changed. Returns the wall time in ms, GPU work included."""
-    be, scene, timings = method.backend, method.scene, {}
-    with be.timed(timings, "total"):
-        if run_gbuffer:
-            gbuffer.run(be, method.gbuf_target, method._meshes[gbuffer.SPEC.name], scene.camera)
-        method.clear_products()
-        for view in method.light_views():
-            rsm.run(be, method.rsm_target, method._meshes[rsm.SPEC.name], view)
-            direct_light.run(be, method.gbuf["position"], method.gbuf["normal"], method.rsm["position"],
-                             method.direct, view, method.rsm_config.depth_bias_m)
-            method.per_light_view(view, timings)
-    return timings["total"]
-
-
 class Overlay:
     """One region at one quality: a method whose textures have the overlay's size, and the versions of
     the capture and camera they were computed from."""
@@ -126,19 +109,18 @@ class Overlay:
         if self.method is None or self.configs != (gi, rsm_config):
             self.method, self.configs = methods.get(gi.method)(backend(), gi, rsm_config), (gi, rsm_config)
             self.geometry_version = -1
-        scene = dataclasses.replace(state.scene, camera=camera)
-        same_size = self.camera is not None and (self.camera.width, self.camera.height) == (
-            camera.width, camera.height)
-        if not same_size or self.geometry_version != state.geometry_version:
-            self.method.set_scene(scene)  # upload geometry, allocate targets
+        if self.geometry_version != state.geometry_version:
+            self.method.set_scene(dataclasses.replace(state.scene, camera=camera))  # upload geometry
             run_gbuffer = True
         elif self.lights_version != state.lights_version or not _same_camera(self.camera, camera):
-            self.method.scene = scene  # geometry on the GPU is still valid
+            # Geometry on the GPU is still valid: only the camera and the lights are new.
+            self.method.set_camera(camera)
+            self.method.set_lights(state.scene.lights)
             run_gbuffer = not _same_camera(self.camera, camera)
         else:
             return False
         self.camera, self.geometry_version, self.lights_version = camera, state.geometry_version, state.lights_version
-        compute(self.method, run_gbuffer)
+        self.method.compute(run_gbuffer)
         return True
 
 

@@ -64,7 +64,7 @@ class RsmConfig(_Validated):
 
     resolution: int = _num(256, 16, 4096, "RSM side in texels (per face for point lights)")
     vpl_samples: int = _num(256, 1, 4096, "VPLs gathered per pixel by the `rsm` method")
-    depth_bias_m: float = _num(0.01, 0.0, 1.0, "shadow-map depth bias in metres")
+    shadow_bias_texels: float = _num(0.0, 0.0, 8.0, "shadow bias in RSM texels beyond the 1.5-texel normal offset")
     visibility: str = _choice("none", ("none", "voxel"), "VPL visibility in the `rsm` gather: none or voxel-traced")
     voxel_cells: int = _num(64, 8, 512, "voxel grid cells along the scene's longest side (voxel visibility)")
     voxel_offset_cells: float = _num(1.5, 0.0, 4.0, "ray ends moved off their surfaces, in cells")

@@ -7,7 +7,7 @@ per texel separately).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -80,10 +80,43 @@ class Scene:
     world_color: np.ndarray = field(default_factory=lambda: np.zeros(3, np.float32))
     camera: Camera | None = None
     warnings: list[str] = field(default_factory=list)
+    # Per triangle: False where the object is hidden from the camera but still reflects light (the
+    # G-buffer skips it, the RSMs keep it). None means every triangle is visible.
+    camera_visible: np.ndarray | None = None
+
+    def seen_by_camera(self) -> np.ndarray:
+        if self.camera_visible is None:
+            return np.ones(self.triangle_count, bool)
+        return np.asarray(self.camera_visible, bool)
 
     @property
     def triangle_count(self) -> int:
         return int(self.positions_m.shape[0])
+
+    def prepared(self) -> tuple[Scene, np.ndarray]:
+        """The geometry as the GPU passes want it, and the world position of its new origin.
+
+        Triangles with a non-finite corner or zero area are dropped (one warning), since one NaN corner
+        would poison the bounds every light view is fitted to. Positions are re-centred on the bounds'
+        centre in float64 before the passes convert them to float32: 1e5 m from the origin fp32 keeps
+        only ~8 mm, less than a shadow map's bias. Images do not depend on the origin.
+        """
+        pos = np.asarray(self.positions_m, np.float64)
+        finite = np.all(np.isfinite(pos), axis=(1, 2)) & np.all(np.isfinite(self.normals), axis=(1, 2))
+        area2 = np.zeros(len(pos))
+        area2[finite] = np.linalg.norm(np.cross(pos[finite, 1] - pos[finite, 0], pos[finite, 2] - pos[finite, 0]),
+                                       axis=1)
+        keep = finite & (area2 > 0)
+        warnings = list(self.warnings)
+        if not np.all(keep):
+            warnings.append(f"{int((~keep).sum())} triangles with non-finite corners or zero area were ignored")
+        kept = replace(self, positions_m=pos[keep], normals=self.normals[keep], albedo=self.albedo[keep],
+                       emission=self.emission[keep], warnings=warnings, camera_visible=self.seen_by_camera()[keep])
+        lo, hi = kept.bounds_m()
+        origin = (lo + hi) / 2.0
+        # Geometry only: lights and camera stay in world space and are shifted per update by the method.
+        local = replace(kept, positions_m=(kept.positions_m - origin).astype(np.float32), lights=[], camera=None)
+        return local, origin
 
     def bounds_m(self) -> tuple[np.ndarray, np.ndarray]:
         """Axis-aligned bounds of the geometry; a unit box at the origin for an empty scene."""

@@ -37,9 +37,6 @@ void main() {
         texel_m = sqrt(texel_scale);
     } else {
         vec3 d = p - light_pos_ws;
-        if (face_index >= 0 && cube_face(d) != face_index) {
-            return;  // another face of this point light shades this pixel
-        }
         dist = length(d);
         vec3 w = d / max(dist, 1e-9);
         to_light = -w;
@@ -50,9 +47,14 @@ void main() {
     if (all(equal(irradiance, vec3(0.0)))) {
         return;
     }
-    // Shadow test against the RSM's stored positions. The receiver is pushed off its surface by about
-    // one RSM texel along its normal (normal-offset bias) so it does not shadow itself.
-    vec3 p_test = p + n * (1.5 * texel_m + depth_bias_m);
+    // Shadow test against the RSM's stored positions. The receiver is pushed off its surface by 1.5 RSM
+    // texels along its normal (normal-offset bias) so it does not shadow itself; every bias is in
+    // texels, so the result does not depend on the scene's scale.
+    vec3 p_test = p + n * (1.5 * texel_m);
+    float bias_m = shadow_bias_texels * texel_m;
+    if (face_index >= 0 && cube_face(p_test - light_pos_ws) != face_index) {
+        return;  // another face of this point light shades this pixel: the one p_test projects into
+    }
     vec4 clip = light_view_projection * vec4(p_test, 1.0);
     vec3 ndc = clip.xyz / clip.w;
     float lit = 1.0;
@@ -63,7 +65,7 @@ void main() {
         if (occ.w > 0.0) {
             float receiver = light_kind == LIGHT_SUN ? dot(p_test, emit_axis) : length(p_test - light_pos_ws);
             float occluder = light_kind == LIGHT_SUN ? dot(occ.xyz, emit_axis) : length(occ.xyz - light_pos_ws);
-            lit = receiver <= occluder + depth_bias_m ? 1.0 : 0.0;
+            lit = receiver <= occluder + bias_m ? 1.0 : 0.0;
         }
     }
     vec4 acc = imageLoad(direct, px);

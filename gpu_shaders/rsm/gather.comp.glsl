@@ -27,12 +27,14 @@ float random01(uint a, uint b, uint c) {
 }
 
 #ifdef VOXEL_VISIBILITY
+// 1 if no occupied voxel lies on the segment, skipping its first and last cell: a VPL low on a wall
+// sits within a cell of the floor's voxels, which would otherwise hide it from the floor it lights.
 float visible(vec3 from_ws, vec3 to_ws) {
     vec3 a = (from_ws - grid_origin) / cell_size;
     vec3 b = (to_ws - grid_origin) / cell_size;
     float len = length(b - a);
     int steps = int(ceil(len * 2.0));
-    for (int s = 1; s < steps; ++s) {
+    for (int s = 2; s < steps - 1; ++s) {
         ivec3 c = ivec3(floor(mix(a, b, float(s) / float(steps))));
         if (all(greaterThanEqual(c, ivec3(0))) && all(lessThan(c, grid_dims))
             && texelFetch(occupancy, c, 0).a > 0.5) {

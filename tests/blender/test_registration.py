@@ -60,7 +60,8 @@ def test_register_unregister_twice_leaves_nothing_behind(bounce, fresh_blend):
     before = _handler_counts()
     assert "load_post" in before and "depsgraph_update_post" in before
     classes = _all_classes(bounce)
-    assert len(classes) == 6
+    # 3 property groups, preferences, 1 operator, 3 panels (main, its viewport sub-panel, the sidebar tab)
+    assert len(classes) == 8
     for _ in range(2):
         bounce.register()
         try:
@@ -156,7 +157,7 @@ def test_settings_survive_save_and_reload(registered, tmp_path):
     settings.gi.method = "rsm"
     settings.gi.bounces = 3
     settings.rsm.resolution = 512
-    settings.rsm.depth_bias_m = 0.05
+    settings.rsm.shadow_bias_texels = 0.05
     path = tmp_path / "settings.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
     bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -167,7 +168,7 @@ def test_settings_survive_save_and_reload(registered, tmp_path):
     assert settings.enabled
     gi, rsm = to_config(settings)
     assert (gi.method, gi.bounces, rsm.resolution) == ("rsm", 3, 512)
-    assert rsm.depth_bias_m == 0.05  # exactly: to_config undoes Blender's float32 rounding
+    assert rsm.shadow_bias_texels == 0.05  # exactly: to_config undoes Blender's float32 rounding
 
 
 class _RecordingLayout:

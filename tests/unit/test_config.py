@@ -20,7 +20,7 @@ def test_defaults_are_valid():
         (GIConfig, "bounces", 0, "GIConfig.bounces = 0: out of range [1, 8]"),
         (GIConfig, "bounces", 2.5, "must be an integer"),
         (GIConfig, "resolution", True, "must be a number"),
-        (RsmConfig, "depth_bias_m", math.nan, "out of range [0.0, 1.0]"),
+        (RsmConfig, "shadow_bias_texels", math.nan, "out of range [0.0, 8.0]"),
         (RsmConfig, "resolution", 1e9, "out of range [16, 4096]"),
     ],
 )

@@ -7,15 +7,15 @@ Passes: gbuffer -> for each light face: rsm -> direct_light. Geometry is uploade
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..backends.base import Backend
 from ..config import GIConfig, RsmConfig
 from ..passes import direct_light, gbuffer, rsm
-from ..passes.light_views import LightView, views_for
-from ..scene import Scene
+from ..passes.light_views import LightView, emissive_lights, views_for
+from ..scene import Camera, Scene
 
 
 @dataclass
@@ -26,15 +26,17 @@ class Result:
     timings_ms: dict[str, float] = field(default_factory=dict)
 
 
-def triangle_attributes(scene: Scene) -> dict[str, np.ndarray] | None:
-    """Per-vertex arrays for the raster passes: three vertices per triangle, flat albedo."""
-    if scene.triangle_count == 0:
+def triangle_attributes(scene: Scene, select: np.ndarray | None = None) -> dict[str, np.ndarray] | None:
+    """Per-vertex arrays for the raster passes: three vertices per triangle, flat albedo; `select`
+    picks triangles (None: all). None when nothing is left to draw."""
+    sel = np.ones(scene.triangle_count, bool) if select is None else select
+    n = int(sel.sum())
+    if n == 0:
         return None
-    n = scene.triangle_count
     return {
-        "pos_ws": scene.positions_m.reshape(n * 3, 3).astype(np.float32),
-        "normal_ws": scene.normals.reshape(n * 3, 3).astype(np.float32),
-        "albedo": np.repeat(scene.albedo.astype(np.float32), 3, axis=0),
+        "pos_ws": scene.positions_m[sel].reshape(n * 3, 3).astype(np.float32),
+        "normal_ws": scene.normals[sel].reshape(n * 3, 3).astype(np.float32),
+        "albedo": np.repeat(scene.albedo[sel].astype(np.float32), 3, axis=0),
     }
 
 
@@ -44,58 +46,106 @@ class DirectMethod:
 
     def __init__(self, backend: Backend, gi: GIConfig, rsm_config: RsmConfig):
         self.backend, self.gi, self.rsm_config = backend, gi, rsm_config
-        self.scene: Scene | None = None
+        self.source: Scene | None = None  # the caller's scene: camera and lights are read from it per update
+        self.scene: Scene | None = None  # its geometry as uploaded (re-centred, sanitised)
         self._meshes: dict[str, object] = {}
+        self._size: tuple[int, int] | None = None
 
     def set_scene(self, scene: Scene) -> None:
-        """Upload geometry and allocate every target once; call again only when geometry changes."""
+        """Upload geometry once; call again only when geometry changes. Camera and lights may change
+        between updates without it: set_camera / set_lights, or by changing `scene`'s own fields."""
         if scene.camera is None:
             raise ValueError("DirectMethod needs a scene with a camera")
         be = self.backend
-        self.scene = scene
-        attrs = triangle_attributes(scene)
-        self._meshes = {
-            spec.name: (be.mesh(be.program(spec), attrs, "triangles") if attrs is not None else None)
-            for spec in (gbuffer.SPEC, rsm.SPEC)
-        }
-        w, h = scene.camera.width, scene.camera.height
-        self.gbuf = {k: be.texture((w, h)) for k in ("position", "normal", "albedo")}
-        self.gbuf_target = be.target([self.gbuf["position"], self.gbuf["normal"], self.gbuf["albedo"]],
-                                     be.depth_texture((w, h)))
+        self.source = scene
+        self.scene, self.origin_m = scene.prepared()
+        # Emissive meshes light the scene like lamps (already in the uploaded, re-centred frame).
+        self.emissive = emissive_lights(self.scene.positions_m, self.scene.emission)
+        selections = {gbuffer.SPEC: self.scene.seen_by_camera(), rsm.SPEC: None}
+        self._meshes = {}
+        for spec, select in selections.items():
+            attrs = triangle_attributes(self.scene, select)
+            self._meshes[spec.name] = be.mesh(be.program(spec), attrs, "triangles") if attrs is not None else None
         n = self.rsm_config.resolution
         self.rsm = {k: be.texture((n, n)) for k in ("position", "normal", "flux")}
         self.rsm_target = be.target([self.rsm["position"], self.rsm["normal"], self.rsm["flux"]],
                                     be.depth_texture((n, n)))
-        self.direct = be.texture((w, h))
-        self._direct_target = be.target([self.direct])
+        self._size = None
+        self._allocate_images()
+
+    def set_camera(self, camera: Camera) -> None:
+        self.source = replace(self.source, camera=camera)
+        self._allocate_images()
+
+    def set_lights(self, lights: list) -> None:
+        self.source = replace(self.source, lights=list(lights))
+
+    def _allocate_images(self) -> None:
+        """Camera-sized targets, (re)made only when the camera's size changes."""
+        size = (self.source.camera.width, self.source.camera.height)
+        if size == self._size:
+            return
+        be = self.backend
+        self._size = size
+        self.gbuf = {k: be.texture(size) for k in ("position", "normal", "albedo")}
+        self.gbuf_target = be.target([self.gbuf["position"], self.gbuf["normal"], self.gbuf["albedo"]],
+                                     be.depth_texture(size))
+        self.allocate_products(size)
+
+    def allocate_products(self, size: tuple[int, int]) -> None:
+        self.direct = self.backend.texture(size)
+        self._direct_target = self.backend.target([self.direct])
+
+    def camera(self) -> Camera:
+        """The current camera in the uploaded geometry's (re-centred) frame."""
+        cam = self.source.camera
+        shift = np.eye(4)
+        shift[:3, 3] = self.origin_m
+        return replace(cam, view=cam.view @ shift)
 
     def light_views(self) -> list[LightView]:
-        scene = self.scene
-        bounds = scene.bounds_m()
-        return [v for i, light in enumerate(scene.lights)
-                for v in views_for(light, i, bounds, self.rsm_config.resolution)]
+        bounds = self.scene.bounds_m()
+        lights = [replace(light, position_m=light.position_m - self.origin_m) for light in self.source.lights]
+        lights += self.emissive
+        return [v for i, light in enumerate(lights) for v in views_for(light, i, bounds, self.rsm_config.resolution)]
 
-    def run(self) -> Result:
-        be, scene = self.backend, self.scene
+    def compute(self, run_gbuffer: bool = True) -> dict[str, float]:
+        """Every pass of one update, no read-back (the viewport samples the textures); the G-buffer may
+        be skipped when only lights changed. Returns timings in ms per pass."""
+        be = self.backend
+        self._allocate_images()
         timings: dict[str, float] = {}
         with be.timed(timings, "total"):
-            with be.timed(timings, "gbuffer"):
-                gbuffer.run(be, self.gbuf_target, self._meshes[gbuffer.SPEC.name], scene.camera)
+            if run_gbuffer:
+                with be.timed(timings, "gbuffer"):
+                    gbuffer.run(be, self.gbuf_target, self._meshes[gbuffer.SPEC.name], self.camera())
             self.clear_products()
             for view in self.light_views():
                 with be.timed(timings, "rsm"):
                     rsm.run(be, self.rsm_target, self._meshes[rsm.SPEC.name], view)
                 with be.timed(timings, "direct_light"):
                     direct_light.run(be, self.gbuf["position"], self.gbuf["normal"], self.rsm["position"],
-                                     self.direct, view, self.rsm_config.depth_bias_m)
+                                     self.direct, view, self.rsm_config.shadow_bias_texels)
                 self.per_light_view(view, timings)
-            with be.timed(timings, "readback"):
-                albedo = be.read(self.gbuf["albedo"])  # alpha = coverage
-                images = {"albedo": albedo}
-                for name, tex in self.product_textures().items():
-                    images[name] = be.read(tex)
-                    images[name][..., 3] = albedo[..., 3]
-        return Result({k: np.ascontiguousarray(v[::-1]) for k, v in images.items()}, timings)
+        return timings
+
+    def read(self) -> dict[str, np.ndarray]:
+        """The products in image order (row 0 = top), alpha = geometry coverage."""
+        albedo = self.backend.read(self.gbuf["albedo"])
+        images = {"albedo": albedo}
+        for name, tex in self.product_textures().items():
+            images[name] = self.backend.read(tex)
+            images[name][..., 3] = albedo[..., 3]
+        return {k: np.ascontiguousarray(v[::-1]) for k, v in images.items()}
+
+    def run(self) -> Result:
+        """One full update (G-buffer, every light, read-back), timed: what a benchmark measures."""
+        timings: dict[str, float] = {}
+        with self.backend.timed(timings, "total"):
+            timings.update({k: v for k, v in self.compute().items() if k != "total"})
+            with self.backend.timed(timings, "readback"):
+                images = self.read()
+        return Result(images, timings)
 
     def clear_products(self) -> None:
         self.backend.clear(self._direct_target)

@@ -27,15 +27,19 @@ class RsmMethod(DirectMethod):
             raise ConfigError(f"method rsm computes one bounce: GIConfig.bounces = {gi.bounces} must be 1")
         super().__init__(backend, gi, rsm_config)
 
+    def allocate_products(self, size: tuple[int, int]) -> None:
+        super().allocate_products(size)
+        self.indirect = self.backend.texture(size)
+        self._indirect_target = self.backend.target([self.indirect])
+
     def set_scene(self, scene) -> None:
         super().set_scene(scene)
-        self.indirect = self.backend.texture(self.direct.size)
-        self._indirect_target = self.backend.target([self.indirect])
         self.voxels = None
         if self.rsm_config.visibility == "voxel":
-            self.grid = Grid.fit(*scene.bounds_m(), max_cells=self.rsm_config.voxel_cells)
+            local = self.scene  # re-centred by DirectMethod.set_scene, like every pass's input
+            self.grid = Grid.fit(*local.bounds_m(), max_cells=self.rsm_config.voxel_cells)
             self.voxelizer = Voxelizer(self.backend, self.grid)
-            self.voxelizer.set_scene(scene)
+            self.voxelizer.set_scene(local)
             timings: dict[str, float] = {}
             with self.backend.timed(timings, "voxelize"):
                 self.voxels = self.voxelizer.run()

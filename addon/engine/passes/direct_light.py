@@ -22,16 +22,16 @@ SPEC = ShaderSpec(
         Var("light_pos_ws", "vec3"), Var("texel_scale", "float"),
         Var("emit_axis", "vec3"), Var("light_kind", "int"),
         Var("light_color_intensity", "vec3"), Var("face_index", "int"),
-        Var("spot_cos_half", "float"), Var("spot_blend", "float"), Var("depth_bias_m", "float"),
+        Var("spot_cos_half", "float"), Var("spot_blend", "float"), Var("shadow_bias_texels", "float"),
     ),
 )
 
 
 def run(backend: Backend, gbuf_position, gbuf_normal, rsm_position, direct, view: LightView,
-        depth_bias_m: float) -> None:
+        shadow_bias_texels: float) -> None:
     names = {u.name for u in SPEC.uniforms}
     uniforms = {k: v for k, v in view.uniforms.items() if k in names}
-    uniforms["depth_bias_m"] = depth_bias_m
+    uniforms["shadow_bias_texels"] = shadow_bias_texels
     backend.dispatch(backend.program(SPEC), group_count(direct.size, SPEC.local_size), uniforms=uniforms,
                      samplers={"gbuf_position": gbuf_position, "gbuf_normal": gbuf_normal,
                                "rsm_position": rsm_position},

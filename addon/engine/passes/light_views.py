@@ -33,6 +33,48 @@ class LightView:
     uniforms: dict
 
 
+def emissive_lights(positions_m: np.ndarray, emission: np.ndarray, bins: int = 8) -> list[Light]:
+    """Emissive triangles as lamps: triangles are grouped by the cell of a coarse grid (`bins` cells
+    along the emitters' longest extent) their centroid falls in, one lamp per group.
+
+    Cycles' mesh emission is two-sided: each side of a surface of radiance L emits pi L A. Flat groups
+    (area-weighted normals mostly agree) become two AREA lights, one per side; closed ones (a sphere:
+    normals cancel, the inner side's light stays inside) one isotropic POINT light of pi L A. Exact far
+    from the emitter; near a large one (a ceiling 2 cm behind a panel) a point is far too concentrated.
+    """
+    lum = emission.max(axis=1) if len(emission) else np.zeros(0)
+    sel = lum > 0
+    if not np.any(sel):
+        return []
+    p = np.asarray(positions_m, np.float64)[sel]
+    e = np.asarray(emission, np.float64)[sel]
+    cross = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    area = 0.5 * np.linalg.norm(cross, axis=1)
+    centroid = p.mean(axis=1)
+    lo, hi = centroid.min(axis=0), centroid.max(axis=0)
+    cell = max(float((hi - lo).max()) / bins, 1e-9)
+    keys = np.floor((centroid - lo) / cell).astype(np.int64)
+    _, group = np.unique(keys, axis=0, return_inverse=True)
+    lights = []
+    for g in range(group.max() + 1):
+        m = group.ravel() == g
+        flux = np.pi * (e[m] * area[m, None]).sum(axis=0)  # W per colour channel
+        total_area = area[m].sum()
+        if total_area <= 0 or flux.max() <= 0:
+            continue
+        weights = flux.max() * area[m] / total_area
+        position = (centroid[m] * weights[:, None]).sum(axis=0) / weights.sum()
+        net = 0.5 * cross[m].sum(axis=0)  # area-weighted normal sum
+        power = float(flux.max())
+        color = flux / power
+        if np.linalg.norm(net) > 0.5 * total_area:
+            lights.append(Light("AREA", position, net, color, power_w=power, name="emissive"))
+            lights.append(Light("AREA", position, -net, color, power_w=power, name="emissive (back)"))
+        else:
+            lights.append(Light("POINT", position, [0, 0, -1], color, power_w=power, name="emissive"))
+    return lights
+
+
 def light_intensity(light: Light) -> np.ndarray:
     """Per-channel radiant intensity (W/sr) at the peak, or the sun's irradiance (W/m^2)."""
     if light.kind == "SUN":
@@ -48,7 +90,10 @@ def views_for(light: Light, index: int, bounds: tuple[np.ndarray, np.ndarray], r
     if light.kind == "SUN":
         return [_sun_view(light, index, corners, resolution)]
     far = float(np.max(np.linalg.norm(corners - light.position_m, axis=1))) * 1.01 + 1e-3
-    near = max(far * 1e-5, 1e-5)
+    # Depth precision goes with far / near: keep near as large as the scene allows. Outside the
+    # bounds, half the distance to them clips nothing; inside, far / 1000 (32-bit depth, ~1e-4 relative).
+    outside_m = float(np.linalg.norm(np.maximum(np.maximum(lo - light.position_m, light.position_m - hi), 0.0)))
+    near = max(far * 1e-3, 0.5 * outside_m)
     if light.kind == "SPOT" and light.spot_size_rad <= SINGLE_FACE_MAX_SPOT_RAD:
         fov = min(light.spot_size_rad * 1.02, SINGLE_FACE_MAX_SPOT_RAD)
         return [_perspective_view(light, index, light.direction, -1, fov, near, far, resolution)]

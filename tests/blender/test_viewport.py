@@ -1,0 +1,202 @@
+"""The viewport overlay: its draw callback renders into a GPUOffScreen with a real camera on the Cornell
+box, and what it adds is checked per pixel; the Blender-gpu run of each method equals the moderngl run.
+
+The add-on is imported as the package `bounce` (a symlink to the repository), as Blender imports it, so
+the relative imports between addon/, operators/ and panels/ resolve and scene.bounce is registered.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+import sys
+import types
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+bpy = pytest.importorskip("bpy")
+
+pytestmark = [pytest.mark.blender, pytest.mark.gpu]
+
+ROOT = Path(__file__).resolve().parents[2]
+W, H = 128, 96  # the region; gi.resolution = 128 makes the overlay's images exactly this size
+CLEAR = (0.1, 0.2, 0.3, 1.0)
+
+
+@pytest.fixture(scope="module")
+def bounce(tmp_path_factory):
+    link_dir = tmp_path_factory.mktemp("pkg")
+    (link_dir / "bounce").symlink_to(ROOT, target_is_directory=True)
+    sys.path.insert(0, str(link_dir))
+    try:
+        yield importlib.import_module("bounce")
+    finally:
+        sys.path.remove(str(link_dir))
+
+
+class _Region:
+    """What the callback reads of bpy.types.Region (there are no regions in background mode)."""
+
+    def __init__(self, width, height):
+        self.width, self.height = width, height
+
+    def as_pointer(self):
+        return 1
+
+
+def view_context(scene, width=W, height=H, location=(0.0, -6.0, 1.0)):
+    """A context as the POST_VIEW callback sees it: region size, region_data's view and window matrices
+    (here a camera 6 m in front of the box looking at its centre, so background surrounds the box)."""
+    cam = scene.camera
+    cam.location = location
+    direction = (0.0, 0.0, 1.0) - np.array(location)
+    from mathutils import Vector
+
+    cam.rotation_euler = Vector(direction).to_track_quat("-Z", "Y").to_euler()
+    bpy.context.view_layer.update()
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    region_data = types.SimpleNamespace(view_matrix=cam.matrix_world.inverted(),
+                                        window_matrix=cam.calc_matrix_camera(depsgraph, x=width, y=height))
+    return types.SimpleNamespace(scene=scene, region=_Region(width, height), region_data=region_data)
+
+
+def captured(live) -> None:
+    """Run the live timer's work now (timers never fire in background mode), at full quality."""
+    live.STATE.last_event_s = -math.inf
+    assert live.tick() is None
+    if bpy.app.timers.is_registered(live.tick):
+        bpy.app.timers.unregister(live.tick)
+
+
+def draw_offscreen(viewport, ctx, width=W, height=H) -> np.ndarray:
+    """Call the draw callback with an RGBA32F offscreen bound, cleared to CLEAR; (h, w, 4), row 0 bottom."""
+    import gpu
+
+    viewport.backend()  # initialises Blender's gpu module in background mode
+    offscreen = gpu.types.GPUOffScreen(width, height, format="RGBA32F")
+    try:
+        with offscreen.bind():
+            fb = gpu.state.active_framebuffer_get()
+            fb.clear(color=CLEAR)
+            viewport.draw_callback(ctx)
+            return np.array(fb.read_color(0, 0, width, height, 4, 0, "FLOAT").to_list(), np.float32)
+    finally:
+        offscreen.free()
+
+
+@pytest.fixture
+def cornell(bounce, fresh_blend):
+    """The add-on registered, the Cornell box built, the overlay enabled with method rsm, captured."""
+    from bounce.addon.bridge import live, scenes
+
+    bounce.register()
+    try:
+        scenes.build("cornell")
+        settings = bpy.context.scene.bounce
+        settings.gi.method = "rsm"
+        settings.gi.resolution = max(W, H)
+        settings.enabled = True
+        ctx = view_context(bpy.context.scene)
+        captured(live)
+        yield ctx
+    finally:
+        bounce.unregister()
+
+
+def _textures(viewport, method) -> dict[str, np.ndarray]:
+    be = viewport.backend()
+    return {"albedo": be.read(method.gbuf["albedo"]), "direct": be.read(method.direct),
+            "indirect": be.read(method.indirect)}
+
+
+@pytest.mark.parametrize("mode, w_direct, w_indirect",
+                         [("COMBINED", 1, 1), ("INDIRECT", 0, 1), ("DIRECT", 1, 0)])
+def test_overlay_adds_albedo_times_light_times_exposure(cornell, mode, w_direct, w_indirect):
+    from bounce.addon.bridge import live, viewport
+
+    settings = cornell.scene.bounce
+    settings.view_mode, settings.exposure, settings.strength = mode, 1.5, 0.7
+    runs = viewport.gpu_runs
+    pixels = draw_offscreen(viewport, cornell)
+    assert live.STATE.error is None
+    assert viewport.gpu_runs == runs + 1
+    tex = _textures(viewport, viewport.overlay_for(1, "full").method)
+    assert tex["albedo"].shape == (H, W, 4)  # the overlay ran at the region's size: texel = pixel
+
+    added = pixels - np.array(CLEAR, np.float32)
+    geometry = tex["albedo"][..., 3] > 0
+    # A camera 6 m away sees the box in the middle and nothing around it.
+    assert 0.2 < geometry.mean() < 0.8
+    # Nothing where the G-buffer saw no geometry: albedo 0 there, so exactly 0 is added (and alpha never).
+    assert np.all(added[~geometry] == 0.0)
+    assert np.all(added[..., 3] == 0.0)
+    # Light everywhere on the box: the spot's direct light on the floor, indirect on every wall.
+    lit = (added[geometry][:, :3].sum(axis=1) > 0).mean()
+    assert lit > (0.1 if mode == "DIRECT" else 0.95), lit
+    assert added.max() > 0.5
+
+    expected = tex["albedo"][..., :3] * (w_direct * tex["direct"][..., :3] + w_indirect * tex["indirect"][..., :3])
+    expected *= 2.0 ** 1.5 * 0.7
+    # The full-screen triangle's uv lands on texel centres, where linear filtering returns the texel
+    # itself, up to the rounding of the interpolated uv: at edges, where a neighbour texel differs a lot,
+    # a tiny fraction of it leaks in (measured: 0.4 % of pixels, at most 5.6e-6 absolute against values
+    # up to ~2). Hence rtol 1e-5 (fp32 maths in another order) and atol 2e-5 (1e-5 of the brightest).
+    np.testing.assert_allclose(added[..., :3], expected, rtol=1e-5, atol=1e-5 * expected.max())
+
+
+def test_redraw_without_changes_does_not_recompute(cornell):
+    from bounce.addon.bridge import viewport
+
+    first = draw_offscreen(viewport, cornell)
+    runs = viewport.gpu_runs
+    cornell.scene.bounce.exposure = 1.0  # a display setting: redraw only
+    second = draw_offscreen(viewport, cornell)
+    assert viewport.gpu_runs == runs
+    clear = np.array(CLEAR, np.float32)
+    # Exposure 0 -> 1 doubles what is added (fp32 sums with the clear colour: a few ulp of ~2).
+    np.testing.assert_allclose(second[..., :3] - clear[:3], 2.0 * (first[..., :3] - clear[:3]), rtol=1e-5, atol=1e-6)
+
+
+def test_navigating_gives_preview_then_full_quality(cornell):
+    from bounce.addon.bridge import live, viewport
+
+    draw_offscreen(viewport, cornell)
+    moved = view_context(cornell.scene, location=(0.5, -6.0, 1.2))
+    draw_offscreen(viewport, moved)  # the view changed: preview at half size, a full update scheduled
+    assert bpy.app.timers.is_registered(live.tick)
+    preview = viewport.overlay_for(1, "preview").camera
+    assert (preview.width, preview.height) == (W // 2, H // 2)
+    captured(live)  # idle now: full quality
+    assert live.STATE.quality == "full"
+    runs = viewport.gpu_runs
+    draw_offscreen(viewport, moved)
+    assert viewport.gpu_runs == runs + 1
+    full = viewport.overlay_for(1, "full").camera
+    assert (full.width, full.height) == (W, H)
+    np.testing.assert_array_equal(full.view, preview.view)
+
+
+@pytest.mark.parametrize("name", ["direct", "rsm"])
+def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, name):
+    from addon.bridge import scenes
+    from addon.bridge.capture import SceneCache
+    from addon.engine import methods
+    from addon.engine.config import GIConfig, RsmConfig
+
+    scenes.build("cornell")
+    scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 64, 48)
+    gi, rsm = GIConfig(method=name, resolution=64), RsmConfig(resolution=128, vpl_samples=64)
+    results = []
+    for be in (gl, blender_backend):
+        method = methods.get(name)(be, gi, rsm)
+        method.set_scene(scene)
+        results.append(method.run().images)
+    a, b = results
+    assert set(a) == set(b) == set(methods.get(name).products)
+    for key in a:
+        assert a[key].max() > 0, key
+        # Same GLSL bodies, same Mesa rasterizer and fp32 maths on both: equal to float32 rounding
+        # (rtol 1e-5), the gather's hash gives both the same VPLs.
+        np.testing.assert_allclose(b[key], a[key], rtol=1e-5, atol=1e-6, err_msg=key)
