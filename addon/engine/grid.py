@@ -17,9 +17,11 @@ class Grid:
     dims: tuple[int, int, int]
 
     @classmethod
-    def fit(cls, lo: np.ndarray, hi: np.ndarray, max_cells: int, pad_cells: float = 1.0) -> Grid:
+    def fit(cls, lo: np.ndarray, hi: np.ndarray, max_cells: int, pad_cells: float = 1.5) -> Grid:
         """Cells of one size so the longest side of the bounds (plus `pad_cells` on each side) gets
-        `max_cells`; the other axes get as many as they need (at least 1)."""
+        `max_cells`; the other axes get as many as they need (at least 1). The half-cell in the default
+        padding puts geometry at the bounds (outer walls) mid-cell, not on a cell boundary where float
+        rounding at another scene scale would pick the neighbouring cell."""
         lo, hi = np.asarray(lo, np.float64), np.asarray(hi, np.float64)
         extent = np.maximum(hi - lo, 1e-6)
         cell = float(extent.max()) / (max_cells - 2.0 * pad_cells)

@@ -104,9 +104,12 @@ class Scene:
         pos = np.asarray(self.positions_m, np.float64)
         finite = np.all(np.isfinite(pos), axis=(1, 2)) & np.all(np.isfinite(self.normals), axis=(1, 2))
         area2 = np.zeros(len(pos))
-        area2[finite] = np.linalg.norm(np.cross(pos[finite, 1] - pos[finite, 0], pos[finite, 2] - pos[finite, 0]),
-                                       axis=1)
-        keep = finite & (area2 > 0)
+        edge2 = np.zeros(len(pos))
+        e1, e2 = pos[finite, 1] - pos[finite, 0], pos[finite, 2] - pos[finite, 0]
+        area2[finite] = np.linalg.norm(np.cross(e1, e2), axis=1)
+        edge2[finite] = np.maximum((e1 * e1).sum(axis=1), (e2 * e2).sum(axis=1))
+        # Zero area relative to the triangle's size: collinear float32 corners leave a ~1e-7 residue.
+        keep = finite & (area2 > 1e-6 * edge2)
         warnings = list(self.warnings)
         if not np.all(keep):
             warnings.append(f"{int((~keep).sum())} triangles with non-finite corners or zero area were ignored")

@@ -93,6 +93,7 @@ def test_values_are_area_weighted_means(gl):
 
 def test_grid_fit_is_not_cubic_for_flat_scenes():
     g = Grid.fit(np.array([0.0, 0.0, 0.0]), np.array([100.0, 50.0, 1.0]), max_cells=64)
-    assert g.dims[0] == 64 and g.dims[1] == 33 and g.dims[2] == 3
+    # 1.5 cells of padding per side: cell = 100 / (64 - 3) m; y: 50 / cell + 3 -> 34; z: 1 / cell + 3 -> 4.
+    assert g.dims == (64, 34, 4)
     lo, hi = g.origin_m, g.origin_m + g.extent_m
     assert np.all(lo <= [0, 0, 0]) and np.all(hi >= [100, 50, 1])

@@ -152,7 +152,10 @@ def test_light_on_a_surface(gl, name):
     assert images["direct"].max() > 0
 
 
-@pytest.mark.parametrize("name", methods_with_known_leaks())
+@pytest.mark.parametrize("name", methods_with_known_leaks(voxel_reason=(
+    "measured indirect up to 0.135: the grid spans the 6 m ground in 64 cells (9 cm), the block's floor "
+    "is 20 cm above the ground, and the march skips the cell next to each end, so ground VPLs below the "
+    "block see its inside through the floor")))
 def test_camera_inside_closed_block(gl, name):
     # The camera sits inside a closed block [-0.3, 0.3]^2 x [0.2, 0.8] (inner faces seen, flipped to the
     # camera); the light is outside. Exact answer: direct 0 and indirect 0 (no light enters the block).
