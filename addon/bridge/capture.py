@@ -89,22 +89,43 @@ def _srgb_to_linear(c: np.ndarray) -> np.ndarray:
     return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
 
 
-def _image_average(image) -> np.ndarray | None:
-    """Mean linear RGB of an image's pixels (byte sRGB images are linearised per pixel first)."""
+def _image_texels(image) -> np.ndarray | None:
+    """Linear RGB texels (h, w, 3), row 0 = the image's bottom (Blender's order, v = 0)."""
     w, h = image.size
     if w * h == 0 or image.channels < 3:
         return None
     px = np.empty(w * h * image.channels, np.float32)
     image.pixels.foreach_get(px)
-    rgb = px.reshape(-1, image.channels)[:, :3].astype(np.float64)
+    rgb = px.reshape(h, w, image.channels)[..., :3].astype(np.float64)
     # Image.pixels of a byte image holds the file's encoded values; float buffers are already linear.
     if not image.is_float and image.colorspace_settings.name.lower().startswith("srgb"):
         rgb = _srgb_to_linear(rgb)
-    return rgb.mean(axis=0)
+    return rgb
 
 
-def _input_color(node, name: str, problems: list[str], images: dict) -> np.ndarray:
-    """A colour input's value: its constant, an RGB node, or an Image Texture's average colour."""
+# Dunavant's 6-point rule on the triangle (exact for polynomials of degree 4). Every point is inside,
+# so a UV corner exactly on the texture's edge (u = 1) never wraps to the opposite side.
+_A, _B = 0.816847572980459, 0.091576213509771
+_C, _D = 0.108103018168070, 0.445948490915965
+_TRI_POINTS = np.array([[_A, _B, _B], [_B, _A, _B], [_B, _B, _A], [_C, _D, _D], [_D, _C, _D], [_D, _D, _C]])
+_TRI_WEIGHTS = np.array([0.109951743655322] * 3 + [0.223381589678011] * 3)
+
+
+def triangle_texture_average(texels: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """Mean colour (n, 3) of a texture over each triangle's UVs (n, 3, 2); repeat wrap, nearest texel."""
+    h, w, _ = texels.shape
+    pts = np.einsum("kc,ncd->nkd", _TRI_POINTS, uv)  # (n, 6, 2)
+    x = np.floor(pts[..., 0] * w).astype(np.int64) % w
+    y = np.floor(pts[..., 1] * h).astype(np.int64) % h
+    return np.einsum("nkc,k->nc", texels[y, x], _TRI_WEIGHTS)
+
+
+def _input_color(node, name: str, problems: list[str], images: dict, textures: list | None = None) -> np.ndarray:
+    """A colour input's value: its constant, an RGB node, or an Image Texture's average colour.
+
+    `textures`, when given, receives the texels of an Image Texture read through the object's UV map
+    (its Vector input unlinked): the caller then averages it per triangle and uses the returned mean
+    only where a mesh has no UVs."""
     sock = node.inputs[name]
     if not sock.is_linked:
         return np.array(sock.default_value[:3], np.float64)
@@ -114,9 +135,11 @@ def _input_color(node, name: str, problems: list[str], images: dict) -> np.ndarr
     if src.type in ("TEX_IMAGE", "TEX_ENVIRONMENT") and src.image is not None:
         key = src.image.name
         if key not in images:
-            images[key] = _image_average(src.image)
+            images[key] = _image_texels(src.image)
         if images[key] is not None:
-            return images[key].copy()
+            if textures is not None and src.type == "TEX_IMAGE" and not src.inputs["Vector"].is_linked:
+                textures.append(images[key])
+            return images[key].reshape(-1, 3).mean(axis=0)
     problems.append(f"{name} <- {src.bl_idname} (constant used)")
     return np.array(sock.default_value[:3], np.float64)
 
@@ -138,8 +161,13 @@ def _surface_node(tree, output_type: str, input_name: str):
     return cycles[0].inputs[input_name].links[0].from_node
 
 
-def material_values(mat, images: dict | None = None) -> tuple[np.ndarray, np.ndarray, str | None]:
-    """(albedo, emission, warning or None) of a material, as Cycles' Diffuse Color pass and emission see it."""
+def material_values(mat, images: dict | None = None, textures: list | None = None
+                    ) -> tuple[np.ndarray, np.ndarray, str | None]:
+    """(albedo, emission, warning or None) of a material, as Cycles' Diffuse Color pass and emission see it.
+
+    With `textures` (a list), a Base Color image texture read through UVs is appended to it and the
+    returned albedo is the texture's average times the rest of the factors: per-triangle albedo is
+    then albedo / average x the texture's mean over the triangle (`_material_arrays`)."""
     images = {} if images is None else images
     if mat is None:
         return np.full(3, NEUTRAL_ALBEDO), np.zeros(3), None  # Cycles' default surface
@@ -148,7 +176,7 @@ def material_values(mat, images: dict | None = None) -> tuple[np.ndarray, np.nda
     node = _surface_node(mat.node_tree, "OUTPUT_MATERIAL", "Surface")
     problems: list[str] = []
     if node is not None and node.type == "BSDF_PRINCIPLED":
-        base = _input_color(node, "Base Color", problems, images)
+        base = _input_color(node, "Base Color", problems, images, textures)
         metallic = _input_float(node, "Metallic", problems)
         transmission = _input_float(node, "Transmission Weight", problems)
         level = _input_float(node, "Specular IOR Level", problems)
@@ -164,7 +192,7 @@ def material_values(mat, images: dict | None = None) -> tuple[np.ndarray, np.nda
         albedo = np.zeros(3)
         emission = _input_color(node, "Color", problems, images) * _input_float(node, "Strength", problems)
     elif node is not None and node.type == "BSDF_DIFFUSE":
-        albedo, emission = _input_color(node, "Color", problems, images), np.zeros(3)
+        albedo, emission = _input_color(node, "Color", problems, images, textures), np.zeros(3)
     else:
         kind = "no surface" if node is None else node.bl_idname
         return np.full(3, NEUTRAL_ALBEDO), np.zeros(3), (
@@ -203,6 +231,7 @@ class _Block:
     local_pos: np.ndarray      # (n, 3, 3) float64, Blender units, object space
     local_nrm: np.ndarray      # (n, 3, 3) float64, object space
     mat_index: np.ndarray      # (n,) int, material slot per triangle
+    uv: np.ndarray | None      # (n, 3, 2) active render UV map, or None
     source: str                # name of the object whose geometry this is (for update tagging)
     instancer: str             # name of the instancing object ("" for a plain object)
     fingerprint: tuple = ()    # identity of the evaluated geometry (see _fingerprint)
@@ -210,8 +239,9 @@ class _Block:
     world: tuple | None = None  # cached (positions_m, normals, keep mask, dropped count)
 
 
-def _read_local(obj) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-    """Object-space triangles, corner normals and material indices of an evaluated object."""
+def _read_local(obj) -> tuple | None:
+    """Object-space triangles, corner normals, material indices and UVs (active render map, or None)
+    of an evaluated object."""
     mesh, tmp = None, False
     if obj.type == "MESH":
         mesh = obj.data
@@ -232,12 +262,18 @@ def _read_local(obj) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
         mesh.loop_triangles.foreach_get("material_index", mi)
         cn = np.empty(nl * 3, np.float64)
         mesh.corner_normals.foreach_get("vector", cn)  # 4.1+: custom/split normals included
+        uv_layer = next((layer for layer in mesh.uv_layers if layer.active_render), None)
+        uv = None
+        if uv_layer is not None:
+            uv_flat = np.empty(nl * 2, np.float64)
+            uv_layer.uv.foreach_get("vector", uv_flat)
+            uv = uv_flat.reshape(-1, 2)[tri_l].reshape(nt, 3, 2)
     finally:
         if tmp:
             obj.to_mesh_clear()
     pos = co.reshape(-1, 3)[tri_v].reshape(nt, 3, 3)
     nrm = cn.reshape(-1, 3)[tri_l].reshape(nt, 3, 3)
-    return pos, nrm, mi
+    return pos, nrm, mi, uv
 
 
 def _fingerprint(obj) -> tuple:
@@ -389,7 +425,7 @@ class SceneCache:
         dropped = sum(b.world[3] for b in seen.values())
         if dropped:
             out.warnings.append(f"{dropped} triangles with NaN/Inf corners or zero area dropped")
-        for _, _, warn in mats.values():
+        for _, _, warn, _ in mats.values():
             if warn:
                 out.warnings.append(warn)
         out.world_color = world_color(scene_bl.world, out.warnings).astype(np.float32)
@@ -409,17 +445,29 @@ class SceneCache:
         return out
 
     def _material_arrays(self, block: _Block, slots: list, mats: dict) -> tuple:
-        """A block's world triangles with per-triangle albedo/emission looked up from its material slots."""
+        """A block's world triangles with per-triangle albedo/emission looked up from its material slots;
+        an image-textured Base Color is averaged over each triangle's UVs."""
         pos, nrm, keep, _ = block.world
-        table_a, table_e = [], []
+        table_a, table_e, table_tex = [], [], []
         for mat in slots or [None]:
             key = mat.name if mat is not None else None
             if key not in mats:
-                mats[key] = material_values(mat, self.images)
+                textures: list = []
+                mats[key] = (*material_values(mat, self.images, textures), textures[0] if textures else None)
             table_a.append(mats[key][0])
             table_e.append(mats[key][1])
+            table_tex.append(mats[key][3])
         idx = np.clip(block.mat_index[keep], 0, len(table_a) - 1)  # Cycles clamps the index too
-        return pos, nrm, np.asarray(table_a).reshape(-1, 3)[idx], np.asarray(table_e).reshape(-1, 3)[idx]
+        albedo = np.asarray(table_a).reshape(-1, 3)[idx]
+        if block.uv is not None:
+            uv = block.uv[keep]
+            for slot, texels in enumerate(table_tex):
+                on = idx == slot
+                if texels is not None and np.any(on):
+                    mean = texels.reshape(-1, 3).mean(axis=0)
+                    scale = np.divide(table_a[slot], mean, out=np.zeros(3), where=mean > 0)
+                    albedo[on] = np.clip(triangle_texture_average(texels, uv[on]) * scale, 0.0, 1.0)
+        return pos, nrm, albedo, np.asarray(table_e).reshape(-1, 3)[idx]
 
 
 def capture(depsgraph, width: int | None = None, height: int | None = None) -> Scene:

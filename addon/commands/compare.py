@@ -1,7 +1,8 @@
 """`python -m addon compare A.exr B.exr`: errors of A against the reference B, as one JSON object.
 
 If B has an alpha channel it is the reference's geometry mask (alpha > 0.5 counts, as written by
-`reference`); a plain RGB reference counts every pixel. Images of different sizes: exit 2.
+`reference`); a plain RGB reference counts every pixel. Images of different sizes: exit 2. HDR-FLIP is
+added when the flip-evaluator package is installed (requirements.txt pins it), else reported as null.
 """
 
 from __future__ import annotations
@@ -9,11 +10,11 @@ from __future__ import annotations
 import json
 
 from ..bridge import images
-from ..engine.errors import ConfigError
-from ..engine.metrics import compare
+from ..engine.errors import BackendUnavailable, ConfigError
+from ..engine.metrics import compare, hdr_flip
 
 NAME = "compare"
-HELP = "print rel_rmse, rel_rmse_8, bias of A.exr against the reference B.exr as JSON"
+HELP = "print rel_rmse, rel_rmse_8, bias, HDR-FLIP of A.exr against the reference B.exr as JSON"
 
 
 def add_arguments(parser) -> None:
@@ -31,7 +32,11 @@ def compare_files(test_path, reference_path) -> dict:
         raise ConfigError("compare needs RGB or RGBA images")
     masked = b.shape[2] >= 4
     mask = b[:, :, 3] > 0.5 if masked else None
-    return {**compare(a[:, :, :3], b[:, :, :3], mask), "masked": masked}
+    try:
+        flip = hdr_flip(a[:, :, :3], b[:, :, :3], mask)
+    except BackendUnavailable:
+        flip = None
+    return {**compare(a[:, :, :3], b[:, :, :3], mask), "hdr_flip": flip, "masked": masked}
 
 
 def run(args) -> int:

@@ -359,3 +359,35 @@ def test_unchanged_instances_are_not_reread(fresh_blend):
     s = cache.update(_dg())
     assert cache.geometry_reads == 4 and s.triangle_count == 36
     np.testing.assert_allclose(s.bounds_m()[0], [0, 9, -1], atol=1e-6)
+
+
+def test_image_texture_averaged_per_triangle(fresh_blend):
+    # A quad cut into 16 x 16 x 2 triangles, UV = (x, y) / 2 + 0.5, textured with a 256-px ramp whose
+    # texel i holds (i + 0.5) / 256 in red: each triangle's albedo is the ramp's mean over the triangle,
+    # i.e. its UV centroid's u (exact for a linear function; nearest-texel lookup adds <= 1/512 per sample).
+    import bmesh
+
+    me = bpy.data.meshes.new("Grid")
+    bm = bmesh.new()
+    bm.loops.layers.uv.new("UVMap")  # calc_uvs fills an existing layer
+    bmesh.ops.create_grid(bm, x_segments=16, y_segments=16, size=1.0, calc_uvs=True)
+    bm.to_mesh(me)
+    bm.free()
+    ob = bpy.data.objects.new("Grid", me)
+    bpy.context.scene.collection.objects.link(ob)
+    img = bpy.data.images.new("ramp", 256, 1, float_buffer=True)
+    ramp = (np.arange(256) + 0.5) / 256
+    rgba = np.stack([ramp, np.zeros(256), np.zeros(256), np.ones(256)], axis=1)
+    img.pixels.foreach_set(rgba.ravel().astype(np.float32))
+    mat = _principled("Ramp", **{"Specular IOR Level": 0.0})
+    tex = mat.node_tree.nodes.new("ShaderNodeTexImage")
+    tex.image = img
+    mat.node_tree.links.new(tex.outputs["Color"], mat.node_tree.nodes["Principled BSDF"].inputs["Base Color"])
+    ob.data.materials.append(mat)
+    s = cap.capture(_dg())
+    assert s.triangle_count == 512
+    # bmesh's grid UVs run 0..1 across the grid's x: u = x / 2 + 0.5 for x in [-1, 1].
+    u_centroid = s.positions_m[:, :, 0].mean(axis=1) / 2 + 0.5
+    np.testing.assert_allclose(s.albedo[:, 0], u_centroid, atol=1 / 256)
+    assert np.ptp(s.albedo[:, 0]) > 0.9  # per triangle, not one average (which would be 0.5)
+    np.testing.assert_allclose(s.albedo[:, 1:], 0.0)

@@ -244,7 +244,8 @@ def test_cli_reference_and_compare(scene_4x3, ref32, tmp_path):
     assert got["rel_rmse"] > got["rel_rmse_8"] > 0
     # same file against itself: zero error
     r = cli("compare", ref32[0] / "direct.exr", ref32[0] / "direct.exr")
-    assert json.loads(r.stdout)["rel_rmse"] == 0.0
+    same = json.loads(r.stdout)
+    assert same["rel_rmse"] == 0.0 and same["hdr_flip"] == 0.0  # FLIP of identical images is exactly 0
 
 
 def test_cli_compare_rgb_and_size_mismatch(tmp_path):
@@ -252,8 +253,9 @@ def test_cli_compare_rgb_and_size_mismatch(tmp_path):
     images.write_exr(tmp_path / "b.exr", np.full((4, 8, 3), 1.0, np.float32))
     images.write_exr(tmp_path / "c.exr", np.full((8, 8, 3), 1.0, np.float32))
     r = cli("compare", tmp_path / "a.exr", tmp_path / "b.exr")
-    assert json.loads(r.stdout) == {"rel_rmse": 1.0, "rel_rmse_8": 1.0, "bias": 2.0, "pixels": 32,
-                                    "note": None, "masked": False}
+    got = json.loads(r.stdout)
+    assert got.pop("hdr_flip") > 0  # 2 vs 1 everywhere: a visible difference (value is FLIP's business)
+    assert got == {"rel_rmse": 1.0, "rel_rmse_8": 1.0, "bias": 2.0, "pixels": 32, "note": None, "masked": False}
     r = cli("compare", tmp_path / "a.exr", tmp_path / "c.exr")
     assert r.returncode == 2 and "differ in size" in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and "Traceback" not in r.stderr
