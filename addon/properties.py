@@ -97,7 +97,9 @@ class BOUNCE_PG_settings(bpy.types.PropertyGroup):
             name="View", description="Which light the viewport overlay adds",
             items=[("COMBINED", "Combined", "Direct and indirect light"),
                    ("INDIRECT", "Indirect", "Indirect light only"),
-                   ("DIRECT", "Direct", "Direct light only")],
+                   ("DIRECT", "Direct", "Direct light only"),
+                   ("VOXELS", "Voxels", "Debug: the voxel grid of the rsm method's visibility on the "
+                                        "surfaces (checkerboard by cell, magenta = hole)")],
             default="INDIRECT"),
         "exposure": FloatProperty(name="Exposure", description="Overlay brightness in stops (x 2^exposure)",
                                   default=0.0, min=-10.0, max=10.0),
@@ -137,9 +139,15 @@ def register() -> None:
     for cls in classes:
         bpy.utils.register_class(cls)
     bpy.types.Scene.bounce = PointerProperty(type=BOUNCE_PG_settings)
+    # Per light, saved with the light datablock: leave a lamp out of Bounce's light (Cycles keeps it).
+    # One definition, shared with the CLI (which runs without the add-on registered).
+    from .bridge.capture import define_light_switch
+
+    define_light_switch()
 
 
 def unregister() -> None:
+    del bpy.types.Light.bounce_include
     del bpy.types.Scene.bounce
     for cls in reversed(classes):
         bpy.utils.unregister_class(cls)

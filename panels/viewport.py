@@ -19,6 +19,12 @@ def draw_settings(layout, settings) -> None:
     column.prop(settings, "exposure")
     column.prop(settings, "strength")
     column.prop(settings, "last_update_ms")
+    lamps = [ob for ob in bpy.context.scene.objects if ob.type == "LIGHT"]
+    if lamps:
+        box = layout.box()
+        box.label(text="Lights")
+        for ob in lamps:
+            box.prop(ob.data, "bounce_include", text=ob.name)
     status = settings.status
     layout.label(text=status, icon="ERROR" if status.startswith("Error") else "INFO")
 

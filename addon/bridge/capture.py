@@ -310,10 +310,29 @@ def _render_hidden(obj) -> bool:
     return bool(cols) and all(c.hide_render for c in cols)
 
 
+LIGHT_SWITCH = "bounce_include"
+
+
+def define_light_switch() -> None:
+    """Define the per-light switch on bpy.types.Light if the add-on has not (the CLI runs without it).
+    Blender 5 keeps bpy.props values apart from custom properties: a saved value is only readable
+    through a property defined under the same name, so the CLI defines the same one."""
+    if not hasattr(bpy.types.Light, LIGHT_SWITCH):
+        setattr(bpy.types.Light, LIGHT_SWITCH, bpy.props.BoolProperty(
+            name="Bounce", description="Include this light in Bounce's direct and indirect light", default=True))
+
+
+def light_included(light_data) -> bool:
+    """The per-light switch (Light properties > Bounce); lamps are included by default."""
+    return bool(getattr(light_data, LIGHT_SWITCH, True))
+
+
 def _light(obj, m: np.ndarray, scale: float, warnings: list[str]) -> Light | None:
     """A Light from an evaluated lamp object and its world matrix (Blender units)."""
     ld = obj.data
     kind = ld.type
+    if not light_included(obj.original.data):  # a UI switch: read it where the UI wrote it
+        return None  # the user excluded it from Bounce (Light > Bounce: Include)
     if kind not in ("POINT", "SPOT", "SUN", "AREA"):
         warnings.append(f"light {obj.name!r}: type {kind} not supported, left out")
         return None

@@ -17,7 +17,7 @@ from ..engine.backends.moderngl_backend import ModernGLBackend
 from ..engine.config import GIConfig, RsmConfig
 from ..engine.errors import SceneError
 from . import images
-from .capture import SceneCache, image_size
+from .capture import SceneCache, define_light_switch, image_size
 
 _backend = None
 
@@ -44,6 +44,7 @@ def render_file(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, repeat
     uploaded): what a user waits for when a light moves.
     """
     open_blend(blend)
+    define_light_switch()  # read the per-light include switch saved in the file
     scene = bpy.context.scene
     if scene.camera is None:
         raise SceneError(f"{blend}: the scene has no camera")

@@ -40,15 +40,15 @@ PRESENT = ShaderSpec(
     vertex="present/present.vert.glsl",
     fragment="present/present.frag.glsl",
     samplers=(Sampler("albedo_tex", "2D"), Sampler("direct_tex", "2D"), Sampler("indirect_tex", "2D")),
-    uniforms=(Var("scale", "float"), Var("w_direct", "float"), Var("w_indirect", "float")),
+    uniforms=(Var("scale", "float"), Var("w_direct", "float"), Var("w_indirect", "float"), Var("use_albedo", "float")),
     attributes=(Var("pos_ndc", "vec2"),),
     varyings=(Var("uv", "vec2"),),
     outputs=(Var("frag_color", "vec4"),),
 )
 FULL_SCREEN_TRIANGLE = np.array([[-1.0, -1.0], [3.0, -1.0], [-1.0, 3.0]], np.float32)
 
-# view_mode -> (weight of direct, weight of indirect)
-MODE_WEIGHTS = {"COMBINED": (1.0, 1.0), "INDIRECT": (0.0, 1.0), "DIRECT": (1.0, 0.0)}
+# view_mode -> (weight of direct, weight of indirect); VOXELS shows the rsm method's voxel grid instead.
+MODE_WEIGHTS = {"COMBINED": (1.0, 1.0), "INDIRECT": (0.0, 1.0), "DIRECT": (1.0, 0.0), "VOXELS": (0.0, 1.0)}
 PREVIEW_SCALE = 0.5        # preview quality: half the resolution ...
 PREVIEW_VPL_DIVISOR = 4    # ... and a quarter of the VPLs: ~8x less gather work while a light is dragged
 MAX_OVERLAYS = 8           # (region, quality) pairs kept; regions come and go with the UI layout
@@ -161,7 +161,13 @@ def present(method, view_mode: str, exposure: float, strength: float) -> None:
     if _present_batch is None:
         _present_batch = backend().mesh(prog, {"pos_ndc": FULL_SCREEN_TRIANGLE}, "triangles").batch
     w_direct, w_indirect = MODE_WEIGHTS[view_mode]
-    indirect = getattr(method, "indirect", None)
+    use_albedo = 1.0
+    if view_mode == "VOXELS":
+        if not hasattr(method, "voxel_view"):
+            raise ValueError(f"the Voxels view needs a voxel method (rsm); {method.name} has no grid")
+        indirect, use_albedo = method.voxel_view(), 0.0
+    else:
+        indirect = getattr(method, "indirect", None)
     if indirect is None:  # a method without indirect light: the sampler needs some texture
         indirect, w_indirect = method.direct, 0.0
     shader = prog.gl
@@ -173,6 +179,7 @@ def present(method, view_mode: str, exposure: float, strength: float) -> None:
         shader.uniform_float("scale", float(2.0 ** exposure * strength))
         shader.uniform_float("w_direct", w_direct)
         shader.uniform_float("w_indirect", w_indirect)
+        shader.uniform_float("use_albedo", use_albedo)
         shader.uniform_sampler("albedo_tex", method.gbuf["albedo"].gl)
         shader.uniform_sampler("direct_tex", method.direct.gl)
         shader.uniform_sampler("indirect_tex", indirect.gl)

@@ -103,6 +103,9 @@ class _RecordingLayout:
     def __init__(self):
         self.drawn, self.labels = [], []
 
+    def box(self, **_kwargs):
+        return self
+
     def column(self, **_kwargs):
         return self
 
@@ -135,8 +138,10 @@ def test_broken_method_logs_once_stops_and_panel_shows_why(live_cornell, monkeyp
     assert settings.status == "Error: viewport overlay: RuntimeError: shader exploded"
     layout = _RecordingLayout()
     draw_settings(layout, settings)
-    assert layout.labels == [settings.status]
-    assert layout.drawn == ["method", "quality", "view_mode", "exposure", "strength", "last_update_ms"]
+    assert layout.labels[-1] == settings.status  # the status line comes last, after the lights list
+    # The settings, then one include switch per lamp (the Cornell box has one spot).
+    assert layout.drawn == ["method", "quality", "view_mode", "exposure", "strength", "last_update_ms",
+                            "bounce_include"]
     # Stopped: the depsgraph handler schedules nothing, the overlay adds nothing.
     if bpy.app.timers.is_registered(live.tick):
         bpy.app.timers.unregister(live.tick)

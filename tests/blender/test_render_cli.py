@@ -5,6 +5,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 pytestmark = pytest.mark.blender
@@ -52,3 +53,18 @@ def test_bad_input_exits_2_with_one_line(scenes_dir, tmp_path, args, needle):
     errors = [line for line in r.stderr.splitlines() if line.startswith("error:")]
     assert len(errors) == 1 and needle in errors[0], r.stderr
     assert "Traceback" not in r.stderr
+
+
+def test_screenshot_adds_the_overlay(tmp_path):
+    # The README's screenshot command: both PNGs exist, and the overlay added light (indirect light
+    # reaches every wall of the Cornell box) without touching the background (the box's open front
+    # is framed by the walls, so every pixel of this camera is geometry: check values instead).
+    from addon.bridge import images
+
+    r = cli("screenshot", "--out", str(tmp_path), "--res", "48")
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "viewport.png").is_file() and (tmp_path / "viewport_bounce.png").is_file()
+    added = images.read_exr(tmp_path / "overlay.exr")
+    assert added.shape == (48, 48, 3)
+    assert np.isfinite(added).all() and added.min() >= 0.0
+    assert (added.sum(axis=-1) > 0).mean() > 0.9

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from ..errors import ConfigError
 from ..grid import Grid
-from ..passes import rsm_gather
+from ..passes import rsm_gather, voxel_view
 from ..passes.light_views import LightView
 from ..passes.voxelize import Voxelizer
 from .direct import DirectMethod
@@ -36,6 +36,11 @@ class RsmMethod(DirectMethod):
         super().set_scene(scene)
         self.voxels = None
         if self.rsm_config.visibility == "voxel":
+            self.voxelize()
+
+    def voxelize(self) -> dict:
+        """Voxelize the uploaded geometry (once per set_scene): the occupancy for visibility."""
+        if self.voxels is None:
             local = self.scene  # re-centred by DirectMethod.set_scene, like every pass's input
             self.grid = Grid.fit(*local.bounds_m(), max_cells=self.rsm_config.voxel_cells)
             self.voxelizer = Voxelizer(self.backend, self.grid)
@@ -44,6 +49,15 @@ class RsmMethod(DirectMethod):
             with self.backend.timed(timings, "voxelize"):
                 self.voxels = self.voxelizer.run()
             self.voxelize_ms = timings["voxelize"]
+        return self.voxels
+
+    def voxel_view(self):
+        """The debug view of the voxel grid at the current G-buffer (a texture; see passes/voxel_view)."""
+        voxels = self.voxelize()
+        if getattr(self, "_voxel_view", None) is None or self._voxel_view.size != self.direct.size:
+            self._voxel_view = self.backend.texture(self.direct.size)
+        voxel_view.run(self.backend, self.gbuf["position"], voxels["vox_albedo"], self.grid, self._voxel_view)
+        return self._voxel_view
 
     def clear_products(self) -> None:
         super().clear_products()
