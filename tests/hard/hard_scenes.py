@@ -156,3 +156,23 @@ def room_camera(s=1.0, offset=(0.0, 0.0, 0.0), size=48):
 
 
 ROOM_LIGHT_M = np.array([0.4, 0.5, 1.4])
+
+
+# Figures recorded by the tests (conftest.figures) for docs/HARD_CASES.md.
+
+def allclose_figure(actual, desired, rtol, atol=0.0) -> float:
+    """The relative error np.testing.assert_allclose(actual, desired, rtol, atol) measures: the smallest rtol
+    at which it passes, max |a - d| / (|d| + atol / rtol), so the assert holds iff this is <= rtol."""
+    a, d = np.asarray(actual, np.float64), np.asarray(desired, np.float64)
+    diff = np.abs(a - d)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        err = np.where(diff == 0, 0.0, diff / (np.abs(d) + atol / rtol))  # 0 / 0 where equal counts as exact
+    return float(err.max()) if err.size else 0.0
+
+
+def sanity(images) -> str:
+    """What assert_sane checks, as a figure: 'finite, min 0' or the count of non-finite values."""
+    bad = sum(int((~np.isfinite(img)).sum()) for img in images.values())
+    if bad:
+        return f"{bad} non-finite"
+    return f"finite, min {min(float(img.min()) for img in images.values()):.3g}"

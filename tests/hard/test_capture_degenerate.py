@@ -11,8 +11,8 @@ pytest.importorskip("bpy")
 pytestmark = [pytest.mark.blender, pytest.mark.gpu]
 
 
-def test_nan_inf_and_zero_area_dropped_with_one_warning(fresh_blend, gl):
-    from hard_scenes import assert_sane, camera, render
+def test_nan_inf_and_zero_area_dropped_with_one_warning(fresh_blend, gl, figures):
+    from hard_scenes import assert_sane, camera, render, sanity
 
     from addon.bridge.capture import capture
 
@@ -33,11 +33,16 @@ def test_nan_inf_and_zero_area_dropped_with_one_warning(fresh_blend, gl):
     bpy.context.view_layer.update()
     sc = capture(bpy.context.evaluated_depsgraph_get(), 32, 32)
     # Exact: the quad's 2 triangles kept, the 4 bad ones dropped, one warning naming 4.
+    # Capture is method-independent: its figures go in a "capture" column.
+    figures("Blender mesh with NaN/Inf/zero-area faces: triangles kept", "capture", sc.triangle_count, "= 2")
+    figures("Blender mesh with NaN/Inf/zero-area faces: warnings", "capture", "; ".join(sc.warnings),
+            "one, naming 4")
     assert sc.triangle_count == 2
     assert np.isfinite(sc.positions_m).all() and np.isfinite(sc.normals).all()
     assert [w for w in sc.warnings if w.startswith("4 triangles")] and len(sc.warnings) == 1
     sc.camera = camera([0, -3, 3], [0, 1, -1], 32)
     for name in ("direct", "rsm"):
         images = render(gl, name, sc)
+        figures("Blender mesh with NaN/Inf/zero-area faces: rendered outputs", name, sanity(images), "finite, min ≥ 0")
         assert_sane(images)
         assert images["direct"].max() > 0

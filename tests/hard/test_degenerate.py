@@ -9,6 +9,7 @@ import pytest
 from hard_scenes import (
     ALL_METHODS,
     ROOM_LIGHT_M,
+    allclose_figure,
     assert_sane,
     box,
     camera,
@@ -21,6 +22,7 @@ from hard_scenes import (
     render,
     room,
     room_camera,
+    sanity,
 )
 from hard_scenes import scene as make_scene
 
@@ -31,6 +33,18 @@ def _room_scene(geo=None):
     return make_scene(room() if geo is None else geo, [point(ROOM_LIGHT_M, 100.0)], room_camera())
 
 
+def _same_figures(a, b):
+    """What _same measures: max |a - b| / mean(b) per product (it asserts this <= rel)."""
+    return {key: float(np.abs(a[key][..., :3].astype(np.float64) - b[key][..., :3]).max())
+            / max(float(b[key][..., :3].mean()), 1e-30) for key in products(b)}
+
+
+def _record_same(figures, case, name, a, b, rel):
+    bound = f"≤ {rel:.0e}".replace("e-0", "e-")  # "≤ 1e-4", as the tests write it
+    for key, figure in _same_figures(a, b).items():
+        figures(f"{case}: {key} max |Δ| / mean", name, figure, bound)
+
+
 def _same(a, b, rel=1e-5):
     for key in products(b):
         scale = float(b[key][..., :3].mean())
@@ -39,7 +53,7 @@ def _same(a, b, rel=1e-5):
 
 
 @pytest.mark.parametrize("name", ALL_METHODS)
-def test_zero_area_and_duplicated_triangles_change_nothing(gl, name):
+def test_zero_area_and_duplicated_triangles_change_nothing(gl, figures, name):
     # 40 zero-area triangles (collinear, repeated corners; normal (0, 0, 0) as a cross product gives) and a
     # second copy of every room triangle: zero-area ones rasterize no fragment, a duplicate loses the
     # depth test against its twin, so the image is identical in exact arithmetic. Measured: direct
@@ -55,22 +69,24 @@ def test_zero_area_and_duplicated_triangles_change_nothing(gl, name):
            np.concatenate([alb, np.full((40, 3), 0.5), alb]))
     ref = render(gl, name, _room_scene())
     got = render(gl, name, _room_scene(geo))
+    _record_same(figures, "zero-area + duplicated triangles vs none", name, got, ref, 1e-4)
     assert_sane(got)
     _same(got, ref, rel=1e-4)
 
 
 @pytest.mark.parametrize("name", ALL_METHODS)
-def test_flipped_normals_change_nothing(gl, name):
+def test_flipped_normals_change_nothing(gl, figures, name):
     # Cycles is two-sided: the G-buffer flips normals to the camera, the RSM to the light. Exact: same image.
     tris, nrm, alb = room()
     ref = render(gl, name, _room_scene())
     got = render(gl, name, _room_scene((tris, -nrm, alb)))
+    _record_same(figures, "flipped normals vs not", name, got, ref, 1e-5)
     _same(got, ref)
 
 
 @pytest.mark.parametrize("name", ALL_METHODS)
 @pytest.mark.parametrize("bad", [np.nan, np.inf])
-def test_non_finite_vertex_in_engine_scene(gl, name, bad):
+def test_non_finite_vertex_in_engine_scene(gl, figures, name, bad):
     # Capture drops such triangles (test_capture_degenerate.py); a hand-built Scene may still carry one.
     # Right answer: the triangle is ignored (output = the room without it), never NaN. Scene.prepared()
     # drops it; before that, NaN bounds emptied every RSM and all shadows vanished.
@@ -80,13 +96,15 @@ def test_non_finite_vertex_in_engine_scene(gl, name, bad):
            np.concatenate([alb, [[0.5] * 3]]))
     ref = render(gl, name, _room_scene())
     got = render(gl, name, _room_scene(geo))
+    figures(f"{bad} vertex in a Scene: outputs", name, sanity(got), "finite")
+    _record_same(figures, f"{bad} vertex in a Scene vs none", name, got, ref, 1e-5)
     assert all(np.isfinite(v).all() for v in got.values())
     _same(got, ref)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ALL_METHODS)
-def test_million_triangle_floor(gl, name):
+def test_million_triangle_floor(gl, figures, name):
     # A 20 x 20 m floor cut into 708^2 quads = 1,002,528 triangles under a 100 W light at 1 m: the same
     # plane as two triangles, so the same image (the G-buffer and RSM positions are interpolated on the same
     # plane; 1e-4 of the mean allows the fp32 rounding of 1e6 small triangles' edges). Timed: one
@@ -105,6 +123,13 @@ def test_million_triangle_floor(gl, name):
     big = render(gl, name, make_scene((tris, nrm, np.full((len(tris), 3), 0.7)), [light], cam))
     seconds = time.perf_counter() - t0
     small = render(gl, name, make_scene(parts((*rect([-10, -10, 0], [20, 0, 0], [0, 20, 0]), 0.7)), [light], cam))
+    figures("1e6-triangle floor: set_scene + run (s)", name, seconds, "< 20")
+    figures("1e6-triangle floor vs 2 triangles: direct rel error", name,
+            allclose_figure(big["direct"][..., :3], small["direct"][..., :3], 1e-4, 1e-4 * small["direct"].mean()),
+            "≤ 1e-4 (atol 1e-4 mean)")
+    if "indirect" in big:
+        figures("1e6-triangle floor: max indirect (both)", name,
+                max(big["indirect"][..., :3].max(), small["indirect"][..., :3].max()), "= 0")
     assert_sane(big)
     assert seconds < 20.0, seconds
     np.testing.assert_allclose(big["direct"][..., :3], small["direct"][..., :3], rtol=1e-4,
@@ -114,15 +139,18 @@ def test_million_triangle_floor(gl, name):
 
 
 @pytest.mark.parametrize("name", ALL_METHODS)
-def test_one_triangle(gl, name):
+def test_one_triangle(gl, figures, name):
     # One triangle facing a light 1 m above its centroid: direct at the pixel seeing the centroid region is
     # I / (pi d^2) cos = 100 / (4 pi) / pi at the foot point; max over the image <= that (exact peak).
     tri = np.array([[[-1, -1, 0], [1, -1, 0], [0, 1, 0]]], np.float64)
     geo = (tri, np.full((1, 3, 3), [0, 0, 1.0]), np.array([[0.7] * 3]))
     images = render(gl, name, make_scene(geo, [point([0, -0.33, 1], 100.0)], camera([0, 0, 3], [0, 0, -1], 32,
                                                                                        up=(0, 1, 0))))
-    assert_sane(images)
     peak = 100 / (4 * np.pi) / np.pi
+    figures("one triangle: peak direct / I/(π d²)", name, images["direct"][..., 0].max() / peak, "[0.9, 1 + 1e-5]")
+    if "indirect" in images:
+        figures("one triangle: max indirect", name, images["indirect"][..., :3].max(), "= 0")
+    assert_sane(images)
     assert 0.9 * peak <= images["direct"][..., 0].max() <= peak * (1 + 1e-5)
     if "indirect" in images:
         assert images["indirect"][..., :3].max() == 0.0  # a single plane cannot light itself
@@ -130,13 +158,18 @@ def test_one_triangle(gl, name):
 
 @pytest.mark.parametrize("name", ALL_METHODS)
 @pytest.mark.parametrize("case", ["empty", "lights_only", "geometry_only"])
-def test_missing_geometry_or_lights_give_zero(gl, name, case):
+def test_missing_geometry_or_lights_give_zero(gl, figures, name, case):
     # Exact answer: zero everywhere, coverage 0 where there is no geometry, and no exception.
     cam = room_camera()
     lights = [point(ROOM_LIGHT_M, 100.0), point([0, 0, 3], 1e3)]
     sc = {"empty": empty_scene([], cam), "lights_only": empty_scene(lights, cam),
           "geometry_only": make_scene(room(), [], cam)}[case]
     images = render(gl, name, sc)
+    label = {"empty": "empty scene", "lights_only": "lights, no geometry", "geometry_only": "geometry, no lights"}[case]
+    for key in products(images):
+        figures(f"{label}: max {key}", name, images[key][..., :3].max(), "= 0")
+    figures(f"{label}: coverage", name, images["albedo"][..., 3].mean(),
+            "= 1" if case == "geometry_only" else "= 0")
     assert_sane(images)
     for key in products(images):
         assert images[key][..., :3].max() == 0.0, key
@@ -144,10 +177,12 @@ def test_missing_geometry_or_lights_give_zero(gl, name, case):
 
 
 @pytest.mark.parametrize("name", ALL_METHODS)
-def test_light_on_a_surface(gl, name):
+def test_light_on_a_surface(gl, figures, name):
     # The light sits exactly on the floor (d = 0 at one point; the floor is edge-on to it, cos = 0 there):
     # outputs stay finite and non-negative; the walls are lit.
     images = render(gl, name, make_scene(room(), [point([0.6, 0.6, 0.0], 100.0)], room_camera()))
+    figures("light on the floor: outputs", name, sanity(images), "finite, min ≥ 0")
+    figures("light on the floor: max direct", name, images["direct"].max(), "> 0")
     assert_sane(images)
     assert images["direct"].max() > 0
 
@@ -156,7 +191,7 @@ def test_light_on_a_surface(gl, name):
     "measured indirect up to 0.135: the grid spans the 6 m ground in 64 cells (9 cm), the block's floor "
     "is 20 cm above the ground, and the march skips the cell next to each end, so ground VPLs below the "
     "block see its inside through the floor")))
-def test_camera_inside_closed_block(gl, name):
+def test_camera_inside_closed_block(gl, figures, name):
     # The camera sits inside a closed block [-0.3, 0.3]^2 x [0.2, 0.8] (inner faces seen, flipped to the
     # camera); the light is outside. Exact answer: direct 0 and indirect 0 (no light enters the block).
     geo = parts((*box([-0.3, -0.3, 0.2], [0.3, 0.3, 0.8], inward=False), 0.8),
@@ -166,6 +201,8 @@ def test_camera_inside_closed_block(gl, name):
     assert_sane(images)
     assert images["albedo"][..., 3].min() == 1.0
     # Measured for rsm without visibility: indirect up to 0.26 (the ground's VPLs reach the inner faces).
+    for key in products(images):
+        figures(f"camera inside a closed block: max {key}", name, images[key][..., :3].max(), "= 0")
     assert images["direct"][..., :3].max() == 0.0
     for key in products(images):
         assert images[key][..., :3].max() == 0.0, key

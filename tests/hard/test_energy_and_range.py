@@ -10,7 +10,21 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hard_scenes import ALL_METHODS, assert_sane, box, camera, make, parts, point, products, render, room, room_camera
+from hard_scenes import (
+    ALL_METHODS,
+    allclose_figure,
+    assert_sane,
+    box,
+    camera,
+    make,
+    parts,
+    point,
+    products,
+    render,
+    room,
+    room_camera,
+    sanity,
+)
 from hard_scenes import scene as make_scene
 
 pytestmark = pytest.mark.gpu
@@ -19,7 +33,7 @@ FACES = [ax for ax in np.eye(3).tolist() + (-np.eye(3)).tolist()]
 
 
 @pytest.mark.parametrize("name", ALL_METHODS)
-def test_white_closed_box_conserves_flux(gl, name):
+def test_white_closed_box_conserves_flux(gl, figures, name):
     # A cube [-1, 1]^3, albedo 1 everywhere, a P = 100 W point light at L = (0.2, -0.1, 0.3) inside.
     # A camera at the centre with six 90-degree faces sees exactly one wall per face, and each pixel of a
     # face covers the same area of its wall (a plane parallel to the image plane), so the surface
@@ -52,6 +66,10 @@ def test_white_closed_box_conserves_flux(gl, name):
             blocks = img[..., 0].reshape(6, 8, 6, 8).mean(axis=(1, 3))
             block_max[key] = max(block_max.get(key, 0.0), float(blocks.max()))
     bound = P / (4 * np.pi) / (np.pi * 0.7**2)
+    flux_bounds = {"direct": "1 ± 1e-3", "indirect": "[0.9, 1.02]"}
+    for key in totals:
+        figures(f"white box: {key} flux / P", name, totals[key] / P, flux_bounds[key])
+        figures(f"white box: max 8x8-block {key}", name, block_max[key], f"≤ {bound:.3g}")
     assert totals["direct"] == pytest.approx(P, rel=1e-3)
     assert block_max["direct"] <= bound
     if "indirect" in totals:
@@ -67,7 +85,7 @@ def _range_scene(powers):
 
 
 @pytest.mark.parametrize("name", ALL_METHODS)
-def test_dynamic_range_is_linear_in_power(gl, name):
+def test_dynamic_range_is_linear_in_power(gl, figures, name):
     # Output is linear in light power: out(P) / P == out(1 W) per pixel. fp32 carries relative 6e-8 per
     # operation and 1e9 W gives I = 8e7 W/sr, irradiance ~1e8 W/m^2, VPL flux ~1e3 W per texel: far from
     # fp32's 3.4e38 limit and 1e-6 W far from its 1.2e-38 normal floor. Measured: per-pixel relative error
@@ -80,12 +98,18 @@ def test_dynamic_range_is_linear_in_power(gl, name):
         for key, img in products(images).items():
             ref = unit[key][..., :3].astype(np.float64)
             got = img[..., :3].astype(np.float64) / p
+            figures(f"linear in power: {key} at {p:g} W vs 1 W, rel error", name,
+                    allclose_figure(got, ref, 1e-3, 1e-6 * ref.max()), "≤ 1e-3 (atol 1e-6 max)")
             assert ref.max() > 0
             np.testing.assert_allclose(got, ref, rtol=1e-3, atol=1e-6 * ref.max(), err_msg=f"{key} at {p:g} W")
     # Both together: the 1e-6 W light is 1e-15 of the other, below fp32's resolution, so the image is the
     # 1e9 W image alone (within the same 1e-3), finite, non-negative.
     both = render(gl, name, _range_scene([1e9, 1e-6]))
     alone = render(gl, name, _range_scene([1e9]))
+    for key in products(both):
+        figures(f"1e9 W + 1e-6 W vs 1e9 W alone: {key} rel error", name,
+                allclose_figure(both[key][..., :3], alone[key][..., :3], 1e-3, 1e-6 * float(alone[key].max())),
+                "≤ 1e-3 (atol 1e-6 max)")
     assert_sane(both)
     for key in products(both):
         np.testing.assert_allclose(both[key][..., :3], alone[key][..., :3], rtol=1e-3,
@@ -93,13 +117,17 @@ def test_dynamic_range_is_linear_in_power(gl, name):
 
 
 @pytest.mark.parametrize("name", ALL_METHODS)
-def test_bright_light_near_wall_no_negative_or_nan(gl, name):
+def test_bright_light_near_wall_no_negative_or_nan(gl, figures, name):
     # A 1e7 W point light 1 cm in front of the back wall of the room (and 1 mm in front of it): the
     # 1/d^2 peak is ~8e5 W/sr / 1e-4 m^2; a VPL at the wall next to a pixel on the same wall has r -> 0
     # (the disk term A / pi keeps it finite). Exact answer for the sign: every term of both outputs is
     # >= 0, so any negative value or NaN is a defect. The peak of direct is bounded by I / (pi d^2).
     for gap in (1e-2, 1e-3):
         images = render(gl, name, make_scene(room(), [point([0.0, 1.0 - gap, 1.0], 1e7)], room_camera()))
+        peak = 1e7 / (4 * np.pi) / (np.pi * gap**2)
+        figures(f"1e7 W light {gap:g} m from a wall: outputs", name, sanity(images), "finite, min ≥ 0")
+        figures(f"1e7 W light {gap:g} m from a wall: peak direct / (I / π d²)", name,
+                images["direct"][..., :3].max() / peak, "(0, 1 + 1e-5]")
         assert_sane(images)
         assert images["direct"][..., :3].max() <= 1e7 / (4 * np.pi) / (np.pi * gap**2) * (1 + 1e-5)
         assert images["direct"][..., :3].max() > 0

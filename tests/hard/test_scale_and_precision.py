@@ -27,7 +27,7 @@ def _rel_l1(a, b):
 
 @pytest.mark.parametrize("name", ALL_METHODS)
 @pytest.mark.parametrize("s", [1e-3, 1e4])
-def test_scale_invariance(gl, name, s):
+def test_scale_invariance(gl, figures, name, s):
     # Exact answer: scaling geometry by s, point powers by s^2 and keeping the sun leaves every image
     # unchanged (direct: I s^2 / (d s)^2; VPL flux ~ I s^2 x texel solid angle, gathered / (r s)^2; the
     # disk term A / pi scales with s^2 too). fp32 positions are relative 6e-8 at any scale, so 1e-3
@@ -35,6 +35,8 @@ def test_scale_invariance(gl, name, s):
     # (a fixed 1 cm shadow bias measured 0.18 at s = 1e-3 before biases were made per RSM texel).
     ref = render(gl, name, _room(1.0))
     images = render(gl, name, _room(s))
+    for key in products(images):
+        figures(f"room x {s:g} vs x 1: {key} rel L1", name, _rel_l1(images[key], ref[key]), "≤ 1e-3")
     assert_sane(images)
     assert (images["albedo"][..., 3] == ref["albedo"][..., 3]).all()
     for key in products(images):
@@ -42,18 +44,20 @@ def test_scale_invariance(gl, name, s):
 
 
 @pytest.mark.parametrize("name", ALL_METHODS)
-def test_indirect_scale_invariance(gl, name):
+def test_indirect_scale_invariance(gl, figures, name):
     # The indirect part alone has no metre-valued bias: it must pass at both scales (measured 5e-7).
     ref = render(gl, name, _room(1.0))
     if "indirect" not in ref:
         pytest.skip(f"{name} has no indirect product")
     for s in (1e-3, 1e4):
-        assert _rel_l1(render(gl, name, _room(s))["indirect"], ref["indirect"]) <= 1e-3, s
+        err = _rel_l1(render(gl, name, _room(s))["indirect"], ref["indirect"])
+        figures(f"room x {s:g} vs x 1: indirect rel L1 (own test)", name, err, "≤ 1e-3")
+        assert err <= 1e-3, s
 
 
 @pytest.mark.parametrize("name", ALL_METHODS)
 @pytest.mark.parametrize("offset", [1e3, 1e4, 1e5])
-def test_far_from_origin(gl, name, offset):
+def test_far_from_origin(gl, figures, name, offset):
     # The same room translated by (offset, offset, 0) with its light and camera. Exact answer: the same
     # image. What fp32 allows: positions carry an absolute error of ulp(offset)/2 = 3e-5 m at 1e3, 5e-4
     # at 1e4, 4e-3 m at 1e5; over light distances of ~1.5 m that is a relative error in 1/d^2 of
@@ -63,8 +67,10 @@ def test_far_from_origin(gl, name, offset):
     # 1e-5 near plane, indirect was off by 0.73 at 1e5 m.
     ref = render(gl, name, _room(1.0, with_sun=False))
     images = render(gl, name, _room(1.0, (offset, offset, 0.0), with_sun=False))
-    assert_sane(images)
     bound = 1e-2 if offset >= 1e5 else 1e-3
     errors = {key: _rel_l1(images[key], ref[key]) for key in products(images)}
+    for key, err in errors.items():
+        figures(f"room {offset:g} m from the origin: {key} rel L1", name, err, "≤ 1e-2" if offset >= 1e5 else "≤ 1e-3")
+    assert_sane(images)
     for key, err in errors.items():
         assert err <= bound, (key, err)

@@ -11,7 +11,7 @@ pytestmark = [pytest.mark.gpu, pytest.mark.slow]
 
 
 @pytest.mark.parametrize("name", ALL_METHODS)
-def test_light_moving_1mm_per_frame(gl, name):
+def test_light_moving_1mm_per_frame(gl, figures, name):
     # Physical change per frame: E = I cos / d^2 with d >= d_min = 0.5 m (light at y = 0.5 to the wall
     # y = 1) changes by |dE / E| <= 2 delta / d + delta / d (the cosine) = 3 x 1 mm / 0.5 m = 6e-3 at most
     # per pixel; the image mean change is below that. Bound on mean|frame_k+1 - frame_k| / mean(frame_k):
@@ -33,5 +33,7 @@ def test_light_moving_1mm_per_frame(gl, name):
                 worst[key] = max(worst.get(key, 0.0), change)
         prev = images
     print(f"{name}: max frame-to-frame relative change {worst}")
+    for key, change in worst.items():
+        figures(f"light moving 1 mm/frame: max mean |Δ frame| / mean, {key}", name, change, "≤ 7e-3")
     for key, change in worst.items():
         assert change <= 7e-3, (key, change)
