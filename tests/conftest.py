@@ -45,6 +45,22 @@ def blender_backend():
     return BlenderGPUBackend()
 
 
+@pytest.fixture(scope="session")
+def bounce(tmp_path_factory):
+    """The repository imported as the package `bounce` (a symlink), as Blender imports the extension,
+    so the relative imports between addon/, operators/ and panels/ resolve."""
+    import importlib
+
+    pytest.importorskip("bpy")
+    link_dir = tmp_path_factory.mktemp("pkg")
+    (link_dir / "bounce").symlink_to(ROOT, target_is_directory=True)
+    sys.path.insert(0, str(link_dir))
+    try:
+        yield importlib.import_module("bounce")
+    finally:
+        sys.path.remove(str(link_dir))
+
+
 @pytest.fixture
 def fresh_blend():
     """An empty Blender file (factory settings), so bpy tests do not see each other's data."""

@@ -45,19 +45,6 @@ ATLAS_COPY = ShaderSpec(
 
 
 @dataclass
-class _Tex(Texture):
-    size: tuple[int, ...]
-    format: str
-    gl: Any
-
-
-@dataclass
-class _Prog(Program):
-    spec: ShaderSpec
-    gl: Any
-
-
-@dataclass
 class _Mesh(Mesh):
     primitive: str
     count: int
@@ -106,7 +93,7 @@ class BlenderGPUBackend(Backend):
 
     def __init__(self):
         ensure_gpu()
-        self._programs: dict[ShaderSpec, _Prog] = {}
+        self._programs: dict[ShaderSpec, Program] = {}
         self._sync = None
 
     @property
@@ -115,17 +102,17 @@ class BlenderGPUBackend(Backend):
         return f"{p.backend_type_get()} {p.version_get()} / {p.renderer_get()} (Blender gpu)"
 
     # -- textures -----------------------------------------------------------------------------------
-    def texture(self, size, fmt="RGBA32F", data=None) -> _Tex:
-        tex = _Tex(tuple(size), fmt, None)
+    def texture(self, size, fmt="RGBA32F", data=None) -> Texture:
+        tex = Texture(tuple(size), fmt, None)
         if data is None:
             data = np.zeros(tuple(reversed(size)) + (FORMATS[fmt],), np.float32)
         self.write(tex, data)
         return tex
 
-    def depth_texture(self, size) -> _Tex:
-        return _Tex(tuple(size), "DEPTH32F", gpu.types.GPUTexture(tuple(size), format="DEPTH_COMPONENT32F"))
+    def depth_texture(self, size) -> Texture:
+        return Texture(tuple(size), "DEPTH32F", gpu.types.GPUTexture(tuple(size), format="DEPTH_COMPONENT32F"))
 
-    def write(self, tex: _Tex, data) -> None:
+    def write(self, tex: Texture, data) -> None:
         # Blender 5.0's Python API cannot update a texture in place: a write replaces the GPU texture.
         expected = tuple(reversed(tex.size)) + (tex.channels,)
         arr = np.asarray(data, dtype=np.float32)
@@ -133,20 +120,20 @@ class BlenderGPUBackend(Backend):
             raise ValueError(f"write: data of shape {arr.shape} does not fit a texture of shape {expected}")
         tex.gl = gpu.types.GPUTexture(tex.size, format=tex.format, data=_buffer(arr))
 
-    def read(self, tex: _Tex) -> np.ndarray:
+    def read(self, tex: Texture) -> np.ndarray:
         shape = tuple(reversed(tex.size)) + (tex.channels,)
         if tex.is_3d:
             w, h, d = tex.size
             atlas = gpu.types.GPUTexture((w, h * d), format="RGBA32F")
             prog = self.program(ATLAS_COPY)
             self.dispatch(prog, group_count((w, h, d), ATLAS_COPY.local_size), samplers={"volume": tex},
-                          images={"atlas": _Tex((w, h * d), "RGBA32F", atlas)})
+                          images={"atlas": Texture((w, h * d), "RGBA32F", atlas)})
             raw = _flat(atlas.read()).reshape(d, h, w, 4)
             return np.ascontiguousarray(raw[..., : tex.channels], dtype=np.float32)
         return _flat(tex.gl.read()).astype(np.float32).reshape(shape)
 
     # -- programs -----------------------------------------------------------------------------------
-    def program(self, spec: ShaderSpec) -> _Prog:
+    def program(self, spec: ShaderSpec) -> Program:
         cached = self._programs.get(spec)
         if cached is not None:
             return cached
@@ -186,11 +173,11 @@ class BlenderGPUBackend(Backend):
         if failed is not None:
             mapped = sources[-1].map_error(log[0])
             raise ShaderCompileError(f"{spec.name}: {failed}\n{mapped.strip()}") from None
-        prog = _Prog(spec, shader)
+        prog = Program(spec, shader)
         self._programs[spec] = prog
         return prog
 
-    def _bind(self, prog: _Prog, uniforms, samplers) -> None:
+    def _bind(self, prog: Program, uniforms, samplers) -> None:
         sh = prog.gl
         sh.bind()
         types = {u.name: u.type for u in prog.spec.uniforms}

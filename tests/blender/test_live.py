@@ -4,7 +4,6 @@ register/unregister leaves no handler, timer or draw handler behind."""
 
 from __future__ import annotations
 
-import importlib
 import logging
 import math
 import sys
@@ -20,17 +19,6 @@ pytestmark = [pytest.mark.blender, pytest.mark.gpu]
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from test_viewport import captured, draw_offscreen, view_context  # noqa: E402
-
-
-@pytest.fixture(scope="module")
-def bounce(tmp_path_factory):
-    link_dir = tmp_path_factory.mktemp("pkg")
-    (link_dir / "bounce").symlink_to(ROOT, target_is_directory=True)
-    sys.path.insert(0, str(link_dir))
-    try:
-        yield importlib.import_module("bounce")
-    finally:
-        sys.path.remove(str(link_dir))
 
 
 @pytest.fixture

@@ -8,8 +8,6 @@ that is what makes the relative imports between addon/, operators/ and panels/ r
 from __future__ import annotations
 
 import dataclasses
-import importlib
-import sys
 from pathlib import Path
 
 import pytest
@@ -17,17 +15,6 @@ import pytest
 bpy = pytest.importorskip("bpy")
 
 ROOT = Path(__file__).resolve().parents[2]
-
-
-@pytest.fixture(scope="module")
-def bounce(tmp_path_factory):
-    link_dir = tmp_path_factory.mktemp("pkg")
-    (link_dir / "bounce").symlink_to(ROOT, target_is_directory=True)
-    sys.path.insert(0, str(link_dir))
-    try:
-        yield importlib.import_module("bounce")
-    finally:
-        sys.path.remove(str(link_dir))
 
 
 @pytest.fixture

@@ -7,9 +7,7 @@ the relative imports between addon/, operators/ and panels/ resolve and scene.bo
 
 from __future__ import annotations
 
-import importlib
 import math
-import sys
 import types
 from pathlib import Path
 
@@ -23,17 +21,6 @@ pytestmark = [pytest.mark.blender, pytest.mark.gpu]
 ROOT = Path(__file__).resolve().parents[2]
 W, H = 128, 96  # the region; gi.resolution = 128 makes the overlay's images exactly this size
 CLEAR = (0.1, 0.2, 0.3, 1.0)
-
-
-@pytest.fixture(scope="module")
-def bounce(tmp_path_factory):
-    link_dir = tmp_path_factory.mktemp("pkg")
-    (link_dir / "bounce").symlink_to(ROOT, target_is_directory=True)
-    sys.path.insert(0, str(link_dir))
-    try:
-        yield importlib.import_module("bounce")
-    finally:
-        sys.path.remove(str(link_dir))
 
 
 class _Region:

@@ -107,11 +107,13 @@ class ShaderSpec:
         return self.compute is not None
 
 
-class Texture(abc.ABC):
-    """A 2D or 3D float texture owned by a backend."""
+@dataclass
+class Texture:
+    """A 2D or 3D float texture owned by a backend; `gl` is the backend's own handle."""
 
     size: tuple[int, ...]  # (w, h) or (w, h, d)
     format: str
+    gl: Any
 
     @property
     def channels(self) -> int:
@@ -122,8 +124,12 @@ class Texture(abc.ABC):
         return len(self.size) == 3
 
 
-class Program(abc.ABC):
+@dataclass
+class Program:
+    """A compiled ShaderSpec; `gl` is the backend's own handle."""
+
     spec: ShaderSpec
+    gl: Any
 
 
 class Mesh(abc.ABC):

@@ -25,19 +25,6 @@ _GL_COLOR_ATTACHMENT0 = 0x8CE0
 
 
 @dataclass
-class _Tex(Texture):
-    size: tuple[int, ...]
-    format: str
-    gl: Any
-
-
-@dataclass
-class _Prog(Program):
-    spec: ShaderSpec
-    gl: Any
-
-
-@dataclass
 class _Mesh(Mesh):
     primitive: str
     count: int
@@ -126,7 +113,7 @@ class ModernGLBackend(Backend):
         with ctx:
             current = self._egl.save()
         self._own_context = current[3] if current else None
-        self._programs: dict[ShaderSpec, _Prog] = {}
+        self._programs: dict[ShaderSpec, Program] = {}
         self._gl = _gl_library()
         self._gl.glFramebufferTextureLayer.argtypes = [ctypes.c_uint] * 3 + [ctypes.c_int] * 2
 
@@ -141,7 +128,7 @@ class ModernGLBackend(Backend):
 
     # -- textures -----------------------------------------------------------------------------------
     @_in_own_context
-    def texture(self, size, fmt="RGBA32F", data=None) -> _Tex:
+    def texture(self, size, fmt="RGBA32F", data=None) -> Texture:
         comps = FORMATS[fmt]
         dtype = _DTYPE[fmt]
         if len(size) == 3:
@@ -152,17 +139,17 @@ class ModernGLBackend(Backend):
         gl.repeat_x = gl.repeat_y = False
         if len(size) == 3:
             gl.repeat_z = False
-        tex = _Tex(tuple(size), fmt, gl)
+        tex = Texture(tuple(size), fmt, gl)
         self.write(tex, np.zeros(tuple(reversed(size)) + (comps,), np.float32) if data is None else data)
         return tex
 
     @_in_own_context
-    def depth_texture(self, size) -> _Tex:
+    def depth_texture(self, size) -> Texture:
         gl = self.ctx.depth_texture(tuple(size))
-        return _Tex(tuple(size), "DEPTH32F", gl)
+        return Texture(tuple(size), "DEPTH32F", gl)
 
     @_in_own_context
-    def write(self, tex: _Tex, data) -> None:
+    def write(self, tex: Texture, data) -> None:
         arr = np.ascontiguousarray(data, dtype=np.float32)
         expected = tuple(reversed(tex.size)) + (tex.channels,)
         if arr.size != int(np.prod(expected)):
@@ -170,14 +157,14 @@ class ModernGLBackend(Backend):
         tex.gl.write(arr.astype(_DTYPE[tex.format]).tobytes())
 
     @_in_own_context
-    def read(self, tex: _Tex) -> np.ndarray:
+    def read(self, tex: Texture) -> np.ndarray:
         self.ctx.memory_barrier()
         raw = np.frombuffer(tex.gl.read(), dtype=_DTYPE[tex.format])
         return raw.astype(np.float32).reshape(tuple(reversed(tex.size)) + (tex.channels,))
 
     # -- programs -----------------------------------------------------------------------------------
     @_in_own_context
-    def program(self, spec: ShaderSpec) -> _Prog:
+    def program(self, spec: ShaderSpec) -> Program:
         cached = self._programs.get(spec)
         if cached is not None:
             return cached
@@ -197,11 +184,11 @@ class ModernGLBackend(Backend):
                 )
             except Exception as exc:
                 raise ShaderCompileError(f"{spec.name}: {fs.map_error(str(exc))}") from None
-        prog = _Prog(spec, gl)
+        prog = Program(spec, gl)
         self._programs[spec] = prog
         return prog
 
-    def _set_uniforms(self, prog: _Prog, uniforms: dict[str, Any] | None) -> None:
+    def _set_uniforms(self, prog: Program, uniforms: dict[str, Any] | None) -> None:
         for name, value in (uniforms or {}).items():
             if name not in prog.gl:
                 continue  # declared but optimised out by the compiler
@@ -213,7 +200,7 @@ class ModernGLBackend(Backend):
             else:
                 prog.gl[name].value = tuple(arr.tolist())
 
-    def _bind_samplers(self, prog: _Prog, samplers: dict[str, Texture] | None) -> None:
+    def _bind_samplers(self, prog: Program, samplers: dict[str, Texture] | None) -> None:
         for unit, s in enumerate(prog.spec.samplers):
             (samplers or {})[s.name].gl.use(location=unit)
 
