@@ -3,8 +3,9 @@
 import bpy
 
 from .about import BOUNCE_OT_report_renderer
+from .bake import BOUNCE_OT_bake
 
-classes = (BOUNCE_OT_report_renderer,)
+classes = (BOUNCE_OT_report_renderer, BOUNCE_OT_bake)
 
 # Blender's own helper: registers in order, unregisters in reverse.
 register, unregister = bpy.utils.register_classes_factory(classes)

@@ -30,3 +30,6 @@ class BOUNCE_PT_main(bpy.types.Panel):
                 if name not in {"rna_type", "name"}:
                     column.prop(group, name)
         layout.operator("bounce.report_renderer", icon="INFO")
+        box = layout.box()
+        box.label(text="Bake (selected objects)", icon="RENDER_STILL")
+        box.operator("bounce.bake", icon="TEXTURE")

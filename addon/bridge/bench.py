@@ -38,6 +38,9 @@ SETTINGS: dict[str, tuple[dict, ...]] = {
     # is what fits a benchmark run; 1024 VPLs at 128 cells (rel_rmse_8 0.055 on cornell) takes minutes.
     "rsm": ({"rsm.vpl_samples": 64}, {"rsm.vpl_samples": 256}, {"rsm.vpl_samples": 1024},
             {"rsm.vpl_samples": 256, "rsm.visibility": "voxel"}),
+    # The published scheme as the baseline row, and the improved transport (docs/LPV.md).
+    "lpv": ({"lpv.variant": "classic", "lpv.geometry_volume": True},
+            {"lpv.variant": "improved", "lpv.geometry_volume": True}),
 }
 REAL_SCENES = ("sponza", "sibenik", "conference")  # /work/shared/scenes/<name>/<name>.blend
 CURVE_SPP = (1, 4, 16, 64, 256)
@@ -62,17 +65,18 @@ def setting_label(setting: dict) -> str:
 
 
 def make_configs(method: str, setting: dict, res: int, bounces: int):
-    """(GIConfig, RsmConfig) for one setting; the dataclasses validate every value (ConfigError)."""
-    from ..engine.config import GIConfig, RsmConfig
+    """(GIConfig, RsmConfig, LpvConfig) for one setting; the dataclasses validate every value
+    (ConfigError)."""
+    from ..engine.config import GIConfig, LpvConfig, RsmConfig
 
-    gi = {"method": method, "resolution": res, "bounces": bounces}
-    rsm = {}
+    groups = {"gi": {"method": method, "resolution": res, "bounces": bounces}, "rsm": {}, "lpv": {}}
     for key, value in setting.items():
         group, _, name = key.partition(".")
-        if group not in ("gi", "rsm") or not name:
-            raise ConfigError(f"bench setting {key!r}: must be 'gi.<field>' or 'rsm.<field>'")
-        (gi if group == "gi" else rsm)[name] = value
-    return GIConfig.from_dict(gi), RsmConfig.from_dict(rsm)
+        if group not in groups or not name:
+            raise ConfigError(f"bench setting {key!r}: must be 'gi.<field>', 'rsm.<field>' or 'lpv.<field>'")
+        groups[group][name] = value
+    return (GIConfig.from_dict(groups["gi"]), RsmConfig.from_dict(groups["rsm"]),
+            LpvConfig.from_dict(groups["lpv"]))
 
 
 def curve_spp(ref_spp: int, quick: bool) -> list[int]:
@@ -395,10 +399,10 @@ def run_bench(opt: Options) -> dict:
         for method, setting in jobs:
             label = setting_label(setting)
             bar.set_postfix_str(f"{name}: {method} {label}")
-            gi, rsm = make_configs(method, setting, opt.res, opt.bounces)
+            gi, rsm, lpv = make_configs(method, setting, opt.res, opt.bounces)
             run_dir = cache / "runs" / name / f"{method}-{label.replace(' ', '').replace(',', '_')}"
             run_dir.mkdir(parents=True, exist_ok=True)
-            st = render_file(blend, run_dir, gi, rsm, repeat=repeat)
+            st = render_file(blend, run_dir, gi, rsm, repeat=repeat, lpv=lpv)
             renderers.add(st["renderer"])
             product = products[method]
             m = _compare(run_dir / f"{product}.exr", ref_dir / f"{product}.exr")

@@ -14,7 +14,7 @@ import bpy
 
 from ..engine import methods
 from ..engine.backends.moderngl_backend import ModernGLBackend
-from ..engine.config import GIConfig, RsmConfig
+from ..engine.config import GIConfig, LpvConfig, RsmConfig
 from ..engine.errors import SceneError
 from . import images
 from .capture import SceneCache, define_light_switch, image_size
@@ -37,7 +37,8 @@ def open_blend(path: Path) -> None:
         raise SceneError(f"cannot open {path}: {str(exc).strip().splitlines()[-1]}") from None
 
 
-def render_file(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, repeat: int = 3) -> dict:
+def render_file(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, repeat: int = 3,
+                lpv: LpvConfig | None = None) -> dict:
     """Render `blend` with gi.method; write <product>.exr for each product and stats.json; return stats.
 
     The timing is the median of `repeat` full updates after one warm-up (programs compiled, geometry
@@ -51,7 +52,7 @@ def render_file(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, repeat
     width, height = image_size(scene, gi.resolution)
     captured = SceneCache().update(bpy.context.evaluated_depsgraph_get(), width, height)
     be = backend()
-    method = methods.get(gi.method)(be, gi, rsm)
+    method = methods.create(be, gi, rsm, lpv)
     method.set_scene(captured)
     method.run()  # warm-up
     runs = [method.run() for _ in range(repeat)]
@@ -65,7 +66,8 @@ def render_file(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, repeat
         notes.append("the scene has no light sources: all light is zero")
     stats = {
         "method": gi.method,
-        "config": {"gi": gi.to_dict(), "rsm": rsm.to_dict()},
+        "config": {"gi": gi.to_dict(), "rsm": rsm.to_dict(),
+                   **({"lpv": method.lpv_config.to_dict()} if gi.method == "lpv" else {})},
         "image_size": [width, height],
         "triangles": captured.triangle_count,
         "lights": len(captured.lights),

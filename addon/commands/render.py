@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from ..engine.config import GIConfig, RsmConfig
+from ..engine.config import GIConfig, LpvConfig, RsmConfig
 from ._args import existing_blend, output_dir
 
 NAME = "render"
@@ -21,6 +21,10 @@ def add_arguments(p) -> None:
     p.add_argument("--vpl-samples", type=int, default=256, help="VPLs gathered per pixel (rsm)")
     p.add_argument("--visibility", default="none", help="VPL visibility for rsm: none or voxel")
     p.add_argument("--voxel-cells", type=int, default=64, help="voxel cells along the longest side")
+    p.add_argument("--grid", type=int, default=32, help="LPV cells along the longest side (lpv)")
+    p.add_argument("--iterations", type=int, default=16, help="LPV propagation steps (lpv, classic)")
+    p.add_argument("--variant", default="classic", help="LPV transport: classic or improved (lpv)")
+    p.add_argument("--geometry-volume", action="store_true", help="LPV: occlude by the voxelized surfaces")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--repeat", type=int, default=3, help="timed runs after a warm-up (median reported)")
 
@@ -29,10 +33,12 @@ def run(args) -> int:
     gi = GIConfig(method=args.method, bounces=args.bounces, resolution=args.res, seed=args.seed)
     rsm = RsmConfig(resolution=args.rsm_res, vpl_samples=args.vpl_samples, visibility=args.visibility,
                     voxel_cells=args.voxel_cells)
+    lpv = LpvConfig(grid_cells=args.grid, iterations=args.iterations, variant=args.variant,
+                    geometry_volume=args.geometry_volume)
     blend = existing_blend(args.blend)
     out = output_dir(args.out)
     from ..bridge.pipeline import render_file  # imports bpy: only when actually rendering
 
-    stats = render_file(blend, out, gi, rsm, repeat=max(1, args.repeat))
+    stats = render_file(blend, out, gi, rsm, repeat=max(1, args.repeat), lpv=lpv)
     print(json.dumps({"out": str(out), "total_ms": round(stats["total_ms"], 2), "notes": stats["notes"]}))
     return 0

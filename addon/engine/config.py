@@ -13,7 +13,7 @@ from typing import Any
 
 from .errors import ConfigError
 
-METHODS = ("direct", "rsm")
+METHODS = ("direct", "rsm", "lpv")
 
 
 def _num(default, lo, hi, doc):
@@ -68,6 +68,22 @@ class RsmConfig(_Validated):
     visibility: str = _choice("none", ("none", "voxel"), "VPL visibility in the `rsm` gather: none or voxel-traced")
     voxel_cells: int = _num(64, 8, 512, "voxel grid cells along the scene's longest side (voxel visibility)")
     voxel_offset_cells: float = _num(1.5, 0.0, 4.0, "ray ends moved off their surfaces, in cells")
+
+
+@dataclass(frozen=True)
+class LpvConfig(_Validated):
+    """Light propagation volume (method `lpv`): docs/LPV.md derives the units and the variants."""
+
+    grid_cells: int = _num(32, 8, 256, "LPV cells along the scene's longest side")
+    iterations: int = _num(16, 1, 256, "propagation steps (classic); improved runs at least the grid's Manhattan span")
+    variant: str = _choice("classic", ("classic", "improved"),
+                           "transport: classic CLPV 5-face scheme, or improved (straight, flux-conserving)")
+    geometry_volume: bool = field(default=False, metadata={"doc": "occlude propagation by the voxelized surfaces"})
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not isinstance(self.geometry_volume, bool):
+            raise ConfigError(f"LpvConfig.geometry_volume = {self.geometry_volume!r}: must be True or False")
 
 
 @dataclass(frozen=True)

@@ -47,8 +47,9 @@ def test_register_unregister_twice_leaves_nothing_behind(bounce, fresh_blend):
     before = _handler_counts()
     assert "load_post" in before and "depsgraph_update_post" in before
     classes = _all_classes(bounce)
-    # 3 property groups, preferences, 1 operator, 3 panels (main, its viewport sub-panel, the sidebar tab)
-    assert len(classes) == 8
+    # 3 property groups, preferences, 2 operators (report_renderer, bake), 3 panels (main, its viewport
+    # sub-panel, the sidebar tab)
+    assert len(classes) == 9
     for _ in range(2):
         bounce.register()
         try:
@@ -167,6 +168,12 @@ class _RecordingLayout:
     def column(self, **_kwargs):
         return self
 
+    def box(self, **_kwargs):
+        return self
+
+    def label(self, **_kwargs):
+        pass
+
     def prop(self, data, name, **_kwargs):
         assert name in data.bl_rna.properties, name
         self.drawn.append(name)
@@ -184,4 +191,4 @@ def test_panel_draws_every_setting(registered):
     BOUNCE_PT_main.draw_header(panel, bpy.context)
     BOUNCE_PT_main.draw(panel, bpy.context)
     fields = [*config.limits(config.GIConfig), *config.limits(config.RsmConfig)]
-    assert drawn == ["enabled", *fields, "bounce.report_renderer"]
+    assert drawn == ["enabled", *fields, "bounce.report_renderer", "bounce.bake"]

@@ -33,11 +33,11 @@ def test_setting_grid_makes_valid_configs():
         labels = [bench.setting_label(s) for s in grid]
         assert len(set(labels)) == len(labels), f"{method}: settings must be distinguishable: {labels}"
         for s in grid:
-            gi, rsm = bench.make_configs(method, s, 64, 1)
-            assert gi.method == method and gi.resolution == 64
+            configs = dict(zip(("gi", "rsm", "lpv"), bench.make_configs(method, s, 64, 1), strict=True))
+            assert configs["gi"].method == method and configs["gi"].resolution == 64
             for key, value in s.items():
                 group, _, name = key.partition(".")
-                assert getattr(gi if group == "gi" else rsm, name) == value
+                assert getattr(configs[group], name) == value
     assert bench.setting_label({"rsm.resolution": 256}) == "resolution 256"
 
 

@@ -1,0 +1,357 @@
+"""Bakes: a method's direct/indirect light per texel of an object's UV layout, or per mesh corner.
+
+The light passes run unchanged on a *texel G-buffer* (bake_raster.py, passes/bake_gbuffer.py): the whole
+scene is captured and uploaded once (RSMs, voxels), then each object's triangles are rasterized in UV
+space into the method's G-buffer and shaded. Values are in Cycles' Diffuse Direct / Indirect units (a
+Cycles DIFFUSE bake without the Color contribution); `combined` = direct + indirect (no albedo).
+
+Images: float RGBA, row 0 = top (V = 1), alpha = coverage (1 where a triangle touches the texel), RGB
+dilated `margin` texels past the coverage so seams do not bleed black when mip-mapped or filtered.
+Vertex colours: one sample per (vertex, corner normal), written to a FLOAT_COLOR corner attribute.
+
+Used by `python -m addon bake` (bake_file) and the BOUNCE_OT_bake operator (Baker directly).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import bpy
+import numpy as np
+
+from ..engine import methods
+from ..engine.config import GIConfig, RsmConfig
+from ..engine.errors import ConfigError, SceneError
+from ..engine.lightmap import PASSES, TARGETS, check_choice, dilate, output_path, shard, uv_problems
+from ..engine.scene import Camera
+from . import images
+from .bake_raster import TexelBaker
+from .capture import SceneCache, define_light_switch, material_values
+
+OVERLAP_WARN = 1e-3  # fraction of covered texels hit by more than one triangle
+
+
+@dataclass
+class ObjectResult:
+    """What happened to one object: status ok | warning | skipped | error."""
+
+    name: str
+    status: str = "ok"
+    message: str = ""
+    file: str | None = None
+    size: list[int] | None = None
+    time_ms: float = 0.0
+    notes: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        return {"file": self.file, "size": self.size, "time_ms": round(self.time_ms, 2), "status": self.status,
+                "message": self.message}
+
+    def line(self) -> str:
+        where = f" -> {self.file}" if self.file else ""
+        size = f" {self.size[0]}x{self.size[1]}" if self.size else ""
+        msg = f" ({self.message})" if self.message else ""
+        return f"{self.status:7s} {self.name}{where}{size} {self.time_ms:.0f} ms{msg}"
+
+
+# ------------------------------------------------------------------------------------------ object data
+
+def _albedo_table(obj) -> np.ndarray:
+    table = [material_values(s.material)[0] for s in obj.material_slots] or [material_values(None)[0]]
+    return np.asarray(table, np.float64).reshape(-1, 3)
+
+
+def _world(matrix: np.ndarray, pos: np.ndarray, nrm: np.ndarray, scale: float) -> tuple[np.ndarray, np.ndarray]:
+    p = (pos @ matrix[:3, :3].T + matrix[:3, 3]) * scale
+    n = nrm @ np.linalg.inv(matrix[:3, :3])  # inverse transpose, row vectors
+    n /= np.maximum(np.linalg.norm(n, axis=-1, keepdims=True), 1e-30)
+    return p, n  # a mirror flips the winding only; UV rasterization does not cull, so it does not matter
+
+
+def _matrix(obj) -> np.ndarray:
+    return np.array([list(r) for r in obj.matrix_world], np.float64)
+
+
+def bake_uv_layer(mesh):
+    """The UV map a bake uses: the active one (as Cycles' bake), else the active render one."""
+    return mesh.uv_layers.active or next((u for u in mesh.uv_layers if u.active_render), None)
+
+
+def object_triangles(obj, depsgraph) -> dict:
+    """World triangles of the evaluated object with its bake UVs: uv (n, 3, 2), positions and corner
+    normals (n, 3, 3) in metres, albedo (n, 3). Raises SceneError for non-meshes and meshes without UVs."""
+    if obj.type != "MESH":
+        raise SceneError(f"not a mesh (type {obj.type})")
+    ev = obj.evaluated_get(depsgraph)
+    mesh = ev.to_mesh()
+    try:
+        layer = bake_uv_layer(mesh)
+        if layer is None:
+            raise SceneError("no UV map: add one (UV > Smart UV Project) to bake")
+        mesh.calc_loop_triangles()
+        nt, nv, nl = len(mesh.loop_triangles), len(mesh.vertices), len(mesh.loops)
+        co = np.empty(nv * 3, np.float64)
+        mesh.vertices.foreach_get("co", co)
+        tri_v, tri_l, mi = np.empty(nt * 3, np.int64), np.empty(nt * 3, np.int64), np.empty(nt, np.int64)
+        mesh.loop_triangles.foreach_get("vertices", tri_v)
+        mesh.loop_triangles.foreach_get("loops", tri_l)
+        mesh.loop_triangles.foreach_get("material_index", mi)
+        cn = np.empty(nl * 3, np.float64)
+        mesh.corner_normals.foreach_get("vector", cn)
+        uv = np.empty(nl * 2, np.float64)
+        layer.uv.foreach_get("vector", uv)
+    finally:
+        ev.to_mesh_clear()
+    scale = depsgraph.scene.unit_settings.scale_length or 1.0
+    pos, nrm = _world(_matrix(ev), co.reshape(-1, 3)[tri_v].reshape(nt, 3, 3),
+                      cn.reshape(-1, 3)[tri_l].reshape(nt, 3, 3), scale)
+    table = _albedo_table(obj)
+    return {"uv": uv.reshape(-1, 2)[tri_l].reshape(nt, 3, 2), "positions": pos, "normals": nrm,
+            "albedo": table[np.clip(mi, 0, len(table) - 1)]}
+
+
+def object_corners(obj, scale: float) -> dict:
+    """Samples for a vertex-colour bake of the object's own mesh (modifiers not applied): one per
+    distinct (vertex, corner normal); `corner_sample` maps each corner to its sample."""
+    if obj.type != "MESH":
+        raise SceneError(f"not a mesh (type {obj.type})")
+    mesh = obj.data
+    nv, nl, npoly = len(mesh.vertices), len(mesh.loops), len(mesh.polygons)
+    if nl == 0:
+        raise SceneError("the mesh has no faces")
+    co = np.empty(nv * 3, np.float64)
+    mesh.vertices.foreach_get("co", co)
+    lv = np.empty(nl, np.int64)
+    mesh.loops.foreach_get("vertex_index", lv)
+    cn = np.empty(nl * 3, np.float64)
+    mesh.corner_normals.foreach_get("vector", cn)
+    totals, mi = np.empty(npoly, np.int64), np.empty(npoly, np.int64)
+    mesh.polygons.foreach_get("loop_total", totals)
+    mesh.polygons.foreach_get("material_index", mi)
+    corner_mi = np.repeat(mi, totals)
+    cn = cn.reshape(-1, 3)
+    key = np.column_stack([lv, np.round(cn * 1e4).astype(np.int64), corner_mi])
+    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    pos, nrm = _world(_matrix(obj), co.reshape(-1, 3)[lv[first]], cn[first], scale)
+    table = _albedo_table(obj)
+    return {"positions": pos, "normals": nrm, "albedo": table[np.clip(corner_mi[first], 0, len(table) - 1)],
+            "corner_sample": inverse.ravel()}
+
+
+# ------------------------------------------------------------------------------------------------ baker
+
+def pass_values(products: dict, pass_name: str) -> np.ndarray:
+    """(..., 4) direct, indirect or combined = direct + indirect; alpha = coverage."""
+    if pass_name == "direct":
+        return products["direct"]
+    if "indirect" not in products:
+        raise ConfigError(f"pass {pass_name} needs an indirect method (rsm, lpv), not direct")
+    if pass_name == "indirect":
+        return products["indirect"]
+    out = products["direct"].copy()
+    out[..., :3] += products["indirect"][..., :3]
+    return out
+
+
+def _default_camera(size: int) -> Camera:
+    return Camera(view=np.eye(4), projection=np.eye(4), width=size, height=size)
+
+
+class Baker:
+    """The scene captured and uploaded once; then bake_image / bake_vertex_colors per object."""
+
+    def __init__(self, backend, depsgraph, gi: GIConfig, rsm: RsmConfig, size: int = 512):
+        t0 = time.perf_counter()
+        define_light_switch()
+        self.depsgraph = depsgraph
+        scene = SceneCache().update(depsgraph, size, size)
+        if scene.camera is None:
+            scene.camera = _default_camera(size)  # only the G-buffer size is taken from it
+        self.scene = scene
+        self.method = methods.get(gi.method)(backend, gi, rsm)
+        self.method.set_scene(scene)
+        self.texels = TexelBaker(self.method)
+        self.setup_ms = (time.perf_counter() - t0) * 1e3
+
+    def bake_image(self, obj, size: int, pass_name: str, margin: int = 16) -> tuple[np.ndarray, list[str]]:
+        """(h, w, 4) float32, row 0 = top, alpha = coverage, and warnings."""
+        tri = object_triangles(obj, self.depsgraph)
+        notes = uv_problems(tri["uv"], tri["positions"])
+        args = (tri["uv"], tri["positions"], tri["normals"], tri["albedo"])
+        overlap = self.texels.overlap(*args, (size, size))
+        if overlap > OVERLAP_WARN:
+            notes.append(f"overlapping UVs: {overlap:.1%} of covered texels belong to several triangles")
+        values = pass_values(self.texels.bake_triangles(*args, (size, size)), pass_name)
+        covered = values[..., 3] > 0.5
+        if not covered.any():
+            notes.append("no texel covered (all UV triangles have zero area or lie outside 0..1)")
+        rgb, _ = dilate(values[..., :3], covered, margin)
+        return np.concatenate([rgb, covered[..., None].astype(np.float32)], axis=2), notes
+
+    def bake_vertex_colors(self, obj, pass_name: str) -> tuple[np.ndarray, list[str]]:
+        """(corners, 4) float32 colours for obj.data's corners, and warnings."""
+        notes = []
+        if any(m.show_render for m in obj.modifiers):
+            notes.append("modifiers are not applied: colours are computed on the base mesh")
+        if obj.data.users > 1:
+            notes.append(f"mesh {obj.data.name!r} is shared by {obj.data.users} users: the last bake wins")
+        scale = self.depsgraph.scene.unit_settings.scale_length or 1.0
+        c = object_corners(obj, scale)
+        values = pass_values(self.texels.bake_points(c["positions"], c["normals"], c["albedo"]), pass_name)
+        out = values[c["corner_sample"]].astype(np.float32)
+        out[:, 3] = 1.0
+        return out, notes
+
+
+# ------------------------------------------------------------------------------------- Blender outputs
+
+def image_name(obj_name: str, pass_name: str) -> str:
+    return f"{obj_name}_bounce_{pass_name}"
+
+
+def store_image(name: str, rgba: np.ndarray):
+    """A float Blender image `name` holding rgba (row 0 = top), packed into the .blend."""
+    h, w = rgba.shape[:2]
+    img = bpy.data.images.get(name)
+    if img is not None and (tuple(img.size) != (w, h) or not img.is_float):
+        bpy.data.images.remove(img)
+        img = None
+    if img is None:
+        img = bpy.data.images.new(name, w, h, alpha=True, float_buffer=True)
+    img.colorspace_settings.name = "Linear Rec.709" if "Linear Rec.709" in _colorspaces(img) else \
+        img.colorspace_settings.name
+    img.pixels.foreach_set(np.ascontiguousarray(rgba[::-1], np.float32).ravel())  # Blender: row 0 = bottom
+    img.file_format = "OPEN_EXR"
+    img.pack()
+    return img
+
+
+def _colorspaces(img) -> set[str]:
+    return {item.identifier for item in img.colorspace_settings.bl_rna.properties["name"].enum_items}
+
+
+def store_vertex_colors(mesh, name: str, colors: np.ndarray):
+    """A FLOAT_COLOR corner attribute `name` on `mesh` (replaced if present)."""
+    old = mesh.color_attributes.get(name)
+    if old is not None:
+        mesh.color_attributes.remove(old)
+    attr = mesh.color_attributes.new(name, "FLOAT_COLOR", "CORNER")
+    attr.data.foreach_set("color", np.ascontiguousarray(colors, np.float32).ravel())
+    return attr
+
+
+def attribute_name(pass_name: str) -> str:
+    return f"bounce_{pass_name}"
+
+
+# ----------------------------------------------------------------------------------------- command line
+
+def check_output_dir(out: Path) -> Path:
+    """DIR exists (or is created, its parent existing) and is writable; else SceneError (exit 2)."""
+    try:
+        out.mkdir(exist_ok=True)
+    except OSError as exc:
+        raise SceneError(f"cannot use output directory {out}: {exc.strerror}") from None
+    if not out.is_dir():
+        raise SceneError(f"output path {out} is not a directory")
+    probe = out / f".bounce_write_test_{os.getpid()}"
+    try:
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as exc:
+        raise SceneError(f"output directory {out} is not writable: {exc.strerror}") from None
+    return out
+
+
+def select_objects(names: list[str] | None, shard_index: int = 0, shard_count: int = 1) -> list[str]:
+    """The names to bake: the given ones, or every mesh object in the scene; then the shard."""
+    if names is None:
+        names = [o.name for o in bpy.context.scene.objects if o.type == "MESH"]
+    return shard(set(names), shard_index, shard_count)
+
+
+def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size: int = 512,
+              gi: GIConfig | None = None, rsm: RsmConfig | None = None, pass_name: str = "indirect",
+              target: str = "image", overwrite: bool = False, shard_index: int = 0, shard_count: int = 1,
+              save_blend: Path | None = None, margin: int = 16, progress: bool = True, backend=None) -> dict:
+    """Bake the objects of `blend` (see module docstring) into out_dir; returns the summary written to
+    out_dir/bake.json. Per-object problems are recorded, never raised; bad arguments raise BounceError."""
+    from .pipeline import backend as default_backend
+    from .pipeline import open_blend
+
+    check_choice(pass_name, PASSES, "--pass")
+    check_choice(target, TARGETS, "--target")
+    if not 8 <= size <= 8192:
+        raise ConfigError(f"--size must be in 8..8192, got {size}")
+    gi = gi or GIConfig(method="rsm")
+    rsm = rsm or RsmConfig(visibility="voxel")
+    out_dir = check_output_dir(Path(out_dir))
+    if save_blend is not None and Path(save_blend).resolve() == Path(blend).resolve():
+        raise ConfigError("--save-blend must not be the input file (the .blend is never modified)")
+    open_blend(blend)
+    names = select_objects(objects, shard_index, shard_count)
+    if not names:
+        raise SceneError(f"{blend}: no objects to bake" + (" in this shard" if shard_count > 1 else ""))
+    t0 = time.perf_counter()
+    be = backend or default_backend()
+    baker = Baker(be, bpy.context.evaluated_depsgraph_get(), gi, rsm, size)
+    results: list[ObjectResult] = []
+    taken: set[str] = set()
+    from tqdm import tqdm
+
+    bar = tqdm(names, desc="bake", unit="obj", file=sys.stderr, disable=not progress)
+    for name in bar:
+        bar.set_postfix_str(name[:30])
+        res = _bake_one(baker, name, out_dir, size, pass_name, target, overwrite, margin, taken)
+        results.append(res)
+        tqdm.write(res.line(), file=sys.stdout)
+    saved = None
+    if save_blend is not None and target == "vertex-colors":
+        bpy.ops.wm.save_as_mainfile(filepath=str(save_blend), copy=True, compress=False)
+        saved = str(save_blend)
+    summary = {
+        "blend": str(blend), "method": gi.method, "pass": pass_name, "target": target, "size": size,
+        "config": {"gi": gi.to_dict(), "rsm": rsm.to_dict()}, "renderer": be.renderer,
+        "setup_ms": round(baker.setup_ms, 2), "total_ms": round((time.perf_counter() - t0) * 1e3, 2),
+        "shard": [shard_index, shard_count], "saved_blend": saved,
+        "scene_warnings": list(baker.scene.warnings),
+        "objects": {r.name: r.to_dict() for r in results},
+    }
+    (out_dir / "bake.json").write_text(json.dumps(summary, indent=2))
+    return summary
+
+
+def _bake_one(baker: Baker, name: str, out_dir: Path, size: int, pass_name: str, target: str, overwrite: bool,
+              margin: int, taken: set[str]) -> ObjectResult:
+    res = ObjectResult(name)
+    t0 = time.perf_counter()
+    try:
+        obj = bpy.data.objects.get(name)
+        if obj is None:
+            raise SceneError("no such object")
+        if target == "image":
+            path = output_path(out_dir, name, pass_name, taken)
+            res.file = str(path)
+            if path.exists() and not overwrite:
+                res.status, res.message = "skipped", "file exists (use --overwrite)"
+                return res
+            rgba, notes = baker.bake_image(obj, size, pass_name, margin)
+            images.write_exr(path, rgba)
+            res.size = [size, size]
+        else:
+            colors, notes = baker.bake_vertex_colors(obj, pass_name)
+            store_vertex_colors(obj.data, attribute_name(pass_name), colors)
+            res.file = f"{obj.data.name}:{attribute_name(pass_name)}"
+            res.size = [len(colors), 1]
+        if notes:
+            res.status, res.message = "warning", "; ".join(notes)
+    except (SceneError, ConfigError) as exc:
+        res.status, res.message = "error", str(exc)
+    finally:
+        res.time_ms = (time.perf_counter() - t0) * 1e3
+    return res

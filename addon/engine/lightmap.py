@@ -1,0 +1,116 @@
+"""Bake helpers in numpy (no GPU, no bpy): seam dilation, safe output names, shard selection, UV checks.
+
+Images here are (h, w, c) float arrays with a boolean coverage mask (h, w); the orientation does not
+matter to any of these functions.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+
+from .errors import ConfigError
+
+PASSES = ("indirect", "direct", "combined")
+TARGETS = ("image", "vertex-colors")
+
+
+def dilate(image: np.ndarray, covered: np.ndarray, iterations: int = 16) -> tuple[np.ndarray, np.ndarray]:
+    """Fill empty texels from covered neighbours, `iterations` rings deep (seam padding).
+
+    Each iteration, every empty texel with at least one filled texel among its 8 neighbours becomes the
+    mean of those neighbours (as filled before the iteration); covered texels never change. Returns
+    (image, filled mask). Exact: texel values are means of their ring-(k-1) neighbours, nothing else.
+    """
+    img = np.array(image, dtype=np.float64, copy=True)
+    filled = np.array(covered, dtype=bool, copy=True)
+    h, w = filled.shape
+    for _ in range(max(0, int(iterations))):
+        if filled.all() or not filled.any():
+            break
+        pad_v = np.zeros((h + 2, w + 2) + img.shape[2:])
+        pad_m = np.zeros((h + 2, w + 2))
+        pad_v[1:-1, 1:-1] = np.where(filled[..., None], img, 0.0) if img.ndim == 3 else np.where(filled, img, 0.0)
+        pad_m[1:-1, 1:-1] = filled
+        total = np.zeros_like(img)
+        n = np.zeros((h, w))
+        for dy in (-1, 0, 1):
+            for dx in (-1, 0, 1):
+                if dy == 0 and dx == 0:
+                    continue
+                total += pad_v[1 + dy:h + 1 + dy, 1 + dx:w + 1 + dx]
+                n += pad_m[1 + dy:h + 1 + dy, 1 + dx:w + 1 + dx]
+        grow = ~filled & (n > 0)
+        if not grow.any():
+            break
+        nn = n[grow][:, None] if img.ndim == 3 else n[grow]
+        img[grow] = total[grow] / nn
+        filled = filled | grow
+    return img.astype(np.asarray(image).dtype, copy=False), filled
+
+
+_UNSAFE = re.compile(r"[^A-Za-z0-9._-]+")
+
+
+def safe_name(name: str) -> str:
+    """A file-name stem from an object name: only letters, digits, '.', '_' and '-'; path separators,
+    '..' and leading dots cannot survive, so the file stays inside the output directory."""
+    stem = _UNSAFE.sub("_", name)
+    stem = re.sub(r"\.{2,}", "_", stem).strip("._ -")
+    return stem[:120] or "object"
+
+
+def output_path(out_dir: Path, object_name: str, pass_name: str, taken: set[str] | None = None) -> Path:
+    """DIR/<safe name>_<pass>.exr, de-duplicated against `taken` (names that sanitise alike get _2, _3);
+    raises ConfigError if the result would not lie directly inside out_dir (it cannot: belt and braces)."""
+    stem = f"{safe_name(object_name)}_{pass_name}"
+    candidate, k = stem, 2
+    while taken is not None and candidate.lower() in taken:
+        candidate, k = f"{stem}_{k}", k + 1
+    if taken is not None:
+        taken.add(candidate.lower())
+    root = Path(out_dir).resolve()
+    path = (root / f"{candidate}.exr").resolve()
+    if path.parent != root:
+        raise ConfigError(f"object name {object_name!r} would write outside {out_dir}")
+    return path
+
+
+def parse_shard(text: str | None) -> tuple[int, int]:
+    """'i/n' -> (i, n) with 0 <= i < n; None -> (0, 1)."""
+    if text is None:
+        return 0, 1
+    m = re.fullmatch(r"\s*(\d+)\s*/\s*(\d+)\s*", text)
+    if not m or int(m.group(2)) < 1 or int(m.group(1)) >= int(m.group(2)):
+        raise ConfigError(f"--shard must be i/n with 0 <= i < n, got {text!r}")
+    return int(m.group(1)), int(m.group(2))
+
+
+def shard(names, index: int, count: int) -> list[str]:
+    """Every count-th name of the sorted names, starting at index: shards are disjoint and cover all."""
+    return sorted(names)[index::count]
+
+
+def uv_problems(uv: np.ndarray, positions: np.ndarray) -> list[str]:
+    """Warnings about a (n, 3, 2) UV layout of (n, 3, 3) world triangles: zero-area UV triangles (they get
+    no texels), UVs outside 0..1 (they fall off the image)."""
+    notes = []
+    e1, e2 = uv[:, 1] - uv[:, 0], uv[:, 2] - uv[:, 0]
+    uv_area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    world_area = 0.5 * np.linalg.norm(np.cross(positions[:, 1] - positions[:, 0], positions[:, 2] - positions[:, 0]),
+                                      axis=1)
+    zero = (uv_area <= 1e-12) & (world_area > 0)
+    if zero.any():
+        notes.append(f"{int(zero.sum())} of {len(uv)} triangles have zero UV area (not baked)")
+    outside = np.any((uv < -1e-6) | (uv > 1 + 1e-6), axis=(1, 2))
+    if outside.any():
+        notes.append(f"{int(outside.sum())} of {len(uv)} triangles have UVs outside 0..1 (clipped)")
+    return notes
+
+
+def check_choice(value: str, choices: tuple[str, ...], what: str) -> str:
+    if value not in choices:
+        raise ConfigError(f"{what} must be one of {', '.join(choices)}, got {value!r}")
+    return value

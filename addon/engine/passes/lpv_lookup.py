@@ -1,0 +1,31 @@
+"""LPV lookup pass: the accumulated SH at every G-buffer pixel -> `indirect`.
+
+Inputs: G-buffer position and normal; `acc_r/g/b` (RGBA32F 3D, accumulated L1 SH of radiant intensity,
+W/sr per cell, by direction of travel), the Grid. Output: `indirect` (RGBA32F, camera size, written,
+not accumulated): E / pi with E = max(0, c(p) . cosine_lobe(-n)) / h^2, c(p) trilinear at
+p = pos + lookup_offset_cells * h * n. Units: Cycles' Diffuse Indirect (docs/LPV.md).
+"""
+
+from __future__ import annotations
+
+from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
+from ..grid import Grid
+
+SPEC = ShaderSpec(
+    name="lpv_lookup",
+    compute="lpv/lookup.comp.glsl",
+    local_size=(8, 8, 1),
+    samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("acc_r", "3D"),
+              Sampler("acc_g", "3D"), Sampler("acc_b", "3D")),
+    images=(Image("indirect", "2D", "RGBA32F", "write"),),
+    uniforms=(Var("grid_origin", "vec3"), Var("cell_size", "float"), Var("dims", "ivec3"),
+              Var("lookup_offset_cells", "float")),
+)
+
+
+def run(backend: Backend, gbuf: dict, acc: dict, indirect, grid: Grid, offset_cells: float = 0.5) -> None:
+    samplers = {"gbuf_position": gbuf["position"], "gbuf_normal": gbuf["normal"], **acc}
+    backend.dispatch(backend.program(SPEC), group_count(indirect.size, SPEC.local_size),
+                     uniforms={"grid_origin": grid.origin_m, "cell_size": grid.cell_size_m, "dims": grid.dims,
+                               "lookup_offset_cells": offset_cells},
+                     samplers=samplers, images={"indirect": indirect})

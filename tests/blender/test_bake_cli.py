@@ -1,0 +1,115 @@
+"""`python -m addon bake`: outputs, bake.json, per-object problems, path sanitising, shards, exit codes."""
+
+import hashlib
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.blender
+ROOT = Path(__file__).resolve().parents[2]
+FAST = ["--size", "16", "--rsm-res", "32", "--vpl-samples", "4", "--visibility", "none", "--quiet"]
+
+# Cornell box plus objects that must each fail or warn on their own.
+BUILD = """
+import bpy, sys
+sys.path.insert(0, {root!r})
+from addon.bridge import scenes
+scenes.build("cornell")
+def mesh(name, verts, faces, uvs=None):
+    me = bpy.data.meshes.new(name)
+    me.from_pydata(verts, [], faces)
+    if uvs is not None:
+        me.uv_layers.new(name="UVMap").data.foreach_set("uv", [c for uv in uvs for c in uv])
+    ob = bpy.data.objects.new(name, me)
+    bpy.context.scene.collection.objects.link(ob)
+quad = [(0, 0, 1), (0.2, 0, 1), (0.2, 0.2, 1), (0, 0.2, 1)]
+mesh("NoUV", quad, [(0, 1, 2, 3)])
+mesh("../evil/Esc", quad, [(0, 1, 2, 3)], [(0, 0), (1, 0), (1, 1), (0, 1)])
+two = quad + [(0.3, 0, 1), (0.5, 0, 1), (0.5, 0.2, 1), (0.3, 0.2, 1)]
+mesh("Overlap", two, [(0, 1, 2, 3), (4, 5, 6, 7)], [(0, 0), (1, 0), (1, 1), (0, 1)] * 2)
+mesh("ZeroUV", two, [(0, 1, 2, 3), (4, 5, 6, 7)], [(0, 0), (1, 0), (1, 1), (0, 1)] + [(0.5, 0.5)] * 4)
+bpy.ops.wm.save_as_mainfile(filepath={out!r})
+"""
+
+
+def cli(*args):
+    return subprocess.run([sys.executable, "-m", "addon", *args], cwd=ROOT, capture_output=True, text=True)
+
+
+@pytest.fixture(scope="module")
+def blend(tmp_path_factory):
+    path = tmp_path_factory.mktemp("bake") / "bad.blend"
+    subprocess.run([sys.executable, "-c", BUILD.format(root=str(ROOT), out=str(path))], check=True,
+                   capture_output=True)
+    return path
+
+
+def digest(path):
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def test_bake_reports_each_object_and_keeps_files_inside(blend, tmp_path):
+    before = digest(blend)
+    out = tmp_path / "out"
+    r = cli("bake", str(blend), "--out", str(out), *FAST)
+    assert r.returncode == 2, r.stderr  # some objects failed: exit 2 with one line, the others baked
+    assert len(r.stderr.strip().splitlines()) == 1 and "NoUV" in r.stderr
+    summary = json.loads((out / "bake.json").read_text())
+    objs = summary["objects"]
+    assert objs["NoUV"]["status"] == "error" and "UV" in objs["NoUV"]["message"]
+    assert objs["Overlap"]["status"] == "warning" and "overlapping" in objs["Overlap"]["message"]
+    assert objs["ZeroUV"]["status"] == "warning" and "zero UV area" in objs["ZeroUV"]["message"]
+    assert objs["Floor"]["status"] == "ok" and objs["Floor"]["size"] == [16, 16]
+    # The name with '..' and '/' lands inside DIR, sanitised.
+    esc = Path(objs["../evil/Esc"]["file"])
+    assert esc.parent == out.resolve() and esc.name == "evil_Esc_indirect.exr" and esc.is_file()
+    assert not (tmp_path / "evil").exists()
+    assert all(p.parent == out for p in out.rglob("*"))
+    # One line of result per object on stdout.
+    assert sum(line.split()[1] in objs for line in r.stdout.splitlines() if line.strip()) == len(objs)
+    from addon.bridge import images
+
+    floor = images.read_exr(out / "Floor_indirect.exr")
+    assert floor.shape == (16, 16, 4) and np.all(floor[..., 3] == 1.0) and floor[..., :3].mean() > 0
+    assert digest(blend) == before  # the .blend is never modified
+    # Again without --overwrite: every file is skipped with a message.
+    r2 = cli("bake", str(blend), "--out", str(out), "--objects", "Floor", *FAST)
+    assert r2.returncode == 0
+    floor2 = json.loads((out / "bake.json").read_text())["objects"]["Floor"]
+    assert floor2["status"] == "skipped" and "--overwrite" in floor2["message"]
+
+
+def test_shard_and_vertex_colors_into_a_copy(blend, tmp_path):
+    copy = tmp_path / "copy.blend"
+    r = cli("bake", str(blend), "--out", str(tmp_path), "--shard", "1/3", "--target", "vertex-colors",
+            "--save-blend", str(copy), "--pass", "combined", *FAST)
+    names = sorted(["BackWall", "Ceiling", "Floor", "LeftWall", "RightWall", "ShortBox", "TallBox", "NoUV",
+                    "../evil/Esc", "Overlap", "ZeroUV"])
+    objs = json.loads((tmp_path / "bake.json").read_text())["objects"]
+    assert sorted(objs) == names[1::3], r.stderr
+    assert r.returncode == 0, r.stderr  # vertex colours need no UVs
+    code = (f"import bpy; bpy.ops.wm.open_mainfile(filepath={str(copy)!r}); "
+            "print(sorted(o.name for o in bpy.data.objects if o.type == 'MESH' "
+            "and 'bounce_combined' in o.data.color_attributes))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert str(sorted(names[1::3])) in out
+
+
+@pytest.mark.parametrize("args, words", [
+    (["missing.blend", "--out", "{tmp}"], "no such file"),
+    (["{blend}", "--out", "/proc/bounce_out"], "output directory"),
+    (["{blend}", "--out", "/proc"], "not writable"),
+    (["{blend}", "--out", "{tmp}", "--shard", "3/3"], "--shard"),
+    (["{blend}", "--out", "{tmp}", "--pass", "glossy"], "--pass"),
+    (["{blend}", "--out", "{tmp}", "--target", "png"], "--target"),
+    (["{blend}", "--out", "{tmp}", "--objects", "Nope"], "Nope"),
+])
+def test_bad_input_exits_2_with_one_line(blend, tmp_path, args, words):
+    r = cli("bake", *[a.format(tmp=tmp_path, blend=blend) for a in args], *FAST)
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error:") and words in lines[0], r.stderr

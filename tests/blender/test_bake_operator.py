@@ -1,0 +1,54 @@
+"""BOUNCE_OT_bake in background mode (moderngl backend): images and vertex colours."""
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.blender
+bpy = pytest.importorskip("bpy")
+
+
+@pytest.fixture
+def cornell(bounce, fresh_blend):
+    from addon.bridge import scenes
+
+    bounce.register()
+    scenes.build("cornell")
+    s = bpy.context.scene.bounce
+    s.gi.method, s.rsm.resolution, s.rsm.vpl_samples = "rsm", 32, 4
+    yield bpy.context
+    bounce.unregister()
+
+
+def select(ctx, *names):
+    for o in ctx.scene.objects:
+        o.select_set(o.name in names)
+    ctx.view_layer.objects.active = ctx.scene.objects[names[0]]
+
+
+def test_bake_images_of_selected_objects(cornell):
+    select(cornell, "Floor", "BackWall")
+    assert bpy.ops.bounce.bake(size=16, pass_name="indirect", target="image") == {"FINISHED"}
+    for name in ("Floor", "BackWall"):
+        img = bpy.data.images[f"{name}_bounce_indirect"]
+        assert tuple(img.size) == (16, 16) and img.is_float and img.packed_file is not None
+        px = np.empty(16 * 16 * 4, np.float32)
+        img.pixels.foreach_get(px)
+        assert px.reshape(-1, 4)[:, 3].min() == 1.0 and px.reshape(-1, 4)[:, :3].mean() > 0
+
+
+def test_bake_vertex_colors(cornell):
+    select(cornell, "Floor")
+    # The Floor's corners lie outside the spot's cone: direct is 0 there, the bounce is not.
+    assert bpy.ops.bounce.bake(pass_name="combined", target="vertex-colors") == {"FINISHED"}
+    me = bpy.data.objects["Floor"].data
+    attr = me.color_attributes["bounce_combined"]
+    col = np.empty(len(me.loops) * 4, np.float32)
+    attr.data.foreach_get("color", col)
+    assert attr.domain == "CORNER" and col.reshape(-1, 4)[:, :3].max() > 0
+
+
+def test_bake_cancels_with_a_message(cornell):
+    bpy.context.scene.bounce.gi.method = "direct"
+    select(cornell, "Floor")
+    with pytest.raises(RuntimeError, match="needs an indirect method"):  # an ERROR report raises in bpy.ops
+        bpy.ops.bounce.bake(pass_name="indirect")

@@ -1,0 +1,327 @@
+"""LPV passes (inject, propagate, lookup) and the `lpv` method against exact answers.
+
+Units (docs/LPV.md): a cell holds the L1 SH (order 1, y, z, x) of the radiant intensity I(w), W/sr, of
+the light leaving it, by direction of travel. The "energy" of a cell is its flux, the integral of the
+reconstructed intensity over the sphere: 2 sqrt(pi) c0 (the band-1 terms integrate to 0). It is
+linear in the coefficients, so it is conserved (or not) exactly, not up to the L1 projection.
+Volumes read back as (z, y, x, 4) arrays.
+"""
+
+import functools
+
+import numpy as np
+import pytest
+
+from addon.engine import sh
+from addon.engine.config import GIConfig, LpvConfig, RsmConfig
+from addon.engine.grid import Grid
+from addon.engine.methods.lpv import LpvMethod
+from addon.engine.passes import lpv_inject, lpv_propagate
+from addon.engine.scene import Camera, Light, Scene
+from addon.engine.transforms import look_along, perspective
+
+pytestmark = pytest.mark.gpu
+
+FRONT, SIDE = 0.4006696846, 0.4234313544
+AXES = [np.array(v, float) for v in ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1))]
+FLUX_PER_C0 = 2.0 * np.sqrt(np.pi)
+
+
+# -- numpy reference of one propagation step ----------------------------------------------------------
+@functools.cache
+def transfer_matrices(variant):
+    """M_d (4x4, acting on (1, y, z, x) coefficients) for the six travel directions d, as in
+    propagate.comp.glsl, built independently: classic from the five faces, improved by quadrature
+    (full 4x4 matrices, so the shader's symmetric form is checked)."""
+    mats = []
+    if variant == "classic":
+        for d in AXES:
+            m = np.zeros((4, 4))
+            for f in AXES:
+                if f @ d < -0.5:
+                    continue
+                w = d if f @ d > 0.5 else (d + 0.5 * f) / np.linalg.norm(d + 0.5 * f)
+                omega = FRONT if f @ d > 0.5 else SIDE
+                m += omega * np.outer(sh.cosine_lobe_l1(f) / np.pi, sh.basis_l1(w))
+            mats.append(m)
+        return mats
+    # M_+x by quadrature (full 4x4), rotated to the other axes exactly: a (theta, phi) rule is not
+    # symmetric between x and z, so quadrature per axis would differ by its own ~1e-5 error.
+    dirs, wts = sh.sphere_quadrature(1024, 2048)
+    y = sh.basis_l1(dirs)
+    wx = wts * np.maximum(dirs[:, 0], 0.0) / np.abs(dirs).sum(axis=1)
+    m_x = np.einsum("k,ki,kj->ij", wx, y, y)
+    slot = {0: 3, 1: 1, 2: 2}  # axis -> coefficient index in (1, y, z, x)
+    for d in AXES:
+        a = int(np.argmax(np.abs(d)))
+        rot = np.eye(3)
+        rot[:, [0, a]] = rot[:, [a, 0]]  # swap x and axis a: maps e_x to e_a ...
+        rot[:, 0] *= d[a]  # ... with d's sign (a signed permutation keeps |w|_1)
+        p = np.zeros((4, 4))
+        p[0, 0] = 1.0
+        for i in range(3):
+            for j in range(3):
+                p[slot[i], slot[j]] = rot[i, j]
+        mats.append(p @ m_x @ p.T)
+    return mats
+
+
+def shifted(v, d):
+    """out[B] = v[B - d], zero where B - d is outside; v is (z, y, x, ...)."""
+    out = np.zeros_like(v)
+    src, dst = [slice(None)] * 3, [slice(None)] * 3
+    for axis, step in zip((2, 1, 0), d.astype(int), strict=True):  # x, y, z -> array axes
+        if step == 1:
+            src[axis], dst[axis] = slice(0, -1), slice(1, None)
+        elif step == -1:
+            src[axis], dst[axis] = slice(1, None), slice(0, -1)
+    out[tuple(dst)] = v[tuple(src)]
+    return out
+
+
+def blocking(vox_normal, d):
+    if vox_normal is None:
+        return np.zeros(vox_normal.shape[:3] if vox_normal is not None else ())
+    return np.minimum(1.0, vox_normal[..., 3] * np.abs(vox_normal[..., :3] @ d))
+
+
+def reference_step(channels, variant, vox_normal=None):
+    """channels: list of (z, y, x, 4) arrays -> the next snapshot of each (float64)."""
+    mats = transfer_matrices(variant)
+    out = [np.zeros(c.shape) for c in channels]
+    for d, m in zip(AXES, mats, strict=True):
+        if vox_normal is None:
+            through = 1.0
+        else:
+            b = blocking(vox_normal, d)
+            through = (1.0 - 0.5 * (shifted(b, d) + b))[..., None]
+        for o, c in zip(out, channels, strict=True):
+            o += through * (shifted(c.astype(np.float64), d) @ m.T)
+    return out
+
+
+# -- GPU helpers --------------------------------------------------------------------------------------
+def volumes(gl, dims, data=None):
+    d = data or [None] * 3
+    return {f"sh_{c}": gl.texture(dims, "RGBA32F", x) for c, x in zip("rgb", d, strict=True)}
+
+
+def gpu_steps(gl, grid, channels, variant, steps, vox_normal=None):
+    """Run `steps` propagation steps; returns (snapshots after each step, accumulation) as arrays."""
+    sets = [volumes(gl, grid.dims, channels), volumes(gl, grid.dims)]
+    acc = {f"acc_{c}": gl.texture(grid.dims) for c in "rgb"}
+    gv = gl.texture(grid.dims, "RGBA32F", vox_normal) if vox_normal is not None else None
+    snaps = []
+    for i in range(steps):
+        lpv_propagate.run(gl, sets[i % 2], sets[(i + 1) % 2], acc, grid, variant, first_step=i == 0, vox_normal=gv)
+        snaps.append([gl.read(sets[(i + 1) % 2][f"sh_{c}"]) for c in "rgb"])
+    return snaps, [gl.read(acc[f"acc_{c}"]) for c in "rgb"]
+
+
+def random_field(rng, dims, cells=6):
+    """Per channel, a few cells each holding a sum of VPL lobes (realizable, non-negative intensity)."""
+    out = []
+    for _ in range(3):
+        v = np.zeros(tuple(reversed(dims)) + (4,), np.float32)
+        for _ in range(cells):
+            z, y, x = (rng.integers(0, n) for n in reversed(dims))
+            n = rng.normal(size=3)
+            v[z, y, x] += rng.uniform(0.1, 2.0) * sh.cosine_lobe_l1(n / np.linalg.norm(n)) / np.pi
+        out.append(v)
+    return out
+
+
+def flux(channels):
+    return np.array([FLUX_PER_C0 * np.sum(c[..., 0], dtype=np.float64) for c in channels])
+
+
+# -- injection ----------------------------------------------------------------------------------------
+def test_injection_of_one_vpl_gives_its_lobe(gl):
+    # Two VPLs in a 4x4 RSM (other texels empty, w = 0) on a 6x5x4 grid of 0.5 m cells at the origin.
+    grid = Grid(np.zeros(3), 0.5, (6, 5, 4))
+    res = 4
+    pos, nrm, phi = (np.zeros((res, res, 4), np.float32) for _ in range(3))
+    n1 = np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])
+    p1, f1 = np.array([1.1, 1.3, 0.6]), np.array([2.0, 1.0, 0.5])
+    n2 = np.array([0.0, 0.0, -1.0])
+    p2, f2 = np.array([2.2, 0.4, 1.9]), np.array([0.25, 0.5, 1.0])
+    pos[1, 2] = [*p1, 1.0]
+    nrm[1, 2] = [*n1, 0.01]
+    phi[1, 2, :3] = f1
+    pos[3, 0] = [*p2, 1.0]
+    nrm[3, 0] = [*n2, 0.01]
+    phi[3, 0, :3] = f2
+    rsm = {k: gl.texture((res, res), "RGBA32F", a) for k, a in (("position", pos), ("normal", nrm), ("flux", phi))}
+    vols = volumes(gl, grid.dims)
+    targets = lpv_inject.layer_targets(gl, vols, grid)
+    for t in targets:
+        gl.clear(t)
+    lpv_inject.run(gl, targets, lpv_inject.texel_points(gl, res), rsm, grid)
+    got = [gl.read(vols[f"sh_{c}"]) for c in "rgb"]
+
+    expected = [np.zeros_like(got[0]) for _ in range(3)]
+    for p, n, f in ((p1, n1, f1), (p2, n2, f2)):
+        x, y, z = np.floor((p + 0.25 * n) / 0.5).astype(int)  # half a cell (0.25 m) along n
+        for ch in range(3):
+            expected[ch][z, y, x] += f[ch] / np.pi * sh.cosine_lobe_l1(n)
+    # The second VPL (normal -z at z = 1.9 m) moves to z = 1.65 m: layer 3, not 3 - 1 = 2... check both
+    # VPLs land in different layers, so the per-layer culling is exercised.
+    assert np.floor((p1 + 0.25 * n1) / 0.5)[2] != np.floor((p2 + 0.25 * n2) / 0.5)[2]
+    for ch in range(3):
+        # fp32 arithmetic of a few products: 1e-6 relative to the largest coefficient.
+        np.testing.assert_allclose(got[ch], expected[ch], atol=1e-6 * np.abs(expected[ch]).max())
+    # The injected flux is the VPLs' flux: 2 sqrt(pi) c0 = phi exactly for a clamped-cosine lobe.
+    np.testing.assert_allclose(flux(got), f1 + f2, rtol=1e-6)
+
+
+# -- propagation --------------------------------------------------------------------------------------
+@pytest.mark.parametrize("variant", ["classic", "improved"])
+def test_gpu_step_equals_numpy_step(gl, variant):
+    rng = np.random.default_rng(3)
+    grid = Grid(np.zeros(3), 1.0, (7, 6, 5))
+    field = random_field(rng, grid.dims, cells=10)
+    vox = np.zeros(tuple(reversed(grid.dims)) + (4,), np.float32)
+    vox[..., :3] = rng.normal(size=vox.shape[:3] + (3,))
+    vox[..., :3] /= np.linalg.norm(vox[..., :3], axis=-1, keepdims=True)
+    vox[..., 3] = rng.uniform(0, 1.5, size=vox.shape[:3]) * (rng.uniform(size=vox.shape[:3]) < 0.4)
+    scale = max(np.abs(c).max() for c in field)
+    for gv in (None, vox):
+        snaps, _ = gpu_steps(gl, grid, field, variant, 1, vox_normal=gv)
+        want = reference_step(field, variant, gv)
+        for got_c, want_c in zip(snaps[0], want, strict=True):
+            # fp32 sums of ~30 products of O(1) values: 1e-5 of the field's scale.
+            np.testing.assert_allclose(got_c, want_c, atol=1e-5 * scale)
+
+
+@pytest.mark.parametrize("variant", ["classic", "improved"])
+def test_one_step_never_gains_energy(gl, variant):
+    # A field well inside a 9^3 grid (nothing reaches a border in one step): one step keeps the flux
+    # exactly (both schemes are flux-conserving: classic's 30 face solid angles sum to 6 x 2 pi / 3
+    # = 4 pi with zero first moment, improved's M_d sum to the identity); with a geometry volume it
+    # can only lose flux. Tolerance: fp32 accumulation, 1e-5 relative.
+    rng = np.random.default_rng(7)
+    grid = Grid(np.zeros(3), 1.0, (9, 9, 9))
+    field = [np.zeros((9, 9, 9, 4), np.float32) for _ in range(3)]
+    inner = random_field(rng, (5, 5, 5), cells=12)
+    for f, i in zip(field, inner, strict=True):
+        f[2:7, 2:7, 2:7] = i
+    before = flux(field)
+    snaps, _ = gpu_steps(gl, grid, field, variant, 1)
+    after = flux(snaps[0])
+    print(f"{variant}: flux before {before}, after one step {after}")
+    np.testing.assert_allclose(after, before, rtol=1e-5)
+    assert np.all(after <= before * (1 + 1e-5))
+    vox = np.zeros((9, 9, 9, 4), np.float32)
+    vox[..., 2] = 1.0
+    vox[4:6, :, :, 3] = 0.8  # horizontal surfaces across two layers
+    snaps, _ = gpu_steps(gl, grid, field, variant, 1, vox_normal=vox)
+    blocked = flux(snaps[0])
+    print(f"{variant}: with a geometry volume {blocked}")
+    assert np.all(blocked <= before * (1 + 1e-5)) and np.all(blocked < before * 0.999)
+
+
+@pytest.mark.parametrize("variant", ["classic", "improved"])
+def test_open_space_energy_only_leaves_through_the_borders(gl, variant):
+    # Flux inside after k steps + flux that crossed the border in steps 1..k = injected. What leaves
+    # in a step is what the numpy reference step sends into a one-cell pad around the grid (checked
+    # against the GPU step above). fp32 over 12 steps: 1e-5 relative.
+    rng = np.random.default_rng(11)
+    grid = Grid(np.zeros(3), 1.0, (7, 6, 5))
+    field = random_field(rng, grid.dims, cells=8)
+    injected = flux(field)
+    steps = 12
+    snaps, _ = gpu_steps(gl, grid, field, variant, steps)
+    left = np.zeros(3)
+    prev = field
+    for k in range(steps):
+        padded = [np.pad(c.astype(np.float64), ((1, 1), (1, 1), (1, 1), (0, 0))) for c in prev]
+        nxt = reference_step(padded, variant)
+        left += flux(nxt) - flux([c[1:-1, 1:-1, 1:-1] for c in nxt])
+        prev = snaps[k]
+        np.testing.assert_allclose(flux(snaps[k]) + left, injected, rtol=1e-5)
+    print(f"{variant}: after {steps} steps inside {flux(snaps[-1]) / injected}, left {left / injected}")
+    assert np.all(left > 0.05 * injected)  # the test measures something: light did reach the borders
+
+
+def point_source_profile(gl, variant, iterations, length=36, side=31):
+    """Diffuse-Indirect-free check of transport: an isotropic 1 W source in an empty grid; irradiance
+    on a surface facing it, LPV / exact (I / r^2), at cell centres along +x, by distance in cells."""
+    grid = Grid(np.zeros(3), 1.0, (length + 6, side, side))
+    src = (4, side // 2, side // 2)  # x, y, z
+    field = [np.zeros((side, side, length + 6, 4), np.float32) for _ in range(3)]
+    field[0][src[2], src[1], src[0], 0] = 1.0 / FLUX_PER_C0  # P = 1 W in the red channel
+    sets = [volumes(gl, grid.dims, field), volumes(gl, grid.dims)]
+    acc = {f"acc_{c}": gl.texture(grid.dims) for c in "rgb"}
+    for i in range(iterations):
+        lpv_propagate.run(gl, sets[i % 2], sets[(i + 1) % 2], acc, grid, variant, first_step=i == 0)
+    acc_r = gl.read(acc["acc_r"])
+    ratios = {}
+    for r in range(1, length + 1):
+        c = acc_r[src[2], src[1], src[0] + r]
+        e = max(c @ sh.cosine_lobe_l1(np.array([1.0, 0, 0])), 0.0)  # normal -x: lobe about +x
+        ratios[r] = e / (1.0 / (4 * np.pi) / r**2)
+    return ratios
+
+
+def test_point_source_irradiance_along_an_axis(gl):
+    classic16 = point_source_profile(gl, "classic", 16)
+    classic64 = point_source_profile(gl, "classic", 64)
+    improved = point_source_profile(gl, "improved", 42 + 31 + 31 - 3)  # its Manhattan-span default
+    improved21 = point_source_profile(gl, "improved", 42 + 21 + 21 - 3, side=21)
+    show = (1, 2, 4, 8, 12, 16, 24, 32)
+    rows = (("classic 16 it", classic16), ("classic 64 it", classic64), ("improved 101 it", improved),
+            ("improved, y/z borders at 10 cells", improved21))
+    for name, prof in rows:
+        print(f"{name}: " + ", ".join(f"{r}: {prof[r]:.2f}" for r in show))
+    # classic reproduces BASELINE.md's diagnosis: light counted ~2x near the source and lost far away
+    # (BASELINE: 2.99x at 4 cells, 0.05x at 24; the exact figures depend on the lookup and grid).
+    assert max(classic64[r] for r in (2, 4, 8)) > 1.8
+    assert classic16[24] < 0.1 and classic64[24] < 0.1
+    # improved, measured (y/z borders 15 cells away): 0.69 at 1 cell (the source's own cell is not
+    # accumulated, and L1 blurs the first step), then 1.27 (2), 1.48 (4), 1.42 (8), 1.55 (12),
+    # 1.70 (16), 1.51 (24), 1.57 (32). It is within 2x at every distance, where classic spans
+    # 0.00..2.4 and is lost beyond 16 cells. The excess over 1 grows near the borders (borders 10
+    # cells away: up to 2.0 at 16 and 2.7 at 32): the L1 transfer carries negative backward lobes,
+    # and the border absorbs them along with the positive light. Bound: [0.6, 1.9] on 2..32 cells.
+    for r in range(2, 33):
+        assert 0.6 <= improved[r] <= 1.9, (r, improved[r])
+
+
+# -- the method ---------------------------------------------------------------------------------------
+def rect(origin, u, v):
+    o, u, v = (np.asarray(a, float) for a in (origin, u, v))
+    p = [o, o + u, o + u + v, o + v]
+    n = np.cross(u, v) / np.linalg.norm(np.cross(u, v))
+    return [[p[0], p[1], p[2]], [p[0], p[2], p[3]]], [n, n]
+
+
+def corner_scene():
+    light = Light("SPOT", [1.0, 0, 1.8], [0, 0, -1], [1, 1, 1], power_w=300.0, spot_size_rad=np.radians(60),
+                  spot_blend=0.1)
+    cam = Camera(look_along([3.5, 0, 1.2], [-1, 0, -0.2], [0, 0, 1]), perspective(np.radians(50), 0.1, 100), 24, 24)
+    rects = [rect([0, -1, 0], [2, 0, 0], [0, 2, 0]), rect([0, -1, 0], [0, 2, 0], [0, 0, 2])]
+    tris, normals, alb = [], [], []
+    for (t, n), a in zip(rects, ([0.8, 0.5, 0.2], [0.5, 0.5, 0.5]), strict=True):
+        tris += t
+        normals += [[ni] * 3 for ni in n]
+        alb += [a] * len(t)
+    return Scene(np.array(tris, np.float32), np.array(normals, np.float32), np.array(alb, np.float32),
+                 np.zeros((len(tris), 3), np.float32), [light], camera=cam)
+
+
+@pytest.mark.parametrize("variant", ["classic", "improved"])
+def test_method_output_is_finite_and_non_negative(gl, variant):
+    method = LpvMethod(gl, GIConfig(method="lpv"), RsmConfig(resolution=64),
+                       LpvConfig(grid_cells=12, variant=variant, geometry_volume=True))
+    method.set_scene(corner_scene())
+    result = method.run()
+    ind = result.images["indirect"][..., :3]
+    cover = result.images["indirect"][..., 3] > 0.5
+    assert np.all(np.isfinite(ind)) and ind.min() >= 0.0
+    assert ind[cover].mean() > 0.0  # the wall sees the lit floor
+    assert set(result.timings_ms) >= {"lpv_inject", "lpv_propagate", "lpv_lookup", "total"}
+
+
+def test_default_constructor_keeps_existing_callers_working(gl):
+    method = LpvMethod(gl, GIConfig(method="lpv"), RsmConfig(resolution=32))
+    assert method.lpv_config == LpvConfig()

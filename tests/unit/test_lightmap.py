@@ -1,0 +1,66 @@
+"""Bake helpers: seam dilation (exact), safe output paths, shard selection."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from addon.engine.errors import ConfigError
+from addon.engine.lightmap import dilate, output_path, parse_shard, safe_name, shard, uv_problems
+
+
+def test_dilation_fills_rings_with_neighbour_means_exactly():
+    img = np.zeros((5, 5, 1))
+    cov = np.zeros((5, 5), bool)
+    img[2, 2], cov[2, 2] = 8.0, True
+    img[2, 3], cov[2, 3] = 4.0, True
+    out, filled = dilate(img, cov, 1)
+    # Ring 1: each empty texel = mean of its covered 8-neighbours (covered texels unchanged).
+    assert out[2, 2, 0] == 8.0 and out[2, 3, 0] == 4.0
+    assert out[1, 1, 0] == 8.0 and out[1, 2, 0] == 6.0 and out[1, 4, 0] == 4.0 and out[2, 1, 0] == 8.0
+    assert filled.sum() == 2 + 10 and not filled[0].any()
+    out2, filled2 = dilate(img, cov, 2)
+    assert filled2.all()
+    # Ring 2: corner (0, 0) sees only (1, 1) of ring 1.
+    assert out2[0, 0, 0] == 8.0
+    np.testing.assert_array_equal(out2[1:4, 1:5], out[1:4, 1:5])  # ring 1 unchanged by ring 2
+
+
+def test_dilation_without_coverage_is_a_no_op():
+    img = np.ones((3, 3, 3))
+    out, filled = dilate(img, np.zeros((3, 3), bool), 4)
+    assert not filled.any() and np.array_equal(out, img)
+
+
+@pytest.mark.parametrize("name", ["../x", "../../etc/passwd", "a/b\\c", "..", ".hidden", "/abs", "C:\\x", "", "é ñ"])
+def test_output_paths_never_leave_the_directory(tmp_path, name):
+    p = output_path(tmp_path, name, "indirect")
+    assert p.parent == tmp_path.resolve() and p.name.endswith("_indirect.exr")
+    assert "/" not in safe_name(name) and "\\" not in safe_name(name) and ".." not in safe_name(name)
+    assert not safe_name(name).startswith(".")
+
+
+def test_names_that_sanitise_alike_get_distinct_files(tmp_path):
+    taken: set[str] = set()
+    a = output_path(tmp_path, "a/b", "direct", taken)
+    b = output_path(tmp_path, "a:b", "direct", taken)
+    assert a != b and Path(b).name == "a_b_direct_2.exr"
+
+
+def test_shards_are_disjoint_and_cover_everything():
+    names = [f"o{i}" for i in range(10)]
+    parts = [shard(names, i, 3) for i in range(3)]
+    assert sorted(sum(parts, [])) == sorted(names)
+    assert parts[1] == sorted(names)[1::3]
+    assert parse_shard("2/5") == (2, 5) and parse_shard(None) == (0, 1)
+    for bad in ("5/5", "1", "-1/2", "a/b", "0/0"):
+        with pytest.raises(ConfigError):
+            parse_shard(bad)
+
+
+def test_uv_problems():
+    pos = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]] * 2, float)
+    uv = np.array([[[0, 0], [1, 0], [0, 1]], [[0.5, 0.5]] * 3], float)
+    notes = uv_problems(uv, pos)
+    assert len(notes) == 1 and "1 of 2 triangles have zero UV area" in notes[0]
+    assert "outside 0..1" in uv_problems(uv + 1.5, pos)[-1]
