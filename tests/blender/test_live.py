@@ -148,9 +148,9 @@ def test_quality_preset_sets_rsm_settings(bounce, fresh_blend):
     try:
         settings = bpy.context.scene.bounce
         settings.quality = "HIGH"
-        assert (settings.rsm.resolution, settings.rsm.vpl_samples) == (512, 1024)
+        assert (settings.rsm.resolution, settings.rsm.vpl_samples, settings.rsm.visibility) == (256, 256, "voxel")
         settings.quality = "DRAFT"
-        assert (settings.rsm.resolution, settings.rsm.vpl_samples) == (128, 64)
+        assert (settings.rsm.resolution, settings.rsm.vpl_samples, settings.rsm.visibility) == (256, 64, "none")
     finally:
         bounce.unregister()
 
