@@ -60,7 +60,8 @@ class DirectMethod:
         self.source = scene
         self.scene, self.origin_m = scene.prepared()
         # Emissive meshes light the scene like lamps (already in the uploaded, re-centred frame).
-        self.emissive = emissive_lights(self.scene.positions_m, self.scene.emission)
+        lo, hi = self.scene.bounds_m()
+        self.emissive = emissive_lights(self.scene.positions_m, self.scene.emission, float((hi - lo).max()))
         selections = {gbuffer.SPEC: self.scene.seen_by_camera(), rsm.SPEC: None}
         self._meshes = {}
         for spec, select in selections.items():

@@ -33,9 +33,11 @@ class LightView:
     uniforms: dict
 
 
-def emissive_lights(positions_m: np.ndarray, emission: np.ndarray, bins: int = 8) -> list[Light]:
+def emissive_lights(positions_m: np.ndarray, emission: np.ndarray, scene_extent_m: float, bins: int = 8
+                    ) -> list[Light]:
     """Emissive triangles as lamps: triangles are grouped by the cell of a coarse grid (`bins` cells
-    along the emitters' longest extent) their centroid falls in, one lamp per group.
+    along the scene's longest extent) their centroid falls in, one lamp per group: at most bins^3
+    lamps, and a small emitter (Sponza's sphere) is one lamp, not hundreds.
 
     Cycles' mesh emission is two-sided: each side of a surface of radiance L emits pi L A. Flat groups
     (area-weighted normals mostly agree) become two AREA lights, one per side; closed ones (a sphere:
@@ -51,8 +53,8 @@ def emissive_lights(positions_m: np.ndarray, emission: np.ndarray, bins: int = 8
     cross = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
     area = 0.5 * np.linalg.norm(cross, axis=1)
     centroid = p.mean(axis=1)
-    lo, hi = centroid.min(axis=0), centroid.max(axis=0)
-    cell = max(float((hi - lo).max()) / bins, 1e-9)
+    lo = centroid.min(axis=0)
+    cell = max(scene_extent_m / bins, 1e-9)
     keys = np.floor((centroid - lo) / cell).astype(np.int64)
     _, group = np.unique(keys, axis=0, return_inverse=True)
     lights = []
