@@ -62,7 +62,10 @@ class DirectMethod:
         # Emissive meshes light the scene like lamps (already in the uploaded, re-centred frame).
         lo, hi = self.scene.bounds_m()
         self.emissive = emissive_lights(self.scene.positions_m, self.scene.emission, float((hi - lo).max()))
-        selections = {gbuffer.SPEC: self.scene.seen_by_camera(), rsm.SPEC: None}
+        # Emitters stay out of the RSMs: their lamps sit on or inside them (a sphere's lamp at its centre
+        # would be shadowed by the sphere itself). They then cast no shadow for other lights either.
+        not_emitting = ~np.any(self.scene.emission > 0, axis=1)
+        selections = {gbuffer.SPEC: self.scene.seen_by_camera(), rsm.SPEC: not_emitting}
         self._meshes = {}
         for spec, select in selections.items():
             attrs = triangle_attributes(self.scene, select)
