@@ -1,11 +1,10 @@
 // Texel G-buffer for bakes: the object's triangles rasterized in UV space, one pixel per texel.
 // Every vertex carries its whole triangle (uv0..2, p0..2, n0..2, the same at its three vertices) and
 // its own corner index. gl_Position comes from the UV, so V = 0 is GL row 0 (the image's bottom).
-// With `dilate` = 1 the triangle is grown by half a texel (conservative coverage without a geometry
-// shader, as gpu_shaders/voxelize/voxelize.vert.glsl: each edge moves out by the texel's half-extent
-// along its normal and the vertex becomes the intersection of its two moved edges); the fragment
+// With `dilate` = 1 the triangle is grown conservatively (common/conservative.glsl); the fragment
 // shader clips the over-grown corners with the triangle's bounding box; an edge texel whose centre lies
 // outside the triangle takes the nearest point on it, and the depth test keeps the nearest triangle.
+#include "common/conservative.glsl"
 
 void main() {
     int k = int(corner + 0.5);
@@ -18,18 +17,7 @@ void main() {
     vec2 p = a;
     float area2 = (t1.x - t0.x) * (t2.y - t0.y) - (t1.y - t0.y) * (t2.x - t0.x);
     if (dilate > 0.5 && abs(area2) > 1e-12) {
-        float orient = sign((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x));
-        vec2 e0 = b - a;  // edge a -> b
-        vec2 e1 = a - c;  // edge c -> a
-        vec2 m0 = orient * normalize(vec2(e0.y, -e0.x) + 1e-12);
-        vec2 m1 = orient * normalize(vec2(e1.y, -e1.x) + 1e-12);
-        float d0 = 0.5 * (abs(m0.x) + abs(m0.y));
-        float d1 = 0.5 * (abs(m1.x) + abs(m1.y));
-        float det = m0.x * m1.y - m0.y * m1.x;
-        vec2 offset = abs(det) > 1e-6 ? vec2(d0 * m1.y - d1 * m0.y, m0.x * d1 - m1.x * d0) / det : vec2(0.0);
-        float len_offset = length(offset);
-        offset *= min(1.0, 4.0 / max(len_offset, 1e-12));  // slivers: the bbox clip trims the rest
-        p = a + offset;
+        p = conservative_corner(a, b, c);
     }
     // Barycentrics of p in (t0, t1, t2): affine in p, so their linear interpolation is exact everywhere.
     vec3 bary = vec3(float(k == 0), float(k == 1), float(k == 2));
