@@ -13,6 +13,7 @@ import numpy as np
 
 from ..backends.base import Backend
 from ..config import GIConfig, RsmConfig
+from ..errors import ConfigError
 from ..passes import direct_light, gbuffer, rsm
 from ..passes.light_views import LightView, emissive_lights, views_for
 from ..scene import Camera, Scene
@@ -159,3 +160,27 @@ class DirectMethod:
 
     def product_textures(self) -> dict:
         return {"direct": self.direct}
+
+
+class OneBounceMethod(DirectMethod):
+    """Base of the one-bounce indirect methods: the `indirect` product (Cycles' Diffuse Indirect units)
+    beside direct light, allocated, cleared and read like `direct`; several bounces are refused."""
+
+    products = ("direct", "indirect", "albedo")
+
+    def __init__(self, backend: Backend, gi: GIConfig, rsm_config: RsmConfig):
+        if gi.bounces != 1:
+            raise ConfigError(f"method {self.name} computes one bounce: GIConfig.bounces = {gi.bounces} must be 1")
+        super().__init__(backend, gi, rsm_config)
+
+    def allocate_products(self, size: tuple[int, int]) -> None:
+        super().allocate_products(size)
+        self.indirect = self.backend.texture(size)
+        self._indirect_target = self.backend.target([self.indirect])
+
+    def clear_products(self) -> None:
+        super().clear_products()
+        self.backend.clear(self._indirect_target)
+
+    def product_textures(self) -> dict:
+        return {**super().product_textures(), "indirect": self.indirect}

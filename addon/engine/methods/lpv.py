@@ -13,12 +13,11 @@ non-cubic for flat scenes. Products: direct, indirect, albedo.
 from __future__ import annotations
 
 from ..config import LpvConfig
-from ..errors import ConfigError
 from ..grid import Grid
 from ..passes import lpv_inject, lpv_lookup, lpv_propagate
 from ..passes.light_views import LightView
 from ..passes.voxelize import Voxelizer
-from .direct import DirectMethod
+from .direct import OneBounceMethod
 
 
 def iterations_for(config: LpvConfig, grid: Grid) -> int:
@@ -30,21 +29,13 @@ def iterations_for(config: LpvConfig, grid: Grid) -> int:
     return config.iterations
 
 
-class LpvMethod(DirectMethod):
+class LpvMethod(OneBounceMethod):
     name = "lpv"
-    products = ("direct", "indirect", "albedo")
 
     def __init__(self, backend, gi, rsm_config, lpv_config: LpvConfig | None = None):
-        if gi.bounces != 1:
-            raise ConfigError(f"method lpv computes one bounce: GIConfig.bounces = {gi.bounces} must be 1")
         super().__init__(backend, gi, rsm_config)
         self.lpv_config = lpv_config if lpv_config is not None else LpvConfig()
         self.grid: Grid | None = None
-
-    def allocate_products(self, size: tuple[int, int]) -> None:
-        super().allocate_products(size)
-        self.indirect = self.backend.texture(size)
-        self._indirect_target = self.backend.target([self.indirect])
 
     def set_scene(self, scene) -> None:
         super().set_scene(scene)
@@ -65,7 +56,6 @@ class LpvMethod(DirectMethod):
 
     def clear_products(self) -> None:
         super().clear_products()
-        self.backend.clear(self._indirect_target)
         for target in self._inject_targets:
             self.backend.clear(target)
 
@@ -92,6 +82,3 @@ class LpvMethod(DirectMethod):
             with be.timed(timings, "lpv_lookup"):
                 lpv_lookup.run(be, self.gbuf, self.accumulated, self.indirect, self.grid)
         return timings
-
-    def product_textures(self) -> dict:
-        return {**super().product_textures(), "indirect": self.indirect}

@@ -10,27 +10,15 @@ through the occupancy grid. Products: direct, indirect, albedo.
 
 from __future__ import annotations
 
-from ..errors import ConfigError
 from ..grid import Grid
 from ..passes import rsm_gather, voxel_view
 from ..passes.light_views import LightView
 from ..passes.voxelize import Voxelizer
-from .direct import DirectMethod
+from .direct import OneBounceMethod
 
 
-class RsmMethod(DirectMethod):
+class RsmMethod(OneBounceMethod):
     name = "rsm"
-    products = ("direct", "indirect", "albedo")
-
-    def __init__(self, backend, gi, rsm_config):
-        if gi.bounces != 1:
-            raise ConfigError(f"method rsm computes one bounce: GIConfig.bounces = {gi.bounces} must be 1")
-        super().__init__(backend, gi, rsm_config)
-
-    def allocate_products(self, size: tuple[int, int]) -> None:
-        super().allocate_products(size)
-        self.indirect = self.backend.texture(size)
-        self._indirect_target = self.backend.target([self.indirect])
 
     def set_scene(self, scene) -> None:
         super().set_scene(scene)
@@ -59,16 +47,9 @@ class RsmMethod(DirectMethod):
         voxel_view.run(self.backend, self.gbuf["position"], voxels["vox_albedo"], self.grid, self._voxel_view)
         return self._voxel_view
 
-    def clear_products(self) -> None:
-        super().clear_products()
-        self.backend.clear(self._indirect_target)
-
     def per_light_view(self, view: LightView, timings: dict[str, float]) -> None:
         with self.backend.timed(timings, "rsm_gather"):
             rsm_gather.run(self.backend, self.gbuf, self.rsm, self.indirect, self.rsm_config.vpl_samples,
                            self.gi.seed + view.light_index * 6 + max(view.face_index, 0),
                            occupancy=self.voxels["vox_albedo"] if self.voxels else None,
                            grid=self.voxels and self.grid, offset_cells=self.rsm_config.voxel_offset_cells)
-
-    def product_textures(self) -> dict:
-        return {**super().product_textures(), "indirect": self.indirect}
