@@ -27,7 +27,7 @@ import numpy as np
 from ..engine import methods
 from ..engine.config import GIConfig, RsmConfig
 from ..engine.errors import ConfigError, SceneError
-from ..engine.lightmap import PASSES, TARGETS, check_choice, dilate, output_path, shard, uv_problems
+from ..engine.lightmap import PASSES, TARGETS, check_choice, dilate, output_path, safe_name, shard, uv_problems
 from ..engine.scene import Camera
 from . import images
 from .bake_raster import TexelBaker
@@ -286,6 +286,8 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
 
     check_choice(pass_name, PASSES, "--pass")
     check_choice(target, TARGETS, "--target")
+    if target == "volume":
+        raise ConfigError("a volume is one per scene, not per object: use bake_volume (--target volume)")
     if not 8 <= size <= 8192:
         raise ConfigError(f"--size must be in 8..8192, got {size}")
     gi = gi or GIConfig(method="rsm")
@@ -355,3 +357,45 @@ def _bake_one(baker: Baker, name: str, out_dir: Path, size: int, pass_name: str,
     finally:
         res.time_ms = (time.perf_counter() - t0) * 1e3
     return res
+
+
+def bake_volume(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, lpv, overwrite: bool = False,
+                backend=None) -> dict:
+    """The LPV's indirect light of the whole scene as a volume for engines: DIR/<stem>_lpv_sh.npz.
+
+    Layout (numpy .npz): `sh_r`, `sh_g`, `sh_b` float32 (z, y, x, 4) — per colour, L1 SH in the order
+    (1, y, z, x) of the radiant intensity (W/sr) of the light that passed through each cell by direction
+    of travel, summed over the propagation steps (docs/LPV.md, "What a cell stores"); `origin_m` (3,)
+    world position of the grid's corner (cell (0, 0, 0) spans origin .. origin + cell_size_m);
+    `cell_size_m` scalar; `dims` (3,) x, y, z. To light a surface with normal n at p: sample the SH
+    trilinearly at p + 0.5 cell n (cell centres at origin + (i + 0.5) cell), E = max(0, c . lobe(-n)) /
+    cell_size_m^2 with lobe(m) = (0.886227, 1.023327 m.y, m.z, m.x); Cycles' Diffuse Indirect = E / pi.
+    """
+    from ..engine.methods.lpv import LpvMethod
+    from .pipeline import backend as default_backend
+    from .pipeline import open_blend
+
+    if gi.method != "lpv":
+        raise ConfigError(f"--target volume bakes the LPV's grid: use --method lpv (got {gi.method})")
+    out_dir = check_output_dir(Path(out_dir))
+    path = out_dir / f"{safe_name(Path(blend).stem)}_lpv_sh.npz"
+    if path.exists() and not overwrite:
+        raise SceneError(f"{path} exists (use --overwrite)")
+    open_blend(blend)
+    define_light_switch()
+    t0 = time.perf_counter()
+    scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 64, 64)
+    if scene.camera is None:
+        scene.camera = _default_camera(64)  # the volume does not depend on a view
+    be = backend or default_backend()
+    method = LpvMethod(be, gi, rsm, lpv)
+    method.set_scene(scene)
+    method.compute()
+    sh = {f"sh_{c}": be.read(method.accumulated[f"acc_{c}"]) for c in "rgb"}
+    grid = method.grid
+    np.savez_compressed(path, **sh, origin_m=grid.origin_m + method.origin_m, cell_size_m=grid.cell_size_m,
+                        dims=np.array(grid.dims))
+    summary = {"blend": str(blend), "file": str(path), "dims": list(grid.dims), "cell_size_m": grid.cell_size_m,
+               "time_ms": round((time.perf_counter() - t0) * 1e3, 2), "config": {"lpv": method.lpv_config.to_dict()}}
+    print(f"{Path(blend).name}: volume {grid.dims[0]}x{grid.dims[1]}x{grid.dims[2]} -> {path}")
+    return summary

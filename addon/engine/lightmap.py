@@ -14,7 +14,7 @@ import numpy as np
 from .errors import ConfigError
 
 PASSES = ("indirect", "direct", "combined")
-TARGETS = ("image", "vertex-colors")
+TARGETS = ("image", "vertex-colors", "volume")
 
 
 def dilate(image: np.ndarray, covered: np.ndarray, iterations: int = 16) -> tuple[np.ndarray, np.ndarray]:
