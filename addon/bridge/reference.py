@@ -229,3 +229,38 @@ def cycles_curve(blend, spp_list, bounces: int, res: int, reference_dir) -> list
             curve.append({"spp": spp, "time_s": stats["render_time_s"], "rel_rmse": m["rel_rmse"],
                           "rel_rmse_8": m["rel_rmse_8"], "bias": m["bias"]})
     return curve
+
+
+def cycles_bake(obj_name: str, pass_filter: set, spp: int, seed: int, size: int) -> tuple[np.ndarray, float]:
+    """Cycles' DIFFUSE bake of one object of the open file into a size x size float image, set up as for
+    references (one diffuse bounce, no clamping, denoising or adaptive sampling); pass_filter {'INDIRECT'}
+    or {'DIRECT'} without 'COLOR' gives the light alone, in Diffuse Indirect / Direct units.
+    Returns (rgba, row 0 = top; seconds of the bake call)."""
+    import bpy
+
+    scene = bpy.context.scene
+    scene.render.engine = "CYCLES"
+    c = scene.cycles
+    c.device = "CPU"
+    c.samples, c.seed = spp, seed
+    c.use_adaptive_sampling = c.use_denoising = False
+    c.diffuse_bounces = c.max_bounces = 1
+    c.glossy_bounces = c.transmission_bounces = c.volume_bounces = c.transparent_max_bounces = 0
+    c.sample_clamp_indirect = c.sample_clamp_direct = 0.0
+    obj = bpy.data.objects[obj_name]
+    img = bpy.data.images.new(f"cycles_{obj_name}", size, size, alpha=True, float_buffer=True)
+    for slot in obj.material_slots:  # the bake writes into the active Image Texture node
+        tree = slot.material.node_tree
+        node = tree.nodes.get("bake_target") or tree.nodes.new("ShaderNodeTexImage")
+        node.name, node.image = "bake_target", img
+        tree.nodes.active = node
+    for o in scene.objects:
+        o.select_set(False)
+    obj.select_set(True)
+    bpy.context.view_layer.objects.active = obj
+    t0 = time.perf_counter()
+    bpy.ops.object.bake(type="DIFFUSE", pass_filter=pass_filter, margin=0, use_clear=True, target="IMAGE_TEXTURES")
+    seconds = time.perf_counter() - t0
+    px = np.empty(size * size * 4, np.float32)
+    img.pixels.foreach_get(px)
+    return px.reshape(size, size, 4)[::-1].copy(), seconds

@@ -7,9 +7,6 @@ products are. Cycles is set up as for references (one diffuse bounce, no clampin
 adaptive sampling); its noise floor is the error between two seeds.
 """
 
-import time
-
-import numpy as np
 import pytest
 
 pytestmark = [pytest.mark.blender, pytest.mark.slow]
@@ -19,41 +16,12 @@ SPP = 256
 OBJECTS = ("Floor", "BackWall")
 
 
-def cycles_bake(bpy, obj_name: str, pass_filter: set, spp: int, seed: int) -> tuple[np.ndarray, float]:
-    """Cycles' DIFFUSE bake of one object into a SIZE x SIZE float image; (rgba row 0 = top, seconds)."""
-    scene = bpy.context.scene
-    scene.render.engine = "CYCLES"
-    c = scene.cycles
-    c.device = "CPU"
-    c.samples, c.seed = spp, seed
-    c.use_adaptive_sampling = c.use_denoising = False
-    c.diffuse_bounces = c.max_bounces = 1
-    c.glossy_bounces = c.transmission_bounces = c.volume_bounces = c.transparent_max_bounces = 0
-    c.sample_clamp_indirect = c.sample_clamp_direct = 0.0
-    obj = bpy.data.objects[obj_name]
-    img = bpy.data.images.new(f"cycles_{obj_name}", SIZE, SIZE, alpha=True, float_buffer=True)
-    for slot in obj.material_slots:  # the bake writes into the active Image Texture node
-        tree = slot.material.node_tree
-        node = tree.nodes.get("bake_target") or tree.nodes.new("ShaderNodeTexImage")
-        node.name, node.image = "bake_target", img
-        tree.nodes.active = node
-    for o in scene.objects:
-        o.select_set(False)
-    obj.select_set(True)
-    bpy.context.view_layer.objects.active = obj
-    t0 = time.perf_counter()
-    bpy.ops.object.bake(type="DIFFUSE", pass_filter=pass_filter, margin=0, use_clear=True, target="IMAGE_TEXTURES")
-    seconds = time.perf_counter() - t0
-    px = np.empty(SIZE * SIZE * 4, np.float32)
-    img.pixels.foreach_get(px)
-    return px.reshape(SIZE, SIZE, 4)[::-1].copy(), seconds
-
-
 def test_bake_matches_cycles_bake(tmp_path):
     import bpy
 
     from addon.bridge import images, scenes
     from addon.bridge.bake import bake_file
+    from addon.bridge.reference import cycles_bake
     from addon.engine import metrics
     from addon.engine.config import GIConfig, RsmConfig
 
@@ -74,7 +42,7 @@ def test_bake_matches_cycles_bake(tmp_path):
     figures = {}
     for name in OBJECTS:
         for pass_name, flt in (("indirect", {"INDIRECT"}), ("direct", {"DIRECT"})):
-            ref, seconds = cycles_bake(bpy, name, flt, SPP, seed=0)
+            ref, seconds = cycles_bake(name, flt, SPP, seed=0, size=SIZE)
             a = ours[name, pass_name]
             mask = (ref[..., 3] > 0.5) & (a[..., 3] > 0.5)
             assert mask.mean() > 0.99  # the walls' UVs fill the square: every texel is covered by both
