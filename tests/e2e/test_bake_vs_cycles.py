@@ -52,7 +52,7 @@ def test_bake_matches_cycles_bake(tmp_path):
                     f"rel_rmse {err['rel_rmse']:.4f}; ours {ours_ms[name, pass_name]:.0f} ms "
                     f"(+ setup {ours_ms['setup', pass_name]:.0f} ms), Cycles {SPP} spp {seconds * 1e3:.0f} ms")
             if pass_name == "indirect":
-                ref2, _ = cycles_bake(bpy, name, flt, SPP, seed=1)
+                ref2, _ = cycles_bake(name, flt, SPP, seed=1, size=SIZE)
                 floor = metrics.compare(ref2[..., :3], ref[..., :3], mask)
                 line += f"; Cycles noise floor rel_rmse_8 {floor['rel_rmse_8']:.4f} rel_rmse {floor['rel_rmse']:.4f}"
             print(line)
