@@ -2,7 +2,9 @@
 
 Images: a float image datablock `<object>_bounce_<pass>` per object (packed into the .blend); vertex
 colours: a FLOAT_COLOR corner attribute `bounce_<pass>`. Runs on Blender's gpu backend in the UI and on
-moderngl in background mode (the same passes on both). Not cancellable: each object is one short GPU job.
+moderngl in background mode (the same passes on both). In a window the bake is modal: one object per
+timer tick, a progress bar, and Esc cancels (objects already baked are kept, the rest are not started).
+In background mode (scripts, `blender --background`) it runs to the end in `execute`.
 """
 
 from __future__ import annotations
@@ -48,46 +50,77 @@ class BOUNCE_OT_bake(bpy.types.Operator):
         return context.window_manager.invoke_props_dialog(self)
 
     def execute(self, context):
+        if not self._start(context):
+            return {"CANCELLED"}
+        if bpy.app.background or context.window is None:
+            for obj in self._objects:
+                self._bake(obj)
+            return self._finish()
+        wm = context.window_manager
+        wm.progress_begin(0, len(self._objects))
+        self._timer = wm.event_timer_add(0.01, window=context.window)
+        wm.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        if event.type == "ESC":
+            self._stop(context)
+            self.report({"WARNING"}, f"bake cancelled after {self._done} of {len(self._objects)} object(s)")
+            return {"CANCELLED"}
+        if event.type != "TIMER":
+            return {"PASS_THROUGH"}
+        self._bake(self._objects[self._next])
+        self._next += 1
+        context.window_manager.progress_update(self._next)
+        if self._next < len(self._objects):
+            return {"RUNNING_MODAL"}
+        self._stop(context)
+        return self._finish()
+
+    def _start(self, context) -> bool:
+        """Capture and upload the scene once; False (with a report) when it cannot bake."""
         from ..addon.bridge import bake
         from ..addon.properties import to_config
 
-        objects = sorted((o for o in context.selected_objects), key=lambda o: o.name)
+        self._objects = sorted((o for o in context.selected_objects), key=lambda o: o.name)
+        self._next, self._done, self._failed = 0, 0, []
         try:
             gi, rsm = to_config(context.scene.bounce)
             if self.pass_name != "direct" and gi.method == "direct":
                 raise BounceError(f"pass {self.pass_name} needs an indirect method: set Bounce > GI > Method to rsm")
-            baker = bake.Baker(_backend(), context.evaluated_depsgraph_get(), gi, rsm, self.size)
+            self._baker = bake.Baker(_backend(), context.evaluated_depsgraph_get(), gi, rsm, self.size)
         except BounceError as exc:
             self.report({"ERROR"}, str(exc))
-            return {"CANCELLED"}
-        wm = context.window_manager
-        progress = not bpy.app.background  # no progress cursor without a window
-        if progress:
-            wm.progress_begin(0, len(objects))
-        done, failed = 0, []
+            return False
+        return True
+
+    def _bake(self, obj) -> None:
+        """One object into its image or colour attribute; a failure is reported and the others go on."""
+        from ..addon.bridge import bake
+
         try:
-            for i, obj in enumerate(objects):
-                try:
-                    if self.target == "image":
-                        rgba, notes = baker.bake_image(obj, self.size, self.pass_name, self.margin)
-                        bake.store_image(bake.image_name(obj.name, self.pass_name), rgba)
-                    else:
-                        colors, notes = baker.bake_vertex_colors(obj, self.pass_name)
-                        bake.store_vertex_colors(obj.data, bake.attribute_name(self.pass_name), colors)
-                    done += 1
-                    for note in notes:
-                        self.report({"WARNING"}, f"{obj.name}: {note}")
-                except BounceError as exc:
-                    failed.append(obj.name)
-                    self.report({"WARNING"}, f"{obj.name}: {exc}")
-                if progress:
-                    wm.progress_update(i + 1)
-        finally:
-            if progress:
-                wm.progress_end()
-        if done == 0:
-            self.report({"ERROR"}, f"nothing baked ({len(failed)} objects failed)")
+            if self.target == "image":
+                rgba, notes = self._baker.bake_image(obj, self.size, self.pass_name, self.margin)
+                bake.store_image(bake.image_name(obj.name, self.pass_name), rgba)
+            else:
+                colors, notes = self._baker.bake_vertex_colors(obj, self.pass_name)
+                bake.store_vertex_colors(obj.data, bake.attribute_name(self.pass_name), colors)
+            self._done += 1
+            for note in notes:
+                self.report({"WARNING"}, f"{obj.name}: {note}")
+        except BounceError as exc:
+            self._failed.append(obj.name)
+            self.report({"WARNING"}, f"{obj.name}: {exc}")
+
+    def _stop(self, context) -> None:
+        wm = context.window_manager
+        wm.event_timer_remove(self._timer)
+        wm.progress_end()
+
+    def _finish(self):
+        if self._done == 0:
+            self.report({"ERROR"}, f"nothing baked ({len(self._failed)} objects failed)")
             return {"CANCELLED"}
-        msg = f"baked {done} object(s) ({self.pass_name}, {self.target})"
-        self.report({"INFO"}, msg + (f"; failed: {', '.join(failed)}" if failed else ""))
+        msg = f"baked {self._done} object(s) ({self.pass_name}, {self.target})"
+        self.report({"INFO"}, msg + (f"; failed: {', '.join(self._failed)}" if self._failed else ""))
         return {"FINISHED"}

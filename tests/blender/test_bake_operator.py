@@ -52,3 +52,41 @@ def test_bake_cancels_with_a_message(cornell):
     select(cornell, "Floor")
     with pytest.raises(RuntimeError, match="needs an indirect method"):  # an ERROR report raises in bpy.ops
         bpy.ops.bounce.bake(pass_name="indirect")
+
+
+def test_modal_bake_steps_per_timer_and_cancels_on_escape(bounce):
+    # The windowed path cannot run headless (no window, no events), so its control flow is driven by
+    # hand: a stand-in operator with the class's own modal/_finish and a recording _bake/_stop.
+    import types
+
+    from bounce.operators.bake import BOUNCE_OT_bake
+
+    def stand_in(n):
+        op = types.SimpleNamespace(_objects=[f"obj{i}" for i in range(n)], _next=0, _done=0, _failed=[],
+                                   pass_name="indirect", target="image", reports=[], baked=[], stopped=0)
+        op.report = lambda kind, msg: op.reports.append((next(iter(kind)), msg))
+
+        def bake_one(obj):
+            op.baked.append(obj)
+            op._done += 1
+
+        op._bake = bake_one
+        op._stop = lambda _ctx: setattr(op, "stopped", op.stopped + 1)
+        op._finish = lambda: BOUNCE_OT_bake._finish(op)
+        return op
+
+    context = types.SimpleNamespace(window_manager=types.SimpleNamespace(progress_update=lambda _v: None))
+    timer, esc, mouse = (types.SimpleNamespace(type=t) for t in ("TIMER", "ESC", "MOUSEMOVE"))
+
+    op = stand_in(3)
+    assert BOUNCE_OT_bake.modal(op, context, mouse) == {"PASS_THROUGH"}  # the UI stays usable
+    assert BOUNCE_OT_bake.modal(op, context, timer) == {"RUNNING_MODAL"}
+    assert op.baked == ["obj0"]
+    assert BOUNCE_OT_bake.modal(op, context, esc) == {"CANCELLED"}
+    assert op.baked == ["obj0"] and op.stopped == 1  # the rest never started; timer and progress ended
+    assert op.reports[-1] == ("WARNING", "bake cancelled after 1 of 3 object(s)")
+
+    op = stand_in(2)
+    assert BOUNCE_OT_bake.modal(op, context, timer) == {"RUNNING_MODAL"}
+    assert BOUNCE_OT_bake.modal(op, context, timer) == {"FINISHED"}
+    assert op.baked == ["obj0", "obj1"] and op.stopped == 1
