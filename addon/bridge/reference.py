@@ -21,6 +21,7 @@ import numpy as np
 from ..engine.errors import ConfigError, SceneError
 from ..engine.metrics import compare
 from . import images
+from .capture import image_size
 
 PASSES = {"indirect": "Diffuse Indirect", "direct": "Diffuse Direct", "albedo": "Diffuse Color"}
 
@@ -33,13 +34,6 @@ def check_settings(spp: int, bounces: int, res: int) -> None:
         raise ConfigError(f"--bounces must be in 1..8, got {bounces}")
     if not 8 <= res <= 8192:
         raise ConfigError(f"--res must be in 8..8192, got {res}")
-
-
-def image_size(res_x: int, res_y: int, res: int) -> tuple[int, int]:
-    """(width, height) with the long side = res and the scene's aspect res_x:res_y kept."""
-    if res_x >= res_y:
-        return res, max(1, round(res * res_y / res_x))
-    return max(1, round(res * res_x / res_y)), res
 
 
 def _open_blend(blend_path):
@@ -153,7 +147,7 @@ def render_reference(blend_path, out_dir, spp: int = 1024, bounces: int = 1, res
     bpy, scene = _open_blend(blend_path)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    width, height = image_size(scene.render.resolution_x, scene.render.resolution_y, res)
+    width, height = image_size(scene, res)
     with tempfile.TemporaryDirectory(prefix="bounce_ref_") as tmp:
         exr = Path(tmp) / "passes.exr"
         info = _configure(bpy, scene, spp, bounces, width, height, seed, exr)

@@ -7,6 +7,7 @@ Passes: gbuffer -> for each light face: rsm -> direct_light. Geometry is uploade
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -51,6 +52,13 @@ class DirectMethod:
         self.scene: Scene | None = None  # its geometry as uploaded (re-centred, sanitised)
         self._meshes: dict[str, object] = {}
         self._size: tuple[int, int] | None = None
+        # Per-pass timings wait for the GPU around every pass: right for benchmarks, a stall per pass
+        # in an interactive viewport, which turns it off and times the whole update itself.
+        self.profile = True
+
+    def timed(self, timings: dict[str, float], name: str):
+        """Time a block into timings[name] when profiling; otherwise run it untimed (no GPU sync)."""
+        return self.backend.timed(timings, name) if self.profile else contextlib.nullcontext()
 
     def set_scene(self, scene: Scene) -> None:
         """Upload geometry once; call again only when geometry changes. Camera and lights may change
@@ -120,15 +128,15 @@ class DirectMethod:
         be = self.backend
         self._allocate_images()
         timings: dict[str, float] = {}
-        with be.timed(timings, "total"):
+        with self.timed(timings, "total"):
             if run_gbuffer:
-                with be.timed(timings, "gbuffer"):
+                with self.timed(timings, "gbuffer"):
                     gbuffer.run(be, self.gbuf_target, self._meshes[gbuffer.SPEC.name], self.camera())
             self.clear_products()
             for view in self.light_views():
-                with be.timed(timings, "rsm"):
+                with self.timed(timings, "rsm"):
                     rsm.run(be, self.rsm_target, self._meshes[rsm.SPEC.name], view)
-                with be.timed(timings, "direct_light"):
+                with self.timed(timings, "direct_light"):
                     direct_light.run(be, self.gbuf["position"], self.gbuf["normal"], self.rsm["position"],
                                      self.direct, view, self.rsm_config.shadow_bias_texels)
                 self.per_light_view(view, timings)
@@ -146,9 +154,9 @@ class DirectMethod:
     def run(self) -> Result:
         """One full update (G-buffer, every light, read-back), timed: what a benchmark measures."""
         timings: dict[str, float] = {}
-        with self.backend.timed(timings, "total"):
+        with self.timed(timings, "total"):
             timings.update({k: v for k, v in self.compute().items() if k != "total"})
-            with self.backend.timed(timings, "readback"):
+            with self.timed(timings, "readback"):
                 images = self.read()
         return Result(images, timings)
 

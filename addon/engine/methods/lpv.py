@@ -60,7 +60,7 @@ class LpvMethod(OneBounceMethod):
             self.backend.clear(target)
 
     def per_light_view(self, view: LightView, timings: dict[str, float]) -> None:
-        with self.backend.timed(timings, "lpv_inject"):
+        with self.timed(timings, "lpv_inject"):
             lpv_inject.run(self.backend, self._inject_targets, self._points, self.rsm, self.grid)
 
     def propagate(self, iterations: int | None = None) -> None:
@@ -73,12 +73,12 @@ class LpvMethod(OneBounceMethod):
     def compute(self, run_gbuffer: bool = True) -> dict[str, float]:
         be = self.backend
         timings: dict[str, float] = {}
-        with be.timed(timings, "total"):
+        with self.timed(timings, "total"):
             inner = super().compute(run_gbuffer)
             inner.pop("total", None)
             timings.update(inner)
-            with be.timed(timings, "lpv_propagate"):
+            with self.timed(timings, "lpv_propagate"):
                 self.propagate()
-            with be.timed(timings, "lpv_lookup"):
+            with self.timed(timings, "lpv_lookup"):
                 lpv_lookup.run(be, self.gbuf, self.accumulated, self.indirect, self.grid)
         return timings

@@ -33,10 +33,7 @@ class RsmMethod(OneBounceMethod):
             self.grid = Grid.fit(*local.bounds_m(), max_cells=self.rsm_config.voxel_cells)
             self.voxelizer = Voxelizer(self.backend, self.grid)
             self.voxelizer.set_scene(local)
-            timings: dict[str, float] = {}
-            with self.backend.timed(timings, "voxelize"):
-                self.voxels = self.voxelizer.run()
-            self.voxelize_ms = timings["voxelize"]
+            self.voxels = self.voxelizer.run()
         return self.voxels
 
     def voxel_view(self):
@@ -48,7 +45,7 @@ class RsmMethod(OneBounceMethod):
         return self._voxel_view
 
     def per_light_view(self, view: LightView, timings: dict[str, float]) -> None:
-        with self.backend.timed(timings, "rsm_gather"):
+        with self.timed(timings, "rsm_gather"):
             rsm_gather.run(self.backend, self.gbuf, self.rsm, self.indirect, self.rsm_config.vpl_samples,
                            self.gi.seed + view.light_index * 6 + max(view.face_index, 0),
                            occupancy=self.voxels["vox_albedo"] if self.voxels else None,
