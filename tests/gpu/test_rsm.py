@@ -99,7 +99,7 @@ def test_gather_matches_the_exact_integral(gl):
 def test_rsm_method_refuses_several_bounces(gl):
     from addon.engine.errors import ConfigError
 
-    with pytest.raises(ConfigError, match="bounces = 2 must be 1"):
+    with pytest.raises(ConfigError, match="at most 1 bounce"):
         RsmMethod(gl, GIConfig(method="rsm", bounces=2), RsmConfig())
 
 

@@ -171,14 +171,17 @@ class DirectMethod:
 
 
 class OneBounceMethod(DirectMethod):
-    """Base of the one-bounce indirect methods: the `indirect` product (Cycles' Diffuse Indirect units)
-    beside direct light, allocated, cleared and read like `direct`; several bounces are refused."""
+    """Base of the indirect methods: the `indirect` product (Cycles' Diffuse Indirect units) beside
+    direct light, allocated, cleared and read like `direct`. A method computes up to `max_bounces`
+    diffuse bounces (GIConfig.bounces); more are refused."""
 
     products = ("direct", "indirect", "albedo")
+    max_bounces = 1
 
     def __init__(self, backend: Backend, gi: GIConfig, rsm_config: RsmConfig):
-        if gi.bounces != 1:
-            raise ConfigError(f"method {self.name} computes one bounce: GIConfig.bounces = {gi.bounces} must be 1")
+        if gi.bounces > self.max_bounces:
+            raise ConfigError(f"method {self.name} computes at most {self.max_bounces} bounce(s): "
+                              f"GIConfig.bounces = {gi.bounces}")
         super().__init__(backend, gi, rsm_config)
 
     def allocate_products(self, size: tuple[int, int]) -> None:
