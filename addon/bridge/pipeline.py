@@ -14,7 +14,7 @@ import bpy
 
 from ..engine import methods
 from ..engine.backends.moderngl_backend import ModernGLBackend
-from ..engine.config import GIConfig, LpvConfig, RsmConfig
+from ..engine.config import GIConfig, LpvConfig, RsmConfig, VctConfig
 from ..engine.errors import SceneError
 from . import images
 from .capture import SceneCache, define_light_switch, image_size
@@ -38,7 +38,7 @@ def open_blend(path: Path) -> None:
 
 
 def render_file(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, repeat: int = 3,
-                lpv: LpvConfig | None = None) -> dict:
+                lpv: LpvConfig | None = None, vct: VctConfig | None = None) -> dict:
     """Render `blend` with gi.method; write <product>.exr for each product and stats.json; return stats.
 
     The timing is the median of `repeat` full updates after one warm-up (programs compiled, geometry
@@ -52,7 +52,7 @@ def render_file(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, repeat
     width, height = image_size(scene, gi.resolution)
     captured = SceneCache().update(bpy.context.evaluated_depsgraph_get(), width, height)
     be = backend()
-    method = methods.create(be, gi, rsm, lpv)
+    method = methods.create(be, gi, rsm, lpv, vct)
     method.set_scene(captured)
     method.run()  # warm-up
     runs = [method.run() for _ in range(repeat)]
@@ -67,7 +67,8 @@ def render_file(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, repeat
     stats = {
         "method": gi.method,
         "config": {"gi": gi.to_dict(), "rsm": rsm.to_dict(),
-                   **({"lpv": method.lpv_config.to_dict()} if gi.method == "lpv" else {})},
+                   **({"lpv": method.lpv_config.to_dict()} if gi.method == "lpv" else {}),
+                   **({"vct": method.vct_config.to_dict()} if gi.method == "vct" else {})},
         "image_size": [width, height],
         "triangles": captured.triangle_count,
         "lights": len(captured.lights),

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from ..engine.config import GIConfig, LpvConfig, RsmConfig
+from ..engine.config import GIConfig, LpvConfig, RsmConfig, VctConfig
 from ._args import existing_blend, output_dir
 
 NAME = "render"
@@ -20,11 +20,15 @@ def add_arguments(p) -> None:
     p.add_argument("--rsm-res", type=int, default=256, help="RSM side in texels")
     p.add_argument("--vpl-samples", type=int, default=256, help="VPLs gathered per pixel (rsm)")
     p.add_argument("--visibility", default="none", help="VPL visibility for rsm: none or voxel")
-    p.add_argument("--voxel-cells", type=int, default=64, help="voxel cells along the longest side")
+    p.add_argument("--voxel-cells", type=int, default=64, help="voxel cells along the longest side (rsm, vct)")
     p.add_argument("--grid", type=int, default=32, help="LPV cells along the longest side (lpv)")
     p.add_argument("--iterations", type=int, default=16, help="LPV propagation steps (lpv, classic)")
     p.add_argument("--variant", default="classic", help="LPV transport: classic or improved (lpv)")
     p.add_argument("--geometry-volume", action="store_true", help="LPV: occlude by the voxelized surfaces")
+    p.add_argument("--cones", type=int, default=16, help="diffuse cones per gather point (vct)")
+    p.add_argument("--step-ratio", type=float, default=0.5, help="cone march step / sampled voxel size (vct)")
+    p.add_argument("--cone-offset", type=float, default=1.5, help="cone origins off the surface, in cells (vct)")
+    p.add_argument("--radiance", default="anisotropic", help="voxel radiance: anisotropic or isotropic (vct)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--repeat", type=int, default=3, help="timed runs after a warm-up (median reported)")
 
@@ -35,10 +39,12 @@ def run(args) -> int:
                     voxel_cells=args.voxel_cells)
     lpv = LpvConfig(grid_cells=args.grid, iterations=args.iterations, variant=args.variant,
                     geometry_volume=args.geometry_volume)
+    vct = VctConfig(voxel_cells=args.voxel_cells, diffuse_cones=args.cones, step_ratio=args.step_ratio,
+                    offset_cells=args.cone_offset, radiance=args.radiance)
     blend = existing_blend(args.blend)
     out = output_dir(args.out)
     from ..bridge.pipeline import render_file  # imports bpy: only when actually rendering
 
-    stats = render_file(blend, out, gi, rsm, repeat=max(1, args.repeat), lpv=lpv)
+    stats = render_file(blend, out, gi, rsm, repeat=max(1, args.repeat), lpv=lpv, vct=vct)
     print(json.dumps({"out": str(out), "total_ms": round(stats["total_ms"], 2), "notes": stats["notes"]}))
     return 0

@@ -13,7 +13,7 @@ from typing import Any
 
 from .errors import ConfigError
 
-METHODS = ("direct", "rsm", "lpv")
+METHODS = ("direct", "rsm", "lpv", "vct")
 
 
 def _num(default, lo, hi, doc):
@@ -84,6 +84,18 @@ class LpvConfig(_Validated):
         super().__post_init__()
         if not isinstance(self.geometry_volume, bool):
             raise ConfigError(f"LpvConfig.geometry_volume = {self.geometry_volume!r}: must be True or False")
+
+
+@dataclass(frozen=True)
+class VctConfig(_Validated):
+    """Voxel cone tracing (method `vct`): docs/VCT.md derives the units and measures the settings."""
+
+    voxel_cells: int = _num(64, 8, 256, "voxel grid cells along the scene's longest side")
+    diffuse_cones: int = _num(16, 3, 32, "cones per gather point, each 2 pi / n sr of the hemisphere")
+    step_ratio: float = _num(0.5, 0.1, 1.0, "march step as a fraction of the sampled voxel's size")
+    offset_cells: float = _num(1.5, 0.0, 4.0, "cone origins moved off their surface along the normal, in cells")
+    radiance: str = _choice("anisotropic", ("anisotropic", "isotropic"),
+                            "voxel radiance: six directions, or their mean (directional opacity kept)")
 
 
 @dataclass(frozen=True)

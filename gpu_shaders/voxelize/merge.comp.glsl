@@ -1,6 +1,7 @@
 // Merges the three axis volumes (each stored with its slab axis as layers) into the canonical grid and
 // divides out the weights: albedo (rgb, a = occupancy 0/1), normal (xyz unit or 0, w = surface area
-// in cell units^2), emission (rgb radiance, a = occupancy).
+// in cell units^2), emission (rgb radiance, a = occupancy); projected (xyz = sum of area x |n| per axis,
+// w = area, both in cell units^2: sums, not divided).
 
 ivec3 permuted(ivec3 c, int axis) {
     return axis == 0 ? c.yzx : (axis == 1 ? c.zxy : c);
@@ -17,15 +18,19 @@ void main() {
            + texelFetch(normal_z, permuted(c, 2), 0);
     vec4 e = texelFetch(emission_x, permuted(c, 0), 0) + texelFetch(emission_y, permuted(c, 1), 0)
            + texelFetch(emission_z, permuted(c, 2), 0);
+    vec4 p = texelFetch(projected_x, permuted(c, 0), 0) + texelFetch(projected_y, permuted(c, 1), 0)
+           + texelFetch(projected_z, permuted(c, 2), 0);
     float weight = a.w;
     if (weight <= 0.0) {
         imageStore(vox_albedo, c, vec4(0.0));
         imageStore(vox_normal, c, vec4(0.0));
         imageStore(vox_emission, c, vec4(0.0));
+        imageStore(vox_projected, c, vec4(0.0));
         return;
     }
     float len_n = length(n.xyz);
     imageStore(vox_albedo, c, vec4(a.rgb / weight, 1.0));
     imageStore(vox_normal, c, vec4(len_n > 1e-6 * weight ? n.xyz / len_n : vec3(0.0), weight));
     imageStore(vox_emission, c, vec4(e.rgb / weight, 1.0));
+    imageStore(vox_projected, c, p);
 }

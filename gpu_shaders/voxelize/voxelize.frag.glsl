@@ -22,4 +22,5 @@ void main() {
     out_albedo = vec4(v_albedo * weight, weight);
     out_normal = vec4(v_normal * weight, weight);
     out_emission = vec4(v_emission * weight, weight);
+    out_projected = vec4(abs(v_normal) * weight, weight);
 }

@@ -1,5 +1,5 @@
 """One module per GI method: which passes run, in which order. `get(name)` returns its class,
-`create(backend, gi, rsm, lpv)` an instance with its configs."""
+`create(backend, gi, rsm, lpv, vct)` an instance with its configs."""
 
 from __future__ import annotations
 
@@ -7,16 +7,17 @@ from ..errors import ConfigError
 
 
 def get(name: str):
-    from . import direct, lpv, rsm
+    from . import direct, lpv, rsm, vct
 
-    methods = {"direct": direct.DirectMethod, "rsm": rsm.RsmMethod, "lpv": lpv.LpvMethod}
+    methods = {"direct": direct.DirectMethod, "rsm": rsm.RsmMethod, "lpv": lpv.LpvMethod, "vct": vct.VctMethod}
     if name not in methods:
         raise ConfigError(f"unknown method {name!r}: known methods are {', '.join(sorted(methods))}")
     return methods[name]
 
 
-def create(backend, gi, rsm, lpv=None):
-    """The method `gi.method` with its configs: every method takes (gi, rsm); lpv also its LpvConfig
-    (defaults when None)."""
+def create(backend, gi, rsm, lpv=None, vct=None):
+    """The method `gi.method` with its configs: every method takes (gi, rsm); lpv also its LpvConfig,
+    vct its VctConfig (defaults when None)."""
     cls = get(gi.method)
-    return cls(backend, gi, rsm, lpv) if gi.method == "lpv" else cls(backend, gi, rsm)
+    own = {"lpv": lpv, "vct": vct}
+    return cls(backend, gi, rsm, own[gi.method]) if gi.method in own else cls(backend, gi, rsm)

@@ -31,11 +31,12 @@ SPEC = ShaderSpec(
 )
 
 
-def texel_points(backend: Backend, resolution: int):
-    """The point mesh: one vertex per RSM texel (its integer coordinates), made once per RSM size."""
+def texel_points(backend: Backend, resolution: int, spec: ShaderSpec = SPEC):
+    """The point mesh: one vertex per RSM texel (its integer coordinates, attribute `texel`), made once
+    per RSM size for the splatting program `spec` (LPV's or VCT's injection)."""
     j, i = np.mgrid[0:resolution, 0:resolution]
     texels = np.stack([i.ravel(), j.ravel()], axis=1).astype(np.float32)
-    return backend.mesh(backend.program(SPEC), {"texel": texels}, "points")
+    return backend.mesh(backend.program(spec), {"texel": texels}, "points")
 
 
 def layer_targets(backend: Backend, volumes: dict, grid: Grid) -> list:

@@ -2,7 +2,10 @@
 
 Inputs: scene triangles; a Grid. Outputs (RGBA32F 3D textures of grid.dims, canonical x, y, z layout):
 `vox_albedo` (diffuse albedo, a = occupancy 0/1), `vox_normal` (area-weighted mean normal, w = surface
-area in the cell in cell units^2), `vox_emission` (emitted radiance W/m^2/sr, a = occupancy).
+area in the cell in cell units^2), `vox_emission` (emitted radiance W/m^2/sr, a = occupancy),
+`vox_projected` (xyz = the surface's projected area along each axis, sum of area x |n_axis|, in cell
+units^2; unlike the mean normal it does not cancel where both sides of a thin wall share a cell: VCT's
+directional opacity; w = surface area).
 
 Portable scatter (ARCHITECTURE.md section 3): each triangle is drawn along its dominant axis into the
 layers of that axis's volumes with additive blending (conservative coverage, see voxelize.vert.glsl),
@@ -30,15 +33,18 @@ RASTER = ShaderSpec(
                 Var("albedo", "vec3"), Var("emission", "vec3")),
     varyings=(Var("v_uvw", "vec3"), Var("v_plane", "vec4"), Var("v_bbox", "vec4"), Var("v_wrange", "vec3"),
               Var("v_albedo", "vec3"), Var("v_emission", "vec3"), Var("v_normal", "vec3")),
-    outputs=(Var("out_albedo", "vec4"), Var("out_normal", "vec4"), Var("out_emission", "vec4")),
+    outputs=(Var("out_albedo", "vec4"), Var("out_normal", "vec4"), Var("out_emission", "vec4"),
+             Var("out_projected", "vec4")),
 )
+
+_QUANTITIES = ("albedo", "normal", "emission", "projected")
 
 MERGE = ShaderSpec(
     name="voxelize_merge",
     compute="voxelize/merge.comp.glsl",
     local_size=(4, 4, 4),
-    samplers=tuple(Sampler(f"{q}_{a}", "3D") for q in ("albedo", "normal", "emission") for a in "xyz"),
-    images=(Image("vox_albedo", "3D"), Image("vox_normal", "3D"), Image("vox_emission", "3D")),
+    samplers=tuple(Sampler(f"{q}_{a}", "3D") for q in _QUANTITIES for a in "xyz"),
+    images=tuple(Image(f"vox_{q}", "3D") for q in _QUANTITIES),
     uniforms=(Var("dims", "ivec3"),),
 )
 
@@ -63,15 +69,14 @@ class Voxelizer:
     def __init__(self, backend: Backend, grid: Grid):
         self.backend, self.grid = backend, grid
         be = backend
-        self.volumes = {name: be.texture(grid.dims) for name in ("vox_albedo", "vox_normal", "vox_emission")}
+        self.volumes = {f"vox_{q}": be.texture(grid.dims) for q in _QUANTITIES}
         self._axis_volumes = []
         self._layer_targets = []
         for axis in range(3):
             size = tuple(grid.dims[i] for i in _PERMUTATION[axis])
-            vols = {q: be.texture(size) for q in ("albedo", "normal", "emission")}
+            vols = {q: be.texture(size) for q in _QUANTITIES}
             self._axis_volumes.append(vols)
-            self._layer_targets.append(
-                [be.target([(vols["albedo"], k), (vols["normal"], k), (vols["emission"], k)]) for k in range(size[2])])
+            self._layer_targets.append([be.target([(vols[q], k) for q in _QUANTITIES]) for k in range(size[2])])
         self._meshes: list = [None, None, None]
 
     def set_scene(self, scene: Scene) -> None:
@@ -107,8 +112,7 @@ class Voxelizer:
                 if self._meshes[axis] is not None:
                     be.draw(prog, target, self._meshes[axis], uniforms={**uniforms, "axis": axis, "layer": k},
                             blend="add")
-        samplers = {f"{q}_{'xyz'[a]}": self._axis_volumes[a][q] for q in ("albedo", "normal", "emission")
-                    for a in range(3)}
+        samplers = {f"{q}_{'xyz'[a]}": self._axis_volumes[a][q] for q in _QUANTITIES for a in range(3)}
         be.dispatch(be.program(MERGE), group_count(grid.dims, MERGE.local_size), uniforms={"dims": grid.dims},
                     samplers=samplers, images=self.volumes)
         return self.volumes

@@ -1,0 +1,99 @@
+"""Method `vct`: voxel cone tracing (Crassin et al. 2011; seeds 003), dense pyramid, N diffuse bounces.
+
+Passes: those of `direct` (G-buffer, per light face: rsm, direct_light), then per RSM face while it is
+bound: vct_inject (flux into the atlas); once per update: vct_pyramid.level0 + downsample, and for
+each bounce after the first: vct_gather.bounce (voxels gather and re-emit) -> accumulate -> a pyramid
+of that bounce alone for the next; finally the pyramid of every bounce's light and vct_gather.pixels
+-> `indirect` (Cycles' Diffuse Indirect units) and `ao`. The scene is voxelized once per geometry
+change (set_scene). docs/VCT.md derives the units and measures the settings against Cycles.
+
+Products: direct, indirect, ao, albedo.
+"""
+
+from __future__ import annotations
+
+from ..config import VctConfig
+from ..grid import Grid
+from ..passes import lpv_inject, vct_gather, vct_inject, vct_pyramid
+from ..passes.light_views import LightView
+from ..passes.vct_inject import DIRECTIONS, Atlas
+from ..passes.voxelize import Voxelizer
+from .direct import OneBounceMethod
+
+
+class VctMethod(OneBounceMethod):
+    name = "vct"
+    products = ("direct", "indirect", "ao", "albedo")
+    max_bounces = 8
+
+    def __init__(self, backend, gi, rsm_config, vct_config: VctConfig | None = None):
+        super().__init__(backend, gi, rsm_config)
+        self.vct_config = vct_config if vct_config is not None else VctConfig()
+        self.grid: Grid | None = None
+
+    def set_scene(self, scene) -> None:
+        super().set_scene(scene)
+        be, cfg = self.backend, self.vct_config
+        self.grid = Grid.fit(*self.scene.bounds_m(), max_cells=cfg.voxel_cells)
+        self.voxelizer = Voxelizer(be, self.grid)
+        self.voxelizer.set_scene(self.scene)
+        self.voxels = self.voxelizer.run()
+        self.atlas = Atlas.for_grid(self.grid)
+        self.flux = vct_pyramid.direction_textures(be, self.atlas.size)
+        self._flux_target = be.target([self.flux[d] for d in DIRECTIONS])
+        self._points = lpv_inject.texel_points(be, self.rsm_config.resolution, vct_inject.SPEC)
+        self.pyramid = vct_pyramid.pyramid_textures(be, self.grid)
+        if self.gi.bounces > 1:
+            self.next_bounce = vct_pyramid.direction_textures(be, self.grid.dims)
+            self.later_bounces = vct_pyramid.direction_textures(be, self.grid.dims)
+
+    def allocate_products(self, size: tuple[int, int]) -> None:
+        super().allocate_products(size)
+        self.ao = self.backend.texture(size)
+
+    def product_textures(self) -> dict:
+        return {**super().product_textures(), "ao": self.ao}
+
+    def clear_products(self) -> None:
+        super().clear_products()
+        self.backend.clear(self._flux_target)
+
+    def per_light_view(self, view: LightView, timings: dict[str, float]) -> None:
+        with self.timed(timings, "vct_inject"):
+            vct_inject.run(self.backend, self._flux_target, self._points, self.rsm, self.grid, self.atlas)
+
+    def _build(self, atlas_weight: float, add: dict | None) -> None:
+        be, iso = self.backend, self.vct_config.radiance == "isotropic"
+        vct_pyramid.level0(be, self.flux, self.voxels["vox_projected"], self.pyramid, self.grid, self.atlas,
+                           atlas_weight, add, iso)
+        vct_pyramid.downsample(be, self.pyramid, self.grid)
+
+    def bounce_light(self, timings: dict[str, float]) -> None:
+        """The pyramid of every bounce's light: the first from the injected flux; each later one gathered
+        at the voxels from a pyramid of the bounce before it alone (so none is counted twice)."""
+        be, cfg = self.backend, self.vct_config
+        with self.timed(timings, "vct_pyramid"):
+            self._build(1.0, None)
+        if self.gi.bounces == 1:
+            return
+        for bounce in range(2, self.gi.bounces + 1):
+            with self.timed(timings, "vct_bounce"):
+                vct_gather.bounce(be, self.pyramid, self.voxels, self.next_bounce, self.grid, cfg)
+                vct_pyramid.accumulate(be, self.later_bounces, self.next_bounce, self.grid, first=bounce == 2)
+            with self.timed(timings, "vct_pyramid"):
+                if bounce < self.gi.bounces:
+                    self._build(0.0, self.next_bounce)
+                else:
+                    self._build(1.0, self.later_bounces)
+
+    def compute(self, run_gbuffer: bool = True) -> dict[str, float]:
+        timings: dict[str, float] = {}
+        with self.timed(timings, "total"):
+            inner = super().compute(run_gbuffer)
+            inner.pop("total", None)
+            timings.update(inner)
+            self.bounce_light(timings)
+            with self.timed(timings, "vct_gather"):
+                vct_gather.pixels(self.backend, self.pyramid, self.gbuf, self.indirect, self.ao, self.grid,
+                                  self.vct_config)
+        return timings

@@ -1,0 +1,63 @@
+"""VCT cone gathers through the radiance pyramid (gpu_shaders/vct/cone.glsl).
+
+- pixels: at every G-buffer pixel, `diffuse_cones` cones about the normal -> `indirect` = E / pi
+  (Cycles' Diffuse Indirect units) and `ao` (1 - cosine-weighted cone opacity).
+- bounce: at every occupied voxel, the same gather on both sides of its surface -> the next bounce's
+  level-0 colours (premultiplied radiance by travel direction), albedo x E / pi x projected area.
+
+Inputs: the pyramid (dict by direction), the Grid, VctConfig; G-buffer or the voxelizer's volumes.
+"""
+
+from __future__ import annotations
+
+from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
+from ..config import VctConfig
+from ..grid import Grid
+from .vct_inject import DIRECTIONS
+from .vct_pyramid import level_count, named, texture_size
+
+_PYRAMID = tuple(Sampler(f"pyr_{d}", "3D") for d in DIRECTIONS)
+_CONE_UNIFORMS = (Var("grid_origin", "vec3"), Var("cell_size", "float"), Var("dims", "ivec3"), Var("levels", "int"),
+                  Var("tex_width", "int"), Var("diffuse_cones", "int"), Var("step_ratio", "float"),
+                  Var("offset_cells", "float"))
+
+PIXELS = ShaderSpec(
+    name="vct_gather",
+    compute="vct/gather.comp.glsl",
+    local_size=(8, 8, 1),
+    samplers=(*_PYRAMID, Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D")),
+    images=(Image("indirect", "2D"), Image("ao", "2D")),
+    uniforms=_CONE_UNIFORMS,
+)
+
+BOUNCE = ShaderSpec(
+    name="vct_bounce",
+    compute="vct/bounce.comp.glsl",
+    local_size=(4, 4, 4),
+    samplers=(*_PYRAMID, Sampler("vox_albedo", "3D"), Sampler("vox_normal", "3D"), Sampler("vox_projected", "3D")),
+    images=tuple(Image(f"next_{d}", "3D") for d in DIRECTIONS),
+    uniforms=_CONE_UNIFORMS,
+)
+
+
+def cone_uniforms(grid: Grid, config: VctConfig) -> dict:
+    return {"grid_origin": grid.origin_m, "cell_size": grid.cell_size_m, "dims": grid.dims,
+            "levels": level_count(grid.dims), "tex_width": texture_size(grid.dims)[0],
+            "diffuse_cones": config.diffuse_cones, "step_ratio": config.step_ratio,
+            "offset_cells": config.offset_cells}
+
+
+def pixels(backend: Backend, pyramid: dict, gbuf: dict, indirect, ao, grid: Grid, config: VctConfig) -> None:
+    backend.dispatch(backend.program(PIXELS), group_count(indirect.size, PIXELS.local_size),
+                     uniforms=cone_uniforms(grid, config),
+                     samplers={**named(pyramid, "pyr"), "gbuf_position": gbuf["position"],
+                               "gbuf_normal": gbuf["normal"]},
+                     images={"indirect": indirect, "ao": ao})
+
+
+def bounce(backend: Backend, pyramid: dict, voxels: dict, next_bounce: dict, grid: Grid, config: VctConfig) -> None:
+    backend.dispatch(backend.program(BOUNCE), group_count(grid.dims, BOUNCE.local_size),
+                     uniforms=cone_uniforms(grid, config),
+                     samplers={**named(pyramid, "pyr"), "vox_albedo": voxels["vox_albedo"],
+                               "vox_normal": voxels["vox_normal"], "vox_projected": voxels["vox_projected"]},
+                     images=named(next_bounce, "next"))

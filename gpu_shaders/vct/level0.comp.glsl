@@ -1,0 +1,50 @@
+// Level 0 of the radiance pyramid from the flux atlas (and, with ADD, plus premultiplied radiance
+// from later bounces): per cell and travel direction t,
+//   colour  c_t = atlas_weight * flux_t / (pi h^2) + add_t
+//   opacity a_t = min(1, projected area of the cell's surface along t's axis / h^2).
+// A Lambertian surfel of flux phi has radiance phi / (pi A); seen along t it covers A |n.t| of the
+// cell's h^2 cross-section, so its premultiplied radiance is phi |n.t| / (pi h^2): what the atlas
+// summed (phi max(0, n.t)) over pi h^2. ISOTROPIC replaces the six colours by their mean (opacity
+// stays directional).
+#include "vct/pyramid.glsl"
+
+ivec2 atlas_texel(ivec3 c) {
+    return ivec2(c.z % tiles_x, c.z / tiles_x) * dims.xy + c.xy;
+}
+
+void main() {
+    ivec3 c = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(c, dims))) {
+        return;
+    }
+    ivec2 at = atlas_texel(c);
+    float to_radiance = atlas_weight / (3.14159265 * cell_size * cell_size);
+    vec3 col[6];
+    col[0] = texelFetch(flux_px, at, 0).rgb * to_radiance;
+    col[1] = texelFetch(flux_nx, at, 0).rgb * to_radiance;
+    col[2] = texelFetch(flux_py, at, 0).rgb * to_radiance;
+    col[3] = texelFetch(flux_ny, at, 0).rgb * to_radiance;
+    col[4] = texelFetch(flux_pz, at, 0).rgb * to_radiance;
+    col[5] = texelFetch(flux_nz, at, 0).rgb * to_radiance;
+#ifdef ADD
+    col[0] += texelFetch(add_px, c, 0).rgb;
+    col[1] += texelFetch(add_nx, c, 0).rgb;
+    col[2] += texelFetch(add_py, c, 0).rgb;
+    col[3] += texelFetch(add_ny, c, 0).rgb;
+    col[4] += texelFetch(add_pz, c, 0).rgb;
+    col[5] += texelFetch(add_nz, c, 0).rgb;
+#endif
+#ifdef ISOTROPIC
+    vec3 mean = (col[0] + col[1] + col[2] + col[3] + col[4] + col[5]) / 6.0;
+    for (int i = 0; i < 6; i++) {
+        col[i] = mean;
+    }
+#endif
+    vec3 opacity = min(texelFetch(vox_projected, c, 0).xyz, vec3(1.0));
+    imageStore(pyr_px, c, vec4(col[0], opacity.x));
+    imageStore(pyr_nx, c, vec4(col[1], opacity.x));
+    imageStore(pyr_py, c, vec4(col[2], opacity.y));
+    imageStore(pyr_ny, c, vec4(col[3], opacity.y));
+    imageStore(pyr_pz, c, vec4(col[4], opacity.z));
+    imageStore(pyr_nz, c, vec4(col[5], opacity.z));
+}

@@ -1,0 +1,172 @@
+"""VCT passes (inject, pyramid, cone gathers) and the `vct` method against exact answers.
+
+Units (docs/VCT.md): the pyramid holds, per axis direction t of travel, premultiplied radiance
+(W/m^2/sr over a cell's cross-section) and opacity; the pixel gather returns E / pi (Cycles' Diffuse
+Indirect). Synthetic volumes are built in numpy and go through the real level-0 and downsample passes.
+Volumes read back as (z, y, x, 4) arrays.
+"""
+
+import numpy as np
+import pytest
+
+from addon.engine.config import VctConfig
+from addon.engine.grid import Grid
+from addon.engine.passes import lpv_inject, vct_gather, vct_inject, vct_pyramid
+from addon.engine.passes.vct_inject import DIRECTIONS, Atlas
+
+pytestmark = pytest.mark.gpu
+
+H_M = 0.1  # cell size of the synthetic grids
+
+
+def to_atlas(volume: np.ndarray, atlas: Atlas) -> np.ndarray:
+    """(z, y, x, 4) -> the 2D atlas (rows, cols, 4): layer z at tile (z % tiles_x, z // tiles_x)."""
+    nz, ny, nx, _ = volume.shape
+    out = np.zeros((atlas.size[1], atlas.size[0], 4), np.float32)
+    for z in range(nz):
+        tx, ty = z % atlas.tiles_x, z // atlas.tiles_x
+        out[ty * ny:(ty + 1) * ny, tx * nx:(tx + 1) * nx] = volume[z]
+    return out
+
+
+class Volumes:
+    """Level-0 inputs in numpy: per direction the injected flux (W), per cell the projected areas."""
+
+    def __init__(self, dims):
+        self.grid = Grid(np.zeros(3), H_M, tuple(dims))
+        shape = tuple(reversed(dims)) + (4,)
+        self.flux = {d: np.zeros(shape, np.float32) for d in DIRECTIONS}
+        self.projected = np.zeros(shape, np.float32)
+
+    def wall(self, axis: int, layer: int, facing: int, radiance: float, span=None):
+        """A one-cell-thick wall across `axis` at `layer`, Lambertian radiance `radiance` on the side
+        `facing` (+1/-1): flux pi L h^2 per cell (area h^2), leaving along +-axis."""
+        idx = [span or slice(None)] * 3
+        idx[2 - axis] = layer
+        idx = tuple(idx)
+        self.projected[idx + (axis,)] += 1.0
+        d = ("px", "py", "pz")[axis] if facing > 0 else ("nx", "ny", "nz")[axis]
+        self.flux[d][idx + (slice(0, 3),)] += radiance * np.pi * H_M**2
+
+    def pyramid(self, gl, isotropic=False):
+        atlas = Atlas.for_grid(self.grid)
+        flux = {d: gl.texture(atlas.size, data=to_atlas(self.flux[d], atlas)) for d in DIRECTIONS}
+        projected = gl.texture(self.grid.dims, data=self.projected)
+        pyr = vct_pyramid.pyramid_textures(gl, self.grid)
+        vct_pyramid.level0(gl, flux, projected, pyr, self.grid, atlas, isotropic=isotropic)
+        vct_pyramid.downsample(gl, pyr, self.grid)
+        return pyr
+
+
+def gather(gl, pyr, grid, points_cells, normals, config=None):
+    """E / pi and ao at points given in cell units (VctConfig's defaults unless `config`)."""
+    config = config or VctConfig()
+    n = len(points_cells)
+    pos = np.zeros((1, n, 4), np.float32)
+    pos[0, :, :3] = grid.origin_m + np.asarray(points_cells) * grid.cell_size_m
+    pos[0, :, 3] = 1.0
+    nrm = np.zeros((1, n, 4), np.float32)
+    nrm[0, :, :3] = normals
+    gbuf = {"position": gl.texture((n, 1), data=pos), "normal": gl.texture((n, 1), data=nrm)}
+    indirect, ao = gl.texture((n, 1)), gl.texture((n, 1))
+    vct_gather.pixels(gl, pyr, gbuf, indirect, ao, grid, config)
+    return gl.read(indirect)[0, :, :3], gl.read(ao)[0, :, 0]
+
+
+def closed_box(n=32, lo=2, radiance=1.0):
+    vols = Volumes((n, n, n))
+    hi = n - 1 - lo
+    span = slice(lo, hi + 1)
+    for axis in range(3):
+        vols.wall(axis, lo, +1, radiance, span)
+        vols.wall(axis, hi, -1, radiance, span)
+    return vols, lo, hi
+
+
+# -- layout --------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("dims", [(1, 1, 1), (5, 3, 2), (32, 32, 32), (40, 8, 20), (65, 3, 3)])
+def test_levels_fit_side_by_side(dims):
+    """Level l lies in [offset_l, offset_l + dims_l.x) and ends before level l + 1 begins."""
+    width = vct_pyramid.texture_size(dims)[0]
+    levels = vct_pyramid.level_count(dims)
+    assert max(vct_pyramid.level_dims(dims, levels - 1)) == 1
+    for lv in range(levels):
+        end = vct_pyramid.level_offset(dims, lv) + vct_pyramid.level_dims(dims, lv)[0]
+        assert end <= (vct_pyramid.level_offset(dims, lv + 1) if lv + 1 < levels else width)
+
+
+# -- passes --------------------------------------------------------------------------------------------
+def test_injection_splits_flux_by_direction(gl):
+    """Two VPLs in one cell: each adds phi * max(0, n.t) to direction t, exactly (a sum of 2 floats)."""
+    grid = Grid(np.zeros(3), 1.0, (4, 3, 5))
+    atlas = Atlas.for_grid(grid)
+    res = 2
+    rsm = {k: gl.texture((res, res)) for k in ("position", "normal", "flux")}
+    pos = np.zeros((res, res, 4), np.float32)
+    nrm = np.zeros((res, res, 4), np.float32)
+    flux = np.zeros((res, res, 4), np.float32)
+    n1 = np.array([0.6, 0.0, -0.8])
+    pos[0, 0] = [2.5, 1.5, 3.5, 1]
+    nrm[0, 0, :3] = n1
+    flux[0, 0, :3] = [1.0, 2.0, 4.0]
+    pos[0, 1] = [2.2, 1.1, 3.9, 1]
+    nrm[0, 1, :3] = [0, 1, 0]
+    flux[0, 1, :3] = [0.5, 0.5, 0.5]
+    for k, a in (("position", pos), ("normal", nrm), ("flux", flux)):
+        gl.write(rsm[k], a)
+    textures = vct_pyramid.direction_textures(gl, atlas.size)
+    target = gl.target([textures[d] for d in DIRECTIONS])
+    points = lpv_inject.texel_points(gl, res, vct_inject.SPEC)
+    vct_inject.run(gl, target, points, rsm, grid, atlas)
+    z = 3
+    row, col = (z // atlas.tiles_x) * 3 + 1, (z % atlas.tiles_x) * 4 + 2
+    expected = {"px": 0.6 * flux[0, 0, :3], "nx": 0, "py": flux[0, 1, :3], "ny": 0, "pz": 0,
+                "nz": 0.8 * flux[0, 0, :3]}
+    for d in DIRECTIONS:
+        got = gl.read(textures[d])
+        np.testing.assert_allclose(got[row, col, :3], np.broadcast_to(expected[d], 3), rtol=1e-6, atol=1e-7,
+                                   err_msg=d)
+        assert np.count_nonzero(got[..., :3]) == np.count_nonzero(got[row, col, :3])  # nothing elsewhere
+
+
+def test_level0_and_downsample_match_numpy(gl):
+    """Level 0 = flux / (pi h^2) with opacity min(1, projected area); level 1 = pairs composited along
+    t (near child first), four pairs averaged. Exact in fp32 up to rounding (rtol 1e-5)."""
+    rng = np.random.default_rng(7)
+    vols = Volumes((6, 4, 5))
+    for d in DIRECTIONS:
+        vols.flux[d][..., :3] = rng.random(vols.flux[d][..., :3].shape)
+    vols.projected[..., :3] = rng.random(vols.projected[..., :3].shape) * 1.5
+    pyr = vols.pyramid(gl)
+    dims = vols.grid.dims
+    level0 = {}
+    for i, d in enumerate(DIRECTIONS):
+        c = vols.flux[d][..., :3] / (np.pi * H_M**2)
+        a = np.minimum(vols.projected[..., i // 2], 1.0)[..., None]
+        level0[d] = np.concatenate([c, a], axis=-1)
+        got = gl.read(pyr[d])[:, :, :dims[0]]
+        np.testing.assert_allclose(got, level0[d], rtol=1e-5, atol=1e-6, err_msg=d)
+    # Level 1 by numpy, cell by cell; children outside level 0 are empty.
+    d1 = vct_pyramid.level_dims(dims, 1)
+    off = vct_pyramid.level_offset(dims, 1)
+
+    def child(vol, x, y, z):
+        inside = x < dims[0] and y < dims[1] and z < dims[2]
+        return vol[z, y, x] if inside else np.zeros(4)
+
+    for i, d in enumerate(DIRECTIONS):
+        axis, positive = i // 2, d.startswith("p")
+        want = np.zeros((d1[2], d1[1], d1[0], 4))
+        for z, y, x in np.ndindex(d1[2], d1[1], d1[0]):
+            for u, v in np.ndindex(2, 2):
+                lo = [u, v]
+                lo.insert(axis, 0)
+                hi = list(lo)
+                hi[axis] = 1
+                a = child(level0[d], 2 * x + lo[0], 2 * y + lo[1], 2 * z + lo[2])
+                b = child(level0[d], 2 * x + hi[0], 2 * y + hi[1], 2 * z + hi[2])
+                near, far = (b, a) if positive else (a, b)
+                want[z, y, x, :3] += 0.25 * (near[:3] + (1 - near[3]) * far[:3])
+                want[z, y, x, 3] += 0.25 * (near[3] + (1 - near[3]) * far[3])
+        got = gl.read(pyr[d])[:d1[2], :d1[1], off:off + d1[0]]
+        np.testing.assert_allclose(got, want, rtol=1e-5, atol=1e-6, err_msg=d)
