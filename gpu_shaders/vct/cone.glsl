@@ -50,9 +50,12 @@ vec4 sample_directional(vec3 g, float lod, vec3 d) {
 // Front-to-back compositing along one cone from g0 (cell units) in direction d with half-angle tangent
 // tan_half: returns (mean radiance over the cone, W/m^2/sr; accumulated opacity). The sampled voxel's
 // side is the cone diameter scaled to the same cross-section area (sqrt(pi)/2: a disc of diameter D
-// covers pi D^2 / 4), so a voxel of radiance L filling the cone reads L; capped by SIDE_CAP. Each step of length dt
-// through voxels of side s corrects the opacity for the path length: a' = 1 - (1 - a)^(dt / s), and
-// the premultiplied colour with it (c a' / a; c dt / s where a is ~0).
+// covers pi D^2 / 4), so a voxel of radiance L filling the cone reads L; capped by SIDE_CAP.
+// Opacity accumulates linearly, a += a_s dt / s (s the sampled voxel's side), and each step adds its
+// radiance times the opacity it added. Trilinear filtering turns an opaque one-voxel wall into a tent
+// of width 2s whose samples sum to 1 at any phase, so the wall stops the cone; the usual
+// a += (1 - a)(1 - (1 - a_s)^(dt/s)) let 19 % through it (tests/gpu/test_vct.py) and 10 % of a closed
+// box's light out.
 vec4 trace_cone(vec3 g0, vec3 d, float tan_half) {
     vec3 colour = vec3(0.0);
     float alpha = 0.0;
@@ -68,10 +71,10 @@ vec4 trace_cone(vec3 g0, vec3 d, float tan_half) {
         vec4 s = sample_directional(g, lod, d);
         float dt = step_ratio * side;
         float r = dt / exp2(lod);
-        float a = 1.0 - pow(max(1.0 - s.a, 0.0), r);
-        vec3 c = s.a > 1e-4 ? s.rgb * (a / s.a) : s.rgb * r;
-        colour += (1.0 - alpha) * c;
-        alpha += (1.0 - alpha) * a;
+        float next = min(1.0, alpha + s.a * r);
+        vec3 radiance = s.a > 1e-4 ? s.rgb / s.a : vec3(0.0);
+        colour += radiance * (next - alpha);
+        alpha = next;
         t += dt;
     }
     return vec4(colour, alpha);
