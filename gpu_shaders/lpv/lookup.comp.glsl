@@ -1,7 +1,8 @@
 // LPV lookup: trilinear SH (accumulated intensity, W/sr per cell) at the G-buffer position moved half a
 // cell along the normal. Intensity over a cell's cross-section h^2 is radiance-like: the irradiance on
 // a surface of normal n is E = max(0, c . cosine_lobe(-n)) / h^2 (the grid stores direction of travel,
-// so the light arriving at the surface travels along -n). Output: E / pi (Cycles' Diffuse Indirect).
+// so the light arriving at the surface travels along -n). Output: E / pi (Cycles' Diffuse Indirect),
+// written, or with ACCUMULATE added to what `indirect` holds.
 #include "common/sh.glsl"
 
 void main() {
@@ -21,5 +22,11 @@ void main() {
     vec3 e = vec3(max(dot(texture(acc_r, uvw), lobe), 0.0),
                   max(dot(texture(acc_g, uvw), lobe), 0.0),
                   max(dot(texture(acc_b, uvw), lobe), 0.0));
-    imageStore(indirect, px, vec4(e / (cell_size * cell_size * SH_A0), 1.0));
+    vec3 out_e = e / (cell_size * cell_size * SH_A0);
+#ifdef ACCUMULATE
+    // One bounce's volume added to the earlier bounces' image: each bounce is clamped on its own, so a
+    // later bounce's negative L1 ringing cannot take light away from an earlier one.
+    out_e += imageLoad(indirect, px).rgb;
+#endif
+    imageStore(indirect, px, vec4(out_e, 1.0));
 }

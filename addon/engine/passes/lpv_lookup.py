@@ -1,9 +1,11 @@
 """LPV lookup pass: the accumulated SH at every G-buffer pixel -> `indirect`.
 
 Inputs: G-buffer position and normal; `acc_r/g/b` (RGBA32F 3D, accumulated L1 SH of radiant intensity,
-W/sr per cell, by direction of travel), the Grid. Output: `indirect` (RGBA32F, camera size, written,
-not accumulated): E / pi with E = max(0, c(p) . cosine_lobe(-n)) / h^2, c(p) trilinear at
-p = pos + lookup_offset_cells * h * n. Units: Cycles' Diffuse Indirect (docs/LPV.md).
+W/sr per cell, by direction of travel), the Grid. Output: `indirect` (RGBA32F, camera size, written;
+added to with `accumulate`): E / pi with E = max(0, c(p) . cosine_lobe(-n)) / h^2, c(p) trilinear at
+p = pos + lookup_offset_cells * h * n. Units: Cycles' Diffuse Indirect (docs/LPV.md). With several
+bounces the method runs it once per bounce's volume, the later ones added (`accumulate`): each bounce's
+irradiance is clamped at 0 on its own.
 """
 
 from __future__ import annotations
@@ -11,21 +13,30 @@ from __future__ import annotations
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
 
-SPEC = ShaderSpec(
-    name="lpv_lookup",
-    compute="lpv/lookup.comp.glsl",
-    local_size=(8, 8, 1),
-    samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("acc_r", "3D"),
-              Sampler("acc_g", "3D"), Sampler("acc_b", "3D")),
-    images=(Image("indirect", "2D", "RGBA32F", "write"),),
-    uniforms=(Var("grid_origin", "vec3"), Var("cell_size", "float"), Var("dims", "ivec3"),
-              Var("lookup_offset_cells", "float")),
-)
+
+def _spec(accumulate: bool) -> ShaderSpec:
+    return ShaderSpec(
+        name="lpv_lookup_add" if accumulate else "lpv_lookup",
+        compute="lpv/lookup.comp.glsl",
+        local_size=(8, 8, 1),
+        samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("acc_r", "3D"),
+                  Sampler("acc_g", "3D"), Sampler("acc_b", "3D")),
+        images=(Image("indirect", "2D", "RGBA32F", "read_write" if accumulate else "write"),),
+        uniforms=(Var("grid_origin", "vec3"), Var("cell_size", "float"), Var("dims", "ivec3"),
+                  Var("lookup_offset_cells", "float")),
+        defines=(("ACCUMULATE", "1"),) if accumulate else (),
+    )
 
 
-def run(backend: Backend, gbuf: dict, acc: dict, indirect, grid: Grid, offset_cells: float = 0.5) -> None:
+SPEC, ACCUMULATE_SPEC = _spec(False), _spec(True)
+
+
+def run(backend: Backend, gbuf: dict, acc: dict, indirect, grid: Grid, offset_cells: float = 0.5,
+        accumulate: bool = False) -> None:
+    """Write `indirect` from `acc`, or with `accumulate` add to it (one later bounce's volume)."""
+    spec = ACCUMULATE_SPEC if accumulate else SPEC
     samplers = {"gbuf_position": gbuf["position"], "gbuf_normal": gbuf["normal"], **acc}
-    backend.dispatch(backend.program(SPEC), group_count(indirect.size, SPEC.local_size),
+    backend.dispatch(backend.program(spec), group_count(indirect.size, spec.local_size),
                      uniforms={"grid_origin": grid.origin_m, "cell_size": grid.cell_size_m, "dims": grid.dims,
                                "lookup_offset_cells": offset_cells},
                      samplers=samplers, images={"indirect": indirect})

@@ -1,0 +1,47 @@
+"""LPV re-injection pass: the next diffuse bounce, emitted by the voxelized surfaces (docs/LPV.md).
+
+Inputs: the previous bounce's accumulation `acc_r/g/b` (RGBA32F 3D, L1 SH, W/sr per cell by direction
+of travel, as lpv_lookup reads it), the voxelizer's `vox_normal` (xyz mean normal, w = surface area in
+the cell in cells^2) and `vox_albedo` (rgb diffuse albedo) on the LPV grid. Output: a fresh snapshot
+`sh_r/g/b` (RGBA32F 3D, written in every cell, not accumulated). A cell A with geometry reflects
+phi = albedo * E * area (W): E the irradiance lpv_lookup would read on a surface at A's centre, on the
+better lit side m of +-n; area = w h^2. Its Lambertian lobe phi / pi * cosine_lobe(m) goes to the
+neighbours A + d in the shares max(0, m.d) / |m|_1 (sum 1). Gather form: one compute invocation per
+cell reads its 6 neighbours; no atomics. `add` sums one bounce's accumulation into the total.
+"""
+
+from __future__ import annotations
+
+from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
+from ..grid import Grid
+
+SPEC = ShaderSpec(
+    name="lpv_reinject",
+    compute="lpv/reinject.comp.glsl",
+    local_size=(4, 4, 4),
+    samplers=tuple(Sampler(f"acc_{c}", "3D") for c in "rgb") + (Sampler("vox_normal", "3D"),
+                                                               Sampler("vox_albedo", "3D")),
+    images=tuple(Image(f"sh_{c}", "3D", "RGBA32F", "write") for c in "rgb"),
+    uniforms=(Var("dims", "ivec3"),),
+)
+
+ADD = ShaderSpec(
+    name="lpv_add",
+    compute="lpv/add.comp.glsl",
+    local_size=(4, 4, 4),
+    samplers=tuple(Sampler(f"bounce_{c}", "3D") for c in "rgb"),
+    images=tuple(Image(f"acc_{c}", "3D", "RGBA32F", "read_write") for c in "rgb"),
+    uniforms=(Var("dims", "ivec3"),),
+)
+
+
+def run(backend: Backend, acc: dict, vox_normal, vox_albedo, snapshot: dict, grid: Grid) -> None:
+    """acc (keys acc_r/g/b) -> snapshot (keys sh_r/g/b), overwritten in every cell."""
+    backend.dispatch(backend.program(SPEC), group_count(grid.dims, SPEC.local_size), uniforms={"dims": grid.dims},
+                     samplers={**acc, "vox_normal": vox_normal, "vox_albedo": vox_albedo}, images=snapshot)
+
+
+def add(backend: Backend, bounce: dict, total: dict, grid: Grid) -> None:
+    """total (keys acc_r/g/b) += bounce (keys acc_r/g/b), per cell."""
+    backend.dispatch(backend.program(ADD), group_count(grid.dims, ADD.local_size), uniforms={"dims": grid.dims},
+                     samplers={f"bounce_{c}": bounce[f"acc_{c}"] for c in "rgb"}, images=total)

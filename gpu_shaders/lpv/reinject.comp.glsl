@@ -1,0 +1,68 @@
+// LPV re-injection (the next bounce), gather form: every cell A with geometry reflects the light the
+// previous bounce brings to its surface, as a Lambertian emitter placed in the neighbours it faces.
+// Cell B writes what its 6 neighbours A = B - d send it; one invocation per cell, 6 iterations.
+//
+// A's surface (voxelizer: mean normal n, area w in cells^2, albedo rho) receives on its side facing m
+// (m = n or -n) E_m = max(0, c(p) . cosine_lobe(-m)) / h^2 with c trilinear at p = centre + 0.5 h m:
+// what lookup.comp.glsl reads on a surface at the cell's centre. Voxel normals of one-sided meshes do
+// not say which side is lit, so A reflects from the side that receives more (the inside of a closed
+// solid and the outside of a room stay dark; L1 reads ~0 behind a one-sided field). It reflects
+// phi = rho * E_m * w h^2 = rho * w * max(0, c . cosine_lobe(-m)) watts (h^2 cancels), emitted as
+// phi / pi * cosine_lobe(m) (flux 2 sqrt(pi) c0 = phi, as inject.vert.glsl does for a VPL), split over
+// the neighbours B = A + d by max(0, m.d) / |m|_1 (a partition of unity over the 6 axes: phi is kept).
+// Not in A itself: A's own geometry volume would block half of it on the first step out.
+#include "common/sh.glsl"
+
+// E_m * h^2 per colour: the previous bounce's light arriving at cell c's surface on the side facing m.
+vec3 arriving(ivec3 c, vec3 m) {
+    vec3 uvw = (vec3(c) + 0.5 + 0.5 * m) / vec3(dims);  // texel centres at (i + 0.5) / dims
+    vec4 lobe = sh_cosine_lobe(-m);
+    return vec3(max(dot(texture(acc_r, uvw), lobe), 0.0), max(dot(texture(acc_g, uvw), lobe), 0.0),
+                max(dot(texture(acc_b, uvw), lobe), 0.0));
+}
+
+// The flux (W, rgb) cell a reflects and the side m it reflects to; zero without a surface: empty cells
+// have w = 0, and opposite faces in one cell cancel to n = 0.
+vec3 reflected(ivec3 a, out vec3 m) {
+    vec4 nv = texelFetch(vox_normal, a, 0);
+    m = vec3(0.0);
+    if (nv.w <= 0.0 || dot(nv.xyz, nv.xyz) == 0.0) {
+        return vec3(0.0);
+    }
+    vec3 e_front = arriving(a, nv.xyz);
+    vec3 e_back = arriving(a, -nv.xyz);
+    bool front = dot(e_front, vec3(1.0)) >= dot(e_back, vec3(1.0));
+    m = front ? nv.xyz : -nv.xyz;
+    return texelFetch(vox_albedo, a, 0).rgb * nv.w * (front ? e_front : e_back);
+}
+
+void main() {
+    ivec3 b = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(b, dims))) {
+        return;
+    }
+    vec4 out_r = vec4(0.0);
+    vec4 out_g = vec4(0.0);
+    vec4 out_b = vec4(0.0);
+    for (int k = 0; k < 6; ++k) {
+        ivec3 d = ivec3(0);
+        d[k / 2] = (k % 2 == 0) ? 1 : -1;
+        ivec3 a = b - d;
+        if (any(lessThan(a, ivec3(0))) || any(greaterThanEqual(a, dims))) {
+            continue;
+        }
+        vec3 m;
+        vec3 phi = reflected(a, m);
+        if (phi == vec3(0.0)) {
+            continue;  // also m = 0, where the share below would divide by zero
+        }
+        float share = max(dot(m, vec3(d)), 0.0) / dot(abs(m), vec3(1.0));
+        vec4 lobe = sh_cosine_lobe(m) * (share / SH_A0);
+        out_r += phi.r * lobe;
+        out_g += phi.g * lobe;
+        out_b += phi.b * lobe;
+    }
+    imageStore(sh_r, b, out_r);
+    imageStore(sh_g, b, out_g);
+    imageStore(sh_b, b, out_b);
+}
