@@ -1,7 +1,8 @@
 """Scene settings: `scene.bounce`, generated from the engine's config dataclasses.
 
 GIConfig and RsmConfig both have a `resolution`, so each config gets its own group
-(`scene.bounce.gi.resolution`, `scene.bounce.rsm.resolution`) and keeps the dataclass's field names.
+(`scene.bounce.gi.resolution`, `scene.bounce.rsm.resolution`, `scene.bounce.lpv.grid_cells`) and keeps
+the dataclass's field names.
 Names, defaults, limits and enum items come from `config.limits()`, so the UI cannot drift from what
 the engine validates.
 """
@@ -14,7 +15,9 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, Po
 from .engine import config
 
 # Group attribute on scene.bounce -> the config it mirrors.
-CONFIGS = {"gi": config.GIConfig, "rsm": config.RsmConfig}
+CONFIGS = {"gi": config.GIConfig, "rsm": config.RsmConfig, "lpv": config.LpvConfig, "vct": config.VctConfig}
+# Groups only one method reads -> that method: the panel shows them only while it is selected.
+GROUP_METHOD = {"lpv": "lpv", "vct": "vct"}
 
 
 _ACRONYMS = {"vpl", "rsm", "lpv", "vct", "sh"}
@@ -38,7 +41,9 @@ def _property(name: str, spec: dict):
         items = [(c, c.replace("-", " ").title(), "") for c in spec["choices"]]
         return EnumProperty(name=label, description=doc, items=items, default=spec["default"])
     default = spec["default"]
-    if isinstance(default, int) and not isinstance(default, bool):
+    if isinstance(default, bool):
+        return BoolProperty(name=label, description=doc, default=default)
+    if isinstance(default, int):
         return IntProperty(name=label, description=doc, default=default, min=spec["min"], max=spec["max"])
     if isinstance(default, float):
         return FloatProperty(
@@ -129,8 +134,9 @@ def _from_blender(value):
     return float(f"{value:.7g}") if isinstance(value, float) else value
 
 
-def to_config(settings) -> tuple[config.GIConfig, config.RsmConfig]:
-    """scene.bounce -> (GIConfig, RsmConfig); raises ConfigError as the engine would."""
+def to_config(settings) -> tuple[config.GIConfig, config.RsmConfig, config.LpvConfig, config.VctConfig]:
+    """scene.bounce -> (GIConfig, RsmConfig, LpvConfig, VctConfig), in CONFIGS' order; raises
+    ConfigError as the engine would."""
     configs = []
     for attr, cls in CONFIGS.items():
         group = getattr(settings, attr)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import bpy
 
-from ..addon.properties import CONFIGS
+from ..addon.properties import CONFIGS, GROUP_METHOD
 
 
 class BOUNCE_PT_main(bpy.types.Panel):
@@ -23,7 +23,10 @@ class BOUNCE_PT_main(bpy.types.Panel):
         settings = context.scene.bounce
         layout.active = settings.enabled
         # Every field of each group, in the config's order: a new config field appears without edits here.
+        # A method's own group (LPV) only while that method is selected.
         for attr in CONFIGS:
+            if GROUP_METHOD.get(attr, settings.gi.method) != settings.gi.method:
+                continue
             group = getattr(settings, attr)
             column = layout.column(heading=attr.upper())
             for name in group.bl_rna.properties.keys():

@@ -1,6 +1,6 @@
 """Viewport overlay: Bounce's light drawn additively over each 3D view (a SpaceView3D POST_VIEW handler).
 
-Per region and quality an `Overlay` owns a method instance (direct or rsm) on the Blender gpu backend,
+Per region and quality an `Overlay` owns a method instance (direct, rsm or lpv) on the Blender gpu backend,
 rendered with the region's own camera: view = `region_data.view_matrix`, projection =
 `region_data.window_matrix`, at the region's size capped to `gi.resolution` on its long side (halved in
 preview quality). The draw adds albedo x (indirect [+ direct]) x 2^exposure x strength with
@@ -104,10 +104,11 @@ class Overlay:
         self.camera: Camera | None = None
         self.geometry_version = self.lights_version = -1
 
-    def update(self, state: live.LiveState, camera: Camera, gi, rsm_config) -> bool:
+    def update(self, state: live.LiveState, camera: Camera, gi, rsm_config, lpv_config, vct_config=None) -> bool:
         """Bring the images up to date; False when they already were."""
-        if self.method is None or self.configs != (gi, rsm_config):
-            self.method, self.configs = methods.get(gi.method)(backend(), gi, rsm_config), (gi, rsm_config)
+        configs = (gi, rsm_config, lpv_config, vct_config)
+        if self.method is None or self.configs != configs:
+            self.method, self.configs = methods.create(backend(), gi, rsm_config, lpv_config, vct_config), configs
             self.method.profile = False  # no GPU sync per pass: the callback times the whole update
             self.geometry_version = -1
         if self.geometry_version != state.geometry_version:
@@ -214,7 +215,7 @@ def _draw(context, settings) -> None:
     if moved:
         live.touch()  # navigating is interaction too: preview now, full quality once it stops
     quality = "preview" if moved or state.quality == "preview" else "full"
-    gi, rsm_config = to_config(settings)
+    gi, rsm_config, lpv_config, vct_config = to_config(settings)
     if quality == "preview":
         rsm_config = dataclasses.replace(rsm_config, vpl_samples=max(1, rsm_config.vpl_samples // PREVIEW_VPL_DIVISOR))
     width, height = view_size(region.width, region.height, gi.resolution, quality)
@@ -225,7 +226,7 @@ def _draw(context, settings) -> None:
     framebuffer, region_viewport = gpu.state.active_framebuffer_get(), gpu.state.viewport_get()
     with _restored_gpu_state():
         t0 = time.perf_counter()
-        computed = overlay.update(state, camera, gi, rsm_config)
+        computed = overlay.update(state, camera, gi, rsm_config, lpv_config, vct_config)
         if computed:
             backend().finish()  # one wait per update (not per pass), so the time shown is the GPU's too
     if computed:

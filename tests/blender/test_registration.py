@@ -47,9 +47,9 @@ def test_register_unregister_twice_leaves_nothing_behind(bounce, fresh_blend):
     before = _handler_counts()
     assert "load_post" in before and "depsgraph_update_post" in before
     classes = _all_classes(bounce)
-    # 3 property groups, preferences, 2 operators (report_renderer, bake), 3 panels (main, its viewport
-    # sub-panel, the sidebar tab)
-    assert len(classes) == 9
+    # 5 property groups (gi, rsm, lpv, vct, settings), preferences, 2 operators (report_renderer, bake),
+    # 3 panels (main, its viewport sub-panel, the sidebar tab)
+    assert len(classes) == 11
     for _ in range(2):
         bounce.register()
         try:
@@ -93,6 +93,9 @@ def _mismatches(group_rna, config_cls, limits_fn) -> list[str]:
         if "choices" in spec:
             got = (prop.type, [i.identifier for i in prop.enum_items], prop.default)
             want = ("ENUM", list(spec["choices"]), spec["default"])
+        elif isinstance(spec["default"], bool):
+            got = (prop.type, prop.default)
+            want = ("BOOLEAN", spec["default"])
         else:
             # Blender floats are 32-bit: compare to float32 precision (rel 1e-6), ints exactly.
             got = (prop.type, prop.default, prop.hard_min, prop.hard_max)
@@ -109,7 +112,7 @@ def test_properties_mirror_every_config_field(registered):
     from bounce.addon.engine import config
     from bounce.addon.properties import CONFIGS
 
-    assert set(CONFIGS.values()) >= {config.GIConfig, config.RsmConfig}
+    assert set(CONFIGS.values()) >= {config.GIConfig, config.RsmConfig, config.LpvConfig}
     for attr, cls in CONFIGS.items():
         group_rna = getattr(bpy.context.scene.bounce, attr).bl_rna
         assert _mismatches(group_rna, cls, config.limits) == []
@@ -129,12 +132,20 @@ def test_mirror_check_catches_a_config_change(registered):
         "depth_m: no property",
     ]
 
+    @dataclasses.dataclass(frozen=True)
+    class DriftedBool(config.LpvConfig):
+        geometry_volume: bool = dataclasses.field(default=True, metadata={"doc": ""})
+
+    problems = _mismatches(bpy.context.scene.bounce.lpv.bl_rna, DriftedBool, config.limits)
+    assert problems == ["geometry_volume: property ('BOOLEAN', False) != config ('BOOLEAN', True)"]
+
 
 def test_defaults_give_default_configs(registered):
     from bounce.addon.engine import config
     from bounce.addon.properties import to_config
 
-    assert to_config(bpy.context.scene.bounce) == (config.GIConfig(), config.RsmConfig())
+    assert to_config(bpy.context.scene.bounce) == (config.GIConfig(), config.RsmConfig(), config.LpvConfig(),
+                                                   config.VctConfig())
 
 
 def test_settings_survive_save_and_reload(registered, tmp_path):
@@ -146,6 +157,8 @@ def test_settings_survive_save_and_reload(registered, tmp_path):
     settings.gi.bounces = 3
     settings.rsm.resolution = 512
     settings.rsm.shadow_bias_texels = 0.05
+    settings.lpv.variant = "improved"
+    settings.lpv.geometry_volume = True
     path = tmp_path / "settings.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
     bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -154,8 +167,9 @@ def test_settings_survive_save_and_reload(registered, tmp_path):
     bpy.ops.wm.open_mainfile(filepath=str(path))
     settings = bpy.context.scene.bounce
     assert settings.enabled
-    gi, rsm = to_config(settings)
+    gi, rsm, lpv, _vct = to_config(settings)
     assert (gi.method, gi.bounces, rsm.resolution) == ("rsm", 3, 512)
+    assert (lpv.variant, lpv.geometry_volume) == ("improved", True)
     assert rsm.shadow_bias_texels == 0.05  # exactly: to_config undoes Blender's float32 rounding
 
 
@@ -186,9 +200,16 @@ def test_panel_draws_every_setting(registered):
     from bounce.addon.engine import config
     from bounce.panels.main import BOUNCE_PT_main
 
-    drawn = []
-    panel = type("Panel", (), {"layout": _RecordingLayout(drawn)})()
-    BOUNCE_PT_main.draw_header(panel, bpy.context)
-    BOUNCE_PT_main.draw(panel, bpy.context)
+    def drawn_settings():
+        drawn = []
+        panel = type("Panel", (), {"layout": _RecordingLayout(drawn)})()
+        BOUNCE_PT_main.draw_header(panel, bpy.context)
+        BOUNCE_PT_main.draw(panel, bpy.context)
+        return drawn
+
     fields = [*config.limits(config.GIConfig), *config.limits(config.RsmConfig)]
-    assert drawn == ["enabled", *fields, "bounce.report_renderer", "bounce.bake"]
+    # The LPV group only while method lpv is selected (the default method is direct).
+    assert drawn_settings() == ["enabled", *fields, "bounce.report_renderer", "bounce.bake"]
+    bpy.context.scene.bounce.gi.method = "lpv"
+    lpv_fields = list(config.limits(config.LpvConfig))
+    assert drawn_settings() == ["enabled", *fields, *lpv_fields, "bounce.report_renderer", "bounce.bake"]

@@ -165,19 +165,20 @@ def test_navigating_gives_preview_then_full_quality(cornell):
     np.testing.assert_array_equal(full.view, preview.view)
 
 
-@pytest.mark.parametrize("name", ["direct", "rsm"])
+@pytest.mark.parametrize("name", ["direct", "rsm", "lpv", "vct"])
 def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, name):
     from addon.bridge import scenes
     from addon.bridge.capture import SceneCache
     from addon.engine import methods
-    from addon.engine.config import GIConfig, RsmConfig
+    from addon.engine.config import GIConfig, LpvConfig, RsmConfig, VctConfig
 
     scenes.build("cornell")
     scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 64, 48)
     gi, rsm = GIConfig(method=name, resolution=64), RsmConfig(resolution=128, vpl_samples=64)
     results = []
     for be in (gl, blender_backend):
-        method = methods.get(name)(be, gi, rsm)
+        method = methods.create(be, gi, rsm, LpvConfig(grid_cells=16, variant="improved", geometry_volume=True),
+                                VctConfig(voxel_cells=16, diffuse_cones=6))
         method.set_scene(scene)
         results.append(method.run().images)
     a, b = results

@@ -211,7 +211,7 @@ def test_one_bright_voxel_falls_off_as_inverse_square(gl):
     e, _ = gather(gl, pyr, vols.grid, points, [(1, 0, 0)] * len(points), VctConfig(offset_cells=0.0))
     exact = 1.0 / (np.pi * distances.astype(float) ** 2)
     ratio = e[:, 0] / exact
-    print("one voxel E / exact by distance", dict(zip(distances.tolist(), ratio.round(3).tolist())))
+    print("one voxel E / exact by distance", dict(zip(distances.tolist(), ratio.round(3).tolist(), strict=True)))
     assert np.all(ratio > 0.0)
     assert ratio.max() / ratio.min() < 3.0
 
