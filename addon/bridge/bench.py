@@ -41,6 +41,8 @@ SETTINGS: dict[str, tuple[dict, ...]] = {
     # The published scheme as the baseline row, and the improved transport (docs/LPV.md).
     "lpv": ({"lpv.variant": "classic", "lpv.geometry_volume": True},
             {"lpv.variant": "improved", "lpv.geometry_volume": True}),
+    # The issue's two grid sizes, at the defaults otherwise (16 cones, docs/VCT.md).
+    "vct": ({"vct.voxel_cells": 64}, {"vct.voxel_cells": 128}),
 }
 REAL_SCENES = ("sponza", "sibenik", "conference")  # /work/shared/scenes/<name>/<name>.blend
 CURVE_SPP = (1, 4, 16, 64, 256)
@@ -65,18 +67,19 @@ def setting_label(setting: dict) -> str:
 
 
 def make_configs(method: str, setting: dict, res: int, bounces: int):
-    """(GIConfig, RsmConfig, LpvConfig) for one setting; the dataclasses validate every value
+    """(GIConfig, RsmConfig, LpvConfig, VctConfig) for one setting; the dataclasses validate every value
     (ConfigError)."""
-    from ..engine.config import GIConfig, LpvConfig, RsmConfig
+    from ..engine.config import GIConfig, LpvConfig, RsmConfig, VctConfig
 
-    groups = {"gi": {"method": method, "resolution": res, "bounces": bounces}, "rsm": {}, "lpv": {}}
+    groups = {"gi": {"method": method, "resolution": res, "bounces": bounces}, "rsm": {}, "lpv": {}, "vct": {}}
     for key, value in setting.items():
         group, _, name = key.partition(".")
         if group not in groups or not name:
-            raise ConfigError(f"bench setting {key!r}: must be 'gi.<field>', 'rsm.<field>' or 'lpv.<field>'")
+            raise ConfigError(f"bench setting {key!r}: must be 'gi.<field>', 'rsm.<field>', 'lpv.<field>' or "
+                              "'vct.<field>'")
         groups[group][name] = value
     return (GIConfig.from_dict(groups["gi"]), RsmConfig.from_dict(groups["rsm"]),
-            LpvConfig.from_dict(groups["lpv"]))
+            LpvConfig.from_dict(groups["lpv"]), VctConfig.from_dict(groups["vct"]))
 
 
 def curve_spp(ref_spp: int, quick: bool) -> list[int]:
@@ -399,10 +402,10 @@ def run_bench(opt: Options) -> dict:
         for method, setting in jobs:
             label = setting_label(setting)
             bar.set_postfix_str(f"{name}: {method} {label}")
-            gi, rsm, lpv = make_configs(method, setting, opt.res, opt.bounces)
+            gi, rsm, lpv, vct = make_configs(method, setting, opt.res, opt.bounces)
             run_dir = cache / "runs" / name / f"{method}-{label.replace(' ', '').replace(',', '_')}"
             run_dir.mkdir(parents=True, exist_ok=True)
-            st = render_file(blend, run_dir, gi, rsm, repeat=repeat, lpv=lpv)
+            st = render_file(blend, run_dir, gi, rsm, repeat=repeat, lpv=lpv, vct=vct)
             renderers.add(st["renderer"])
             product = products[method]
             m = _compare(run_dir / f"{product}.exr", ref_dir / f"{product}.exr")
