@@ -26,7 +26,7 @@ def add_arguments(p) -> None:
     p.add_argument("--variant", default="classic", help="LPV transport: classic or improved (lpv)")
     p.add_argument("--geometry-volume", action="store_true", help="LPV: occlude by the voxelized surfaces")
     p.add_argument("--cones", type=int, default=16, help="diffuse cones per gather point (vct)")
-    p.add_argument("--step-ratio", type=float, default=0.5, help="cone march step / sampled voxel size (vct)")
+    p.add_argument("--step-ratio", type=float, default=1.0, help="cone march step / sampled voxel size (vct)")
     p.add_argument("--cone-offset", type=float, default=1.5, help="cone origins off the surface, in cells (vct)")
     p.add_argument("--radiance", default="anisotropic", help="voxel radiance: anisotropic or isotropic (vct)")
     p.add_argument("--seed", type=int, default=0)

@@ -11,20 +11,9 @@
 // moved `offset_cells` off their surfaces along their normals, crosses no occupied voxel (a march in
 // half-cell steps through the voxelizer's occupancy).
 
+#include "common/hash.glsl"
+
 const float PI = 3.14159265;
-
-uint hash_u32(uint x) {
-    x ^= x >> 16u;
-    x *= 0x7feb352du;
-    x ^= x >> 15u;
-    x *= 0x846ca68bu;
-    x ^= x >> 16u;
-    return x;
-}
-
-float random01(uint a, uint b, uint c) {
-    return float(hash_u32(a ^ hash_u32(b ^ hash_u32(c))) >> 8u) * (1.0 / 16777216.0);
-}
 
 #ifdef VOXEL_VISIBILITY
 // 1 if no occupied voxel lies on the segment, skipping its first and last cell: a VPL low on a wall

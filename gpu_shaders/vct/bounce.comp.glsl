@@ -22,8 +22,9 @@ void main() {
         }
         n = normalize(n);
         vec3 p = grid_origin + (vec3(c) + 0.5) * cell_size;
-        e_pos = albedo.rgb * gather_diffuse(p, n).rgb;
-        e_neg = albedo.rgb * gather_diffuse(p, -n).rgb;
+        float turn = 6.28318531 * random01(uint(c.x), uint(c.y), uint(c.z) ^ uint(seed) * 65536u);
+        e_pos = albedo.rgb * gather_diffuse(p, n, turn).rgb;
+        e_neg = albedo.rgb * gather_diffuse(p, -n, turn).rgb;
     }
     // Light leaving along +axis comes from the side whose normal has a positive component on it.
     imageStore(next_px, c, vec4((n.x >= 0.0 ? e_pos : e_neg) * proj.x, 0.0));

@@ -2,6 +2,7 @@
 // Uniforms used: grid_origin, cell_size (m), dims (level 0), levels, tex_width (x size of the
 // textures), diffuse_cones, step_ratio, offset_cells. Positions `g` are in level-0 cell units.
 #include "vct/pyramid.glsl"
+#include "common/hash.glsl"
 
 const int MAX_CONE_STEPS = 96;
 // Sampled voxels are at most this fraction of the distance travelled: grid-aligned blocks as wide as
@@ -9,6 +10,7 @@ const int MAX_CONE_STEPS = 96;
 // surface, opaque and dark (a closed box of radiance 1 read 0.31 straight up; 0.9 with this cap).
 // The cone is then sampled narrower than it is wide: an estimate of its mean radiance from its core.
 const float SIDE_CAP = 0.25;
+#define START_CELLS 0.5
 
 // Trilinear sample of one direction's texture at level `level`, clamped to that level's cells
 // (the march stops at the grid's border, so clamping only reaches half a cell outside it).
@@ -59,7 +61,7 @@ vec4 sample_directional(vec3 g, float lod, vec3 d) {
 vec4 trace_cone(vec3 g0, vec3 d, float tan_half) {
     vec3 colour = vec3(0.0);
     float alpha = 0.0;
-    float t = 0.0;
+    float t = START_CELLS;
     float max_lod = float(levels - 1);
     for (int i = 0; i < MAX_CONE_STEPS; i++) {
         vec3 g = g0 + t * d;
@@ -92,8 +94,10 @@ void tangent_frame(vec3 n, out vec3 tx, out vec3 ty) {
 // Diffuse gather about normal n at position p (m): `diffuse_cones` cones splitting the hemisphere
 // into equal solid angles (cos theta uniform in (0, 1], a golden-angle spiral in phi), each of solid
 // angle 2 pi / N and weighted by its cos theta; weights sum to 1, so a uniform environment of
-// radiance L returns exactly L. Returns (E / pi, the cosine-weighted occlusion).
-vec4 gather_diffuse(vec3 p, vec3 n) {
+// radiance L returns exactly L. `rotation` (radians) turns the spiral about n: a per-receiver random
+// turn makes the cones' aliasing (bands where a cone edge crosses a wall) unstructured noise, which
+// neighbouring pixels average. Returns (E / pi, the cosine-weighted occlusion).
+vec4 gather_diffuse(vec3 p, vec3 n, float rotation) {
     vec3 tx, ty;
     tangent_frame(n, tx, ty);
     vec3 g0 = (p - grid_origin) / cell_size + offset_cells * n;
@@ -103,7 +107,7 @@ vec4 gather_diffuse(vec3 p, vec3 n) {
     for (int i = 0; i < diffuse_cones; i++) {
         float z = 1.0 - (float(i) + 0.5) / float(diffuse_cones);
         float r = sqrt(max(1.0 - z * z, 0.0));
-        float phi = 2.39996323 * float(i);
+        float phi = 2.39996323 * float(i) + rotation;
         vec3 d = normalize(tx * (r * cos(phi)) + ty * (r * sin(phi)) + n * z);
         sum += (2.0 * z / float(diffuse_cones)) * trace_cone(g0, d, tan_half);
     }

@@ -182,8 +182,8 @@ def test_empty_volume_gives_zero_and_no_occlusion(gl):
 
 def test_closed_box_of_uniform_radiance(gl):
     """Inside a closed box whose walls all have radiance L, E / pi = L exactly (any receiver). The cone
-    gather reads 0.967-0.971 L (16 cones; the rest escapes through coarse voxels that straddle a wall
-    and the outside, docs/VCT.md) and never more than L: bounds 0.93 (a regression to the
+    gather reads 0.94-0.96 L (16 cones; the rest escapes through coarse voxels that straddle a wall
+    and the outside, docs/VCT.md) and never more than L: bounds 0.92 (a regression to the
     exponential opacity read 0.87-0.90) and L."""
     vols, lo, hi = closed_box(32, radiance=2.0)
     mid = (lo + hi + 1) / 2
@@ -191,29 +191,30 @@ def test_closed_box_of_uniform_radiance(gl):
     e, ao = gather(gl, vols.pyramid(gl), vols.grid, points, [(0, 0, 1), (0, 0, 1), (0.6, 0.0, 0.8)])
     print("closed box E/pi / L:", e[:, 0] / 2.0, "ao", ao)
     assert np.all(e <= 2.0 * (1 + 1e-5))
-    assert np.all(e >= 2.0 * 0.93)
+    assert np.all(e >= 2.0 * 0.92)
     np.testing.assert_allclose(e[:, 0], e[:, 1], rtol=1e-6)  # grey stays grey
 
 
 def test_one_bright_voxel_falls_off_as_inverse_square(gl):
-    """A voxel of radiance L seen face-on from distance r gives E / pi = L h^2 cos / (pi r^2) (a
-    Lambertian square patch h^2 in the far field). Cone tracing spreads it over the cone that sees it
-    and reads 0.35, 0.24, 0.32, 0.44 of the exact value at 4, 8, 16, 24 cells (the cone's mean over its
-    solid angle is not the patch's point value, and the side cap samples only its core): r^2 E stays
-    within a factor 2 (bound 3), so the falloff is 1/r^2, but one small source is under-read ~3x."""
-    n = 64
+    """A voxel of radiance L seen face-on from distance r gives E / pi = L h^2 / (pi r^2) (a Lambertian
+    square patch h^2 in the far field). Each receiver turns its cones by its own random angle, so one
+    receiver aliases a source this small (0.05x to 2x); the mean over 512 receivers at the same point
+    is the estimate. Measured mean / exact at 4, 8, 16, 24 cells: 0.57, 0.73, 0.71, 0.71 (flat beyond
+    a few cells: the falloff is 1/r^2; the level is ~0.7 because the side cap samples the cone's core
+    and trilinear filtering spreads the voxel over 8). Bounds: spread < 1.5x, level in [0.5, 1.0]."""
+    n, copies = 64, 512
     vols = Volumes((n, n, n))
     c = n // 2
     vols.wall(0, c, -1, 1.0, span=slice(c, c + 1))  # one cell facing -x
     pyr = vols.pyramid(gl)
     distances = np.array([4, 8, 16, 24])
-    points = [(c + 0.5 - r, c + 0.5, c + 0.5) for r in distances]
+    points = [(c + 0.5 - r, c + 0.5, c + 0.5) for r in distances for _ in range(copies)]
     e, _ = gather(gl, pyr, vols.grid, points, [(1, 0, 0)] * len(points), VctConfig(offset_cells=0.0))
-    exact = 1.0 / (np.pi * distances.astype(float) ** 2)
-    ratio = e[:, 0] / exact
-    print("one voxel E / exact by distance", dict(zip(distances.tolist(), ratio.round(3).tolist(), strict=True)))
-    assert np.all(ratio > 0.0)
-    assert ratio.max() / ratio.min() < 3.0
+    mean = e[:, 0].reshape(len(distances), copies).mean(axis=1)
+    ratio = mean / (1.0 / (np.pi * distances.astype(float) ** 2))
+    print("one voxel mean E / exact by distance", dict(zip(distances.tolist(), ratio.round(3).tolist(), strict=True)))
+    assert np.all((ratio >= 0.5) & (ratio <= 1.0))
+    assert ratio.max() / ratio.min() < 1.5
 
 
 def test_wall_one_voxel_thick_stops_light(gl):

@@ -45,7 +45,7 @@ class LpvMethod(OneBounceMethod):
     def set_scene(self, scene) -> None:
         super().set_scene(scene)
         be, cfg = self.backend, self.lpv_config
-        self.grid = Grid.fit(*self.scene.bounds_m(), max_cells=cfg.grid_cells)
+        self.grid = Grid.fit(*self.bounds_m, max_cells=cfg.grid_cells)
         dims = self.grid.dims
         # Two snapshot sets (ping-pong; set 0 receives the injection) and the accumulation.
         self.snapshots = [{f"sh_{c}": be.texture(dims) for c in "rgb"} for _ in range(2)]

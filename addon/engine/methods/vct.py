@@ -34,7 +34,7 @@ class VctMethod(OneBounceMethod):
     def set_scene(self, scene) -> None:
         super().set_scene(scene)
         be, cfg = self.backend, self.vct_config
-        self.grid = Grid.fit(*self.scene.bounds_m(), max_cells=cfg.voxel_cells)
+        self.grid = Grid.fit(*self.bounds_m, max_cells=cfg.voxel_cells)
         self.voxelizer = Voxelizer(be, self.grid)
         self.voxelizer.set_scene(self.scene)
         self.voxels = self.voxelizer.run()
@@ -78,7 +78,8 @@ class VctMethod(OneBounceMethod):
             return
         for bounce in range(2, self.gi.bounces + 1):
             with self.timed(timings, "vct_bounce"):
-                vct_gather.bounce(be, self.pyramid, self.voxels, self.next_bounce, self.grid, cfg)
+                vct_gather.bounce(be, self.pyramid, self.voxels, self.next_bounce, self.grid, cfg,
+                                  self.gi.seed + bounce)
                 vct_pyramid.accumulate(be, self.later_bounces, self.next_bounce, self.grid, first=bounce == 2)
             with self.timed(timings, "vct_pyramid"):
                 if bounce < self.gi.bounces:
@@ -95,5 +96,5 @@ class VctMethod(OneBounceMethod):
             self.bounce_light(timings)
             with self.timed(timings, "vct_gather"):
                 vct_gather.pixels(self.backend, self.pyramid, self.gbuf, self.indirect, self.ao, self.grid,
-                                  self.vct_config)
+                                  self.vct_config, self.gi.seed)
         return timings

@@ -19,7 +19,7 @@ from .vct_pyramid import level_count, named, texture_size
 _PYRAMID = tuple(Sampler(f"pyr_{d}", "3D") for d in DIRECTIONS)
 _CONE_UNIFORMS = (Var("grid_origin", "vec3"), Var("cell_size", "float"), Var("dims", "ivec3"), Var("levels", "int"),
                   Var("tex_width", "int"), Var("diffuse_cones", "int"), Var("step_ratio", "float"),
-                  Var("offset_cells", "float"))
+                  Var("offset_cells", "float"), Var("seed", "int"))
 
 PIXELS = ShaderSpec(
     name="vct_gather",
@@ -40,24 +40,27 @@ BOUNCE = ShaderSpec(
 )
 
 
-def cone_uniforms(grid: Grid, config: VctConfig) -> dict:
-    return {"grid_origin": grid.origin_m, "cell_size": grid.cell_size_m, "dims": grid.dims,
+def cone_uniforms(grid: Grid, config: VctConfig, seed: int) -> dict:
+    """`seed` turns every receiver's cone spiral by its own random angle (GIConfig.seed)."""
+    return {"seed": seed, "grid_origin": grid.origin_m, "cell_size": grid.cell_size_m, "dims": grid.dims,
             "levels": level_count(grid.dims), "tex_width": texture_size(grid.dims)[0],
             "diffuse_cones": config.diffuse_cones, "step_ratio": config.step_ratio,
             "offset_cells": config.offset_cells}
 
 
-def pixels(backend: Backend, pyramid: dict, gbuf: dict, indirect, ao, grid: Grid, config: VctConfig) -> None:
+def pixels(backend: Backend, pyramid: dict, gbuf: dict, indirect, ao, grid: Grid, config: VctConfig,
+           seed: int = 0) -> None:
     backend.dispatch(backend.program(PIXELS), group_count(indirect.size, PIXELS.local_size),
-                     uniforms=cone_uniforms(grid, config),
+                     uniforms=cone_uniforms(grid, config, seed),
                      samplers={**named(pyramid, "pyr"), "gbuf_position": gbuf["position"],
                                "gbuf_normal": gbuf["normal"]},
                      images={"indirect": indirect, "ao": ao})
 
 
-def bounce(backend: Backend, pyramid: dict, voxels: dict, next_bounce: dict, grid: Grid, config: VctConfig) -> None:
+def bounce(backend: Backend, pyramid: dict, voxels: dict, next_bounce: dict, grid: Grid, config: VctConfig,
+           seed: int = 0) -> None:
     backend.dispatch(backend.program(BOUNCE), group_count(grid.dims, BOUNCE.local_size),
-                     uniforms=cone_uniforms(grid, config),
+                     uniforms=cone_uniforms(grid, config, seed),
                      samplers={**named(pyramid, "pyr"), "vox_albedo": voxels["vox_albedo"],
                                "vox_normal": voxels["vox_normal"], "vox_projected": voxels["vox_projected"]},
                      images=named(next_bounce, "next"))

@@ -1,0 +1,58 @@
+"""tools/gpu_timing.py without a GPU: scene files round-trip, camera resizing, timing summaries."""
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+
+from addon.engine.scene import Camera, Light, Scene
+
+ROOT = Path(__file__).resolve().parents[2]
+_spec = importlib.util.spec_from_file_location("gpu_timing", ROOT / "tools" / "gpu_timing.py")
+gpu_timing = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(gpu_timing)
+
+
+def _scene() -> Scene:
+    pos = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 0, 1], [1, 0, 1], [0, 1, 1]]], np.float32)
+    proj = np.diag([1.0, 16 / 9, -1.0, 0.0])
+    proj[3, 2] = -1.0
+    return Scene(positions_m=pos, normals=np.tile([0, 0, 1], (2, 3, 1)).astype(np.float32),
+                 albedo=np.full((2, 3), 0.5, np.float32), emission=np.zeros((2, 3), np.float32),
+                 lights=[Light("SPOT", [0, 0, 2], [0, 0, -1], [1, 1, 1], power_w=300.0, spot_size_rad=1.2,
+                               spot_blend=0.15, name="Spot")],
+                 world_color=np.array([0.1, 0.2, 0.3], np.float32),
+                 camera=Camera(np.eye(4), proj, 1920, 1080), camera_visible=np.array([True, False]))
+
+
+def test_scene_round_trip(tmp_path):
+    scene = _scene()
+    gpu_timing.save_scene(scene, tmp_path / "s", {"name": "s"})
+    back = gpu_timing.load_scene(tmp_path / "s")
+    for name in ("positions_m", "normals", "albedo", "emission", "camera_visible", "world_color"):
+        np.testing.assert_array_equal(getattr(back, name), getattr(scene, name))
+    assert back.positions_m.dtype == np.float32
+    (light,), (orig,) = back.lights, scene.lights
+    assert (light.kind, light.power_w, light.spot_size_rad, light.name) == ("SPOT", 300.0, 1.2, "Spot")
+    np.testing.assert_allclose(light.direction, orig.direction)
+    np.testing.assert_allclose(back.camera.projection, scene.camera.projection)
+    assert (back.camera.width, back.camera.height) == (1920, 1080)
+
+
+def test_camera_resize_keeps_horizontal_fov(tmp_path):
+    scene = _scene()
+    gpu_timing.save_scene(scene, tmp_path / "s")
+    same_aspect = gpu_timing.load_scene(tmp_path / "s", (320, 180)).camera
+    np.testing.assert_allclose(same_aspect.projection, scene.camera.projection)
+    square = gpu_timing.load_scene(tmp_path / "s", (100, 100)).camera
+    assert (square.width, square.height) == (100, 100)
+    assert square.projection[1, 1] == square.projection[0, 0] == 1.0
+
+
+def test_per_pass_sums_the_lpv_target_passes():
+    runs = [{"total": 3.0, "gbuffer": 1.0, "lpv_inject": 0.5, "lpv_propagate": 1.0, "lpv_lookup": 0.5},
+            {"total": 5.0, "gbuffer": 1.0, "lpv_inject": 1.0, "lpv_propagate": 2.0, "lpv_lookup": 1.0}]
+    out = gpu_timing.per_pass(runs)
+    assert out["lpv_inject+propagate+lookup"]["median"] == 3.0
+    assert out["total"]["median"] == 4.0 and out["total"]["n"] == 2
+    assert "vct_inject+pyramid" not in out

@@ -1,0 +1,525 @@
+"""Full-update timings of every method on a real GPU, for the issue's targets (LPV: one spot light's
+injection, propagation and lookup at 1920x1080 <= 1 ms at 32^3, <= 3 ms at 64^3; VCT later).
+
+Two steps, because the GPU machine has no Blender:
+
+    # here (bpy from .venv): capture the scenes into .npz + .json files the engine reads without bpy
+    .venv/bin/python tools/gpu_timing.py export --out .gpubench
+    # anywhere with moderngl and an EGL OpenGL 4.3 context (the GPU machine; llvmpipe for a smoke test)
+    python3 tools/gpu_timing.py run --scenes .gpubench --out DIR [--res 1920x1080] [--repeat 20]
+
+`run` times each (scene, method config) three ways after `set_scene` and 3 warm-up updates:
+  wall_total   compute() with method.profile off, then one backend.finish(): what an update costs
+  gpu_*        GL timestamp queries (glQueryCounter) around every pass, no waits between passes
+  wall_pass_*  method.profile on: glFinish before and after every pass (stalls; per-pass upper bound)
+It writes timings.json and timings.md into DIR.
+
+On the lent GPU machine (no moderngl there): carry .whl (cp312 wheels of moderngl 5.13.0 and glcontext
+3.1.0), .gl (glvnd debs: libegl1 libglvnd0 libopengl0 libgl1 libglx0 libgles2) and .gpubench, then
+    for f in .gl/*.deb; do dpkg -x $f /; done; ldconfig;
+    export __EGL_VENDOR_LIBRARY_FILENAMES=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json;
+    python3 -m pip install -q --no-index --no-deps --target /tmp/site .whl/*.whl;
+    PYTHONPATH=/tmp/site:$PWD python3 tools/gpu_timing.py run --scenes .gpubench --out $OUT
+Raster passes (gbuffer, rsm, lpv_inject, vct_inject, voxelize) are far slower on an H100 than on a
+graphics GPU: few of its units run vertex/fragment work. Its compute-pass figures are the meaningful ones.
+The backend's GL context is made current once and
+kept current (a standalone process), so no eglMakeCurrent per backend call is counted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ctypes
+import ctypes.util
+import dataclasses
+import json
+import platform
+import sys
+import time
+import traceback
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+SCENES = ("cornell", "sponza")
+SPONZA = Path("/work/shared/scenes/sponza/sponza.blend")
+EXPORT_SIZE = (1920, 1080)
+LPV_PASSES = ("lpv_inject", "lpv_propagate", "lpv_lookup")
+VCT_PASSES = ("vct_inject", "vct_pyramid")  # + voxelize (timed apart) = the issue's "voxelize + inject + filter"
+
+
+# --------------------------------------------------------------------------------------- scene files
+
+def _jsonable(value):
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def save_scene(scene, path_stem: Path, meta: dict | None = None) -> dict:
+    """Write `scene` (an engine Scene with a camera) as <stem>.npz (geometry, float32) and <stem>.json
+    (lights, camera, world, warnings). Returns the json's content."""
+    cam = scene.camera
+    visible = scene.seen_by_camera()
+    np.savez_compressed(
+        path_stem.with_suffix(".npz"),
+        positions_m=np.asarray(scene.positions_m, np.float32),
+        normals=np.asarray(scene.normals, np.float32),
+        albedo=np.asarray(scene.albedo, np.float32),
+        emission=np.asarray(scene.emission, np.float32),
+        camera_visible=np.asarray(visible, bool),
+    )
+    info = {
+        "lights": [{f.name: _jsonable(getattr(light, f.name)) for f in dataclasses.fields(light)}
+                   for light in scene.lights],
+        "world_color": _jsonable(np.asarray(scene.world_color, np.float64)),
+        "camera": None if cam is None else {"view": cam.view.tolist(), "projection": cam.projection.tolist(),
+                                            "width": cam.width, "height": cam.height},
+        "warnings": list(scene.warnings),
+        "triangles": scene.triangle_count,
+        **(meta or {}),
+    }
+    path_stem.with_suffix(".json").write_text(json.dumps(info, indent=1))
+    return info
+
+
+def camera_at(camera, width: int, height: int):
+    """`camera` resized to width x height; the projection keeps its horizontal field of view (exact when
+    the aspect ratio is unchanged, as for 1920x1080 -> 320x180)."""
+    from addon.engine.scene import Camera
+
+    proj = np.array(camera.projection, np.float64)
+    if (width, height) != (camera.width, camera.height):
+        proj[1, 1] = proj[0, 0] * width / height
+    return Camera(view=np.array(camera.view, np.float64), projection=proj, width=int(width), height=int(height))
+
+
+def load_scene(path_stem: Path, size: tuple[int, int] | None = None):
+    """The Scene saved by save_scene, its camera resized to `size` (None: as saved)."""
+    from addon.engine.scene import Camera, Light, Scene
+
+    info = json.loads(path_stem.with_suffix(".json").read_text())
+    with np.load(path_stem.with_suffix(".npz")) as z:
+        arrays = {k: z[k] for k in z.files}
+    names = {f.name for f in dataclasses.fields(Light)}
+    lights = [Light(**{k: (np.array(v) if isinstance(v, list) else v) for k, v in d.items() if k in names})
+              for d in info["lights"]]
+    cam = info.get("camera")
+    camera = None
+    if cam is not None:
+        camera = Camera(view=np.array(cam["view"]), projection=np.array(cam["projection"]),
+                        width=int(cam["width"]), height=int(cam["height"]))
+        if size is not None:
+            camera = camera_at(camera, *size)
+    return Scene(positions_m=arrays["positions_m"], normals=arrays["normals"], albedo=arrays["albedo"],
+                 emission=arrays["emission"], lights=lights,
+                 world_color=np.array(info["world_color"], np.float32), camera=camera,
+                 warnings=list(info.get("warnings", [])), camera_visible=arrays["camera_visible"])
+
+
+def export(out: Path, names: list[str]) -> None:
+    """Build/open each scene in Blender, capture it at 1920x1080 and save it (needs bpy)."""
+    import bpy
+
+    from addon.bridge import scenes
+    from addon.bridge.capture import SceneCache, define_light_switch
+    from addon.bridge.pipeline import open_blend
+
+    out.mkdir(parents=True, exist_ok=True)
+    for name in names:
+        if name == "sponza":
+            if not SPONZA.exists():
+                print(f"skip sponza: {SPONZA} not found", file=sys.stderr)
+                continue
+            open_blend(SPONZA)
+            source = str(SPONZA)
+        else:
+            scenes.build(name)
+            source = f"addon.bridge.scenes.build({name!r})"
+        define_light_switch()
+        captured = SceneCache().update(bpy.context.evaluated_depsgraph_get(), *EXPORT_SIZE)
+        info = save_scene(captured, out / name, {"name": name, "source": source,
+                                                 "blender_version": bpy.app.version_string})
+        size = (out / f"{name}.npz").stat().st_size
+        print(f"{name}: {info['triangles']} triangles, lights {[d['kind'] for d in info['lights']]}, "
+              f"{size / 2**20:.2f} MiB")
+
+
+# --------------------------------------------------------------------------------------- GL timers
+
+class GpuTimestamps:
+    """GL_TIMESTAMP queries (glQueryCounter) around each pass: GPU time per pass without stalling the
+    pipeline. Functions come from eglGetProcAddress, so it works wherever the EGL context does."""
+
+    GL_TIMESTAMP = 0x8E28
+    GL_QUERY_RESULT = 0x8866
+
+    def __init__(self):
+        self.available = False
+        self.error = ""
+        try:
+            egl = ctypes.CDLL(ctypes.util.find_library("EGL") or "libEGL.so.1")
+            egl.eglGetProcAddress.restype = ctypes.c_void_p
+            egl.eglGetProcAddress.argtypes = [ctypes.c_char_p]
+
+            def fn(name, *argtypes):
+                addr = egl.eglGetProcAddress(name.encode())
+                if not addr:
+                    raise RuntimeError(f"eglGetProcAddress({name}) failed")
+                return ctypes.CFUNCTYPE(None, *argtypes)(addr)
+
+            self._gen = fn("glGenQueries", ctypes.c_int, ctypes.POINTER(ctypes.c_uint))
+            self._counter = fn("glQueryCounter", ctypes.c_uint, ctypes.c_uint)
+            self._result = fn("glGetQueryObjectui64v", ctypes.c_uint, ctypes.c_uint,
+                              ctypes.POINTER(ctypes.c_uint64))
+            self._pool: list[int] = []
+            self._used = 0
+            self.records: list[tuple[str, int, int]] = []
+            self.available = True
+        except Exception as exc:  # noqa: BLE001 - reported, wall-clock timings still run
+            self.error = f"{type(exc).__name__}: {exc}"
+
+    def _query(self) -> int:
+        if self._used == len(self._pool):
+            ids = (ctypes.c_uint * 64)()
+            self._gen(64, ids)
+            self._pool.extend(int(i) for i in ids)
+        q = self._pool[self._used]
+        self._used += 1
+        self._counter(q, self.GL_TIMESTAMP)
+        return q
+
+    def begin_update(self) -> None:
+        self._used = 0
+        self.records = []
+
+    def timed(self, timings: dict, name: str):
+        """Drop-in for method.timed: a context manager stamping the GPU timeline before and after."""
+        import contextlib
+
+        @contextlib.contextmanager
+        def cm():
+            q0 = self._query()
+            yield
+            self.records.append((name, q0, self._query()))
+
+        return cm()
+
+    def end_update(self) -> dict[str, float]:
+        """Per-pass GPU ms of the update just finished (call after glFinish): passes summed over light
+        faces; `total` the longest (outermost) span, as the methods nest their totals."""
+        value = ctypes.c_uint64()
+        out: dict[str, float] = {}
+        for name, q0, q1 in self.records:
+            self._result(q0, self.GL_QUERY_RESULT, ctypes.byref(value))
+            t0 = value.value
+            self._result(q1, self.GL_QUERY_RESULT, ctypes.byref(value))
+            ms = (value.value - t0) / 1e6
+            out[name] = max(out.get(name, 0.0), ms) if name == "total" else out.get(name, 0.0) + ms
+        return out
+
+
+# --------------------------------------------------------------------------------------- runs
+
+def configs(vct_available: bool):
+    """(label, GIConfig kwargs, RsmConfig kwargs, LpvConfig / VctConfig kwargs or None)."""
+    rows = [
+        ("direct", {"method": "direct"}, {}, None),
+        ("rsm-256vpl", {"method": "rsm"}, {"vpl_samples": 256}, None),
+        ("rsm-256vpl-voxelvis64", {"method": "rsm"}, {"vpl_samples": 256, "visibility": "voxel",
+                                                       "voxel_cells": 64}, None),
+        ("lpv-improved-gv-32", {"method": "lpv"}, {},
+         {"grid_cells": 32, "variant": "improved", "geometry_volume": True}),
+        ("lpv-improved-gv-64", {"method": "lpv"}, {},
+         {"grid_cells": 64, "variant": "improved", "geometry_volume": True}),
+        ("lpv-classic-32", {"method": "lpv"}, {}, {"grid_cells": 32, "variant": "classic"}),
+    ]
+    if vct_available:
+        rows += [("vct-64", {"method": "vct"}, {}, {"voxel_cells": 64}),
+                 ("vct-64-6cones", {"method": "vct"}, {}, {"voxel_cells": 64, "diffuse_cones": 6}),
+                 ("vct-128", {"method": "vct"}, {}, {"voxel_cells": 128})]
+    return rows
+
+
+def make_method(be, gi_kw: dict, rsm_kw: dict, extra_kw: dict | None, resolution: int):
+    """The method instance; VCT's config class is looked up by name (VctConfig) since it may not exist
+    yet when this tool was written."""
+    from addon.engine import config, methods
+
+    gi = config.GIConfig(resolution=resolution, **gi_kw)
+    rsm = config.RsmConfig(**rsm_kw)
+    if gi.method == "lpv":
+        return methods.create(be, gi, rsm, config.LpvConfig(**extra_kw))
+    if gi.method == "vct":
+        cls = methods.get("vct")
+        vct_cfg = getattr(config, "VctConfig", None)
+        if vct_cfg is None:
+            return cls(be, gi, rsm)
+        fields = {f.name for f in dataclasses.fields(vct_cfg)}
+        kw = {k: v for k, v in (extra_kw or {}).items() if k in fields}
+        return cls(be, gi, rsm, vct_cfg(**kw))
+    return methods.create(be, gi, rsm)
+
+
+def summary(values: list[float]) -> dict:
+    arr = np.asarray(values, np.float64)
+    return {"median": float(np.median(arr)), "p90": float(np.percentile(arr, 90)), "min": float(arr.min()),
+            "n": int(arr.size)}
+
+
+def per_pass(runs: list[dict[str, float]]) -> dict[str, dict]:
+    names = list(dict.fromkeys(k for r in runs for k in r))
+    out = {k: summary([r.get(k, 0.0) for r in runs]) for k in names}
+    lpv = [k for k in LPV_PASSES if k in names]
+    if lpv:  # the issue's LPV figure: injection + propagation + lookup
+        out["lpv_inject+propagate+lookup"] = summary([sum(r.get(k, 0.0) for k in lpv) for r in runs])
+    vct = [k for k in VCT_PASSES if k in names]
+    if vct:
+        out["vct_inject+pyramid"] = summary([sum(r.get(k, 0.0) for k in vct) for r in runs])
+    return out
+
+
+def time_method(be, method, scene, warmup: int, repeat: int, stamps: GpuTimestamps) -> dict:
+    res: dict = {}
+    be.finish()
+    t0 = time.perf_counter()
+    method.set_scene(scene)
+    be.finish()
+    res["set_scene_ms"] = (time.perf_counter() - t0) * 1e3
+
+    # 1. what an update costs: no per-pass waits, one finish at the end
+    method.profile = False
+    for _ in range(warmup):
+        method.compute()
+    be.finish()
+    totals = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        method.compute()
+        be.finish()
+        totals.append((time.perf_counter() - t0) * 1e3)
+    res["wall_total"] = summary(totals)
+
+    # 2. GPU timestamps per pass (no waits between passes)
+    if stamps.available:
+        method.profile = True
+        method.timed = stamps.timed  # instance attribute shadows DirectMethod.timed
+        try:
+            runs = []
+            for i in range(warmup + repeat):
+                stamps.begin_update()
+                method.compute()
+                be.finish()
+                r = stamps.end_update()
+                if i >= warmup:
+                    runs.append(r)
+            res["gpu"] = per_pass(runs)
+        finally:
+            del method.timed
+
+    # 3. method.profile: glFinish around every pass
+    method.profile = True
+    for _ in range(warmup):
+        method.compute()
+    res["wall_profiled"] = per_pass([method.compute() for _ in range(repeat)])
+
+    # 4. re-voxelization alone (done once per geometry change in set_scene; per update for dynamic scenes)
+    voxelizer = getattr(method, "voxelizer", None) or getattr(method, "_voxelizer", None)
+    if voxelizer is not None:
+        wall, gpu = [], []
+        for i in range(warmup + repeat):
+            if stamps.available:
+                stamps.begin_update()
+            be.finish()
+            t0 = time.perf_counter()
+            if stamps.available:
+                with stamps.timed({}, "voxelize"):
+                    voxelizer.run()
+            else:
+                voxelizer.run()
+            be.finish()
+            if i >= warmup:
+                wall.append((time.perf_counter() - t0) * 1e3)
+                if stamps.available:
+                    gpu.append(stamps.end_update()["voxelize"])
+        res["voxelize"] = {"wall": summary(wall), **({"gpu": summary(gpu)} if gpu else {})}
+    res["gl_error"] = be.gl_error()
+    return res
+
+
+def _patch_gl_library() -> None:
+    """The backend opens libGL for glFramebufferTextureLayer; where libGL.so.1 cannot load (glvnd's
+    libGLX needs libX11, absent on a bare GPU machine) fall back to libOpenGL.so.0 (no X11)."""
+    from addon.engine.backends import moderngl_backend as mb
+
+    original = mb._gl_library
+
+    def gl_library():
+        try:
+            return original()
+        except OSError:
+            for name in ("libOpenGL.so.0", ctypes.util.find_library("OpenGL")):
+                if name:
+                    try:
+                        return ctypes.CDLL(name)
+                    except OSError:
+                        pass
+            raise
+
+    mb._gl_library = gl_library
+
+
+def run(scenes_dir: Path, out: Path, size: tuple[int, int], repeat: int, warmup: int,
+        only_scenes: list[str] | None, only_configs: list[str] | None) -> dict:
+    from addon.engine import methods
+    from addon.engine.backends.moderngl_backend import ModernGLBackend
+    from addon.engine.errors import ConfigError
+
+    _patch_gl_library()
+    out.mkdir(parents=True, exist_ok=True)
+    be = ModernGLBackend()
+    be.ctx.__enter__()  # keep the context current: the backend then skips eglMakeCurrent per call
+    stamps = GpuTimestamps()
+    try:
+        methods.get("vct")
+        vct = True
+    except ConfigError:
+        vct = False
+    report = {
+        "renderer": be.renderer,
+        "gl_vendor": be.ctx.info.get("GL_VENDOR"),
+        "host": platform.node(),
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "moderngl": __import__("moderngl").__version__,
+        "size": list(size),
+        "warmup": warmup,
+        "repeat": repeat,
+        "timers": {
+            "wall_total": "perf_counter around compute() with method.profile=False + one glFinish",
+            "gpu": ("GL_TIMESTAMP queries (glQueryCounter) around every pass, no waits; "
+                    + ("available" if stamps.available else f"UNAVAILABLE: {stamps.error}")),
+            "wall_profiled": "method.profile=True: perf_counter with glFinish before/after every pass",
+        },
+        "context": "EGL context kept current for the whole process",
+        "vct": "timed" if vct else "skipped: addon.engine.methods.get('vct') raised ConfigError",
+        "scenes": {},
+    }
+    print(f"renderer: {report['renderer']}; numpy {np.__version__}; gpu timers: {report['timers']['gpu']}",
+          flush=True)
+    stems = sorted(p.with_suffix("") for p in scenes_dir.glob("*.npz"))
+    for stem in stems:
+        if only_scenes and stem.name not in only_scenes:
+            continue
+        scene = load_scene(stem, size)
+        entry = {"triangles": scene.triangle_count, "lights": [light.kind for light in scene.lights], "configs": {}}
+        report["scenes"][stem.name] = entry
+        for label, gi_kw, rsm_kw, extra in configs(vct):
+            if only_configs and label not in only_configs:
+                continue
+            t0 = time.perf_counter()
+            try:
+                method = make_method(be, gi_kw, rsm_kw, extra, max(size))
+                result = time_method(be, method, scene, warmup, repeat, stamps)
+                result["config"] = {"gi": gi_kw, "rsm": rsm_kw, "extra": extra}
+                grid = getattr(method, "grid", None)
+                if grid is not None:
+                    result["grid_dims"] = list(grid.dims)
+                if hasattr(method, "lpv_config"):
+                    from addon.engine.methods.lpv import iterations_for
+
+                    result["propagation_steps"] = iterations_for(method.lpv_config, method.grid)
+                del method
+            except Exception as exc:  # noqa: BLE001 - one failing config must not lose the others
+                result = {"error": f"{type(exc).__name__}: {exc}", "traceback": traceback.format_exc()}
+            entry["configs"][label] = result
+            gpu_total = result.get("gpu", {}).get("total", {}).get("median", float("nan"))
+            msg = result.get("error") or (f"total {result['wall_total']['median']:.3f} ms wall, "
+                                          f"gpu {gpu_total:.3f} ms")
+            print(f"{stem.name:8s} {label:24s} {msg}  ({time.perf_counter() - t0:.1f} s)", flush=True)
+            (out / "timings.json").write_text(json.dumps(report, indent=1))
+    (out / "timings.json").write_text(json.dumps(report, indent=1))
+    (out / "timings.md").write_text(markdown(report))
+    return report
+
+
+def _fmt(stat: dict | None) -> str:
+    return "-" if not stat else f"{stat['median']:.3f} / {stat['p90']:.3f}"
+
+
+def markdown(report: dict) -> str:
+    w, h = report["size"]
+    lines = [f"# GPU timings at {w}x{h}", "",
+             f"Renderer: {report['renderer']}; numpy {report['numpy']}, moderngl {report['moderngl']}; "
+             f"{report['warmup']} warm-up + {report['repeat']} timed updates per config; VCT: {report['vct']}.",
+             "",
+             "Times in ms, median / p90. " + "; ".join(f"**{k}**: {v}" for k, v in report["timers"].items()) + ".",
+             "",
+             "Issue targets: LPV inject+propagate+lookup (GPU) <= 1 ms at 32^3, <= 3 ms at 64^3; VCT voxelize + "
+             "inject + pyramid (GPU medians summed) <= 2 ms at 128^3 on sponza, vct_gather <= 2 ms.",
+             "",
+             "| scene | config | grid | set_scene | wall total | GPU total | GPU target passes | GPU voxelize |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for scene, entry in report["scenes"].items():
+        for label, r in entry["configs"].items():
+            if "error" in r:
+                lines.append(f"| {scene} | {label} | | ERROR: {r['error']} | | | | |")
+                continue
+            grid = "x".join(map(str, r["grid_dims"])) if "grid_dims" in r else ""
+            if "propagation_steps" in r:
+                grid += f" ({r['propagation_steps']} steps)"
+            gpu = r.get("gpu", {})
+            vox = r.get("voxelize", {}).get("gpu")
+            target = ""
+            if "lpv_inject+propagate+lookup" in gpu:
+                target = f"inject+propagate+lookup {_fmt(gpu['lpv_inject+propagate+lookup'])}"
+            elif "vct_inject+pyramid" in gpu:
+                both = gpu["vct_inject+pyramid"]["median"] + (vox["median"] if vox else float("nan"))
+                target = (f"voxelize+inject+pyramid {both:.3f}; gather {_fmt(gpu.get('vct_gather'))}")
+            lines.append(f"| {scene} | {label} | {grid} | {r['set_scene_ms']:.1f} | {_fmt(r['wall_total'])} | "
+                         f"{_fmt(gpu.get('total'))} | {target} | {_fmt(vox)} |")
+    lines += ["", "## Per pass (median / p90 ms): GPU timestamps | wall with glFinish around each pass", ""]
+    for scene, entry in report["scenes"].items():
+        for label, r in entry["configs"].items():
+            if "error" in r:
+                continue
+            gpu, wall = r.get("gpu", {}), r["wall_profiled"]
+            passes = list(dict.fromkeys([*gpu, *wall]))
+            lines.append(f"**{scene} / {label}**: " + ", ".join(
+                f"{p} {_fmt(gpu.get(p))} | {_fmt(wall.get(p))}" for p in passes))
+            lines.append("")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    ex = sub.add_parser("export", help="capture the scenes (needs bpy)")
+    ex.add_argument("--out", type=Path, default=Path(".gpubench"))
+    ex.add_argument("--scenes", nargs="*", default=list(SCENES))
+    rn = sub.add_parser("run", help="time the methods (needs moderngl and an EGL GL 4.3 context)")
+    rn.add_argument("--scenes", type=Path, default=Path(".gpubench"))
+    rn.add_argument("--out", type=Path, required=True)
+    rn.add_argument("--res", default="1920x1080")
+    rn.add_argument("--repeat", type=int, default=20)
+    rn.add_argument("--warmup", type=int, default=3)
+    rn.add_argument("--only-scenes", nargs="*")
+    rn.add_argument("--only-configs", nargs="*")
+    args = ap.parse_args(argv)
+    if args.cmd == "export":
+        export(args.out, args.scenes)
+        return 0
+    w, h = (int(v) for v in args.res.lower().split("x"))
+    report = run(args.scenes, args.out, (w, h), args.repeat, args.warmup, args.only_scenes, args.only_configs)
+    print(markdown(report))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
