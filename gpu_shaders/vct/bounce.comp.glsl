@@ -22,9 +22,11 @@ void main() {
         }
         n = normalize(n);
         vec3 p = grid_origin + (vec3(c) + 0.5) * cell_size;
-        float turn = 6.28318531 * random01(uint(c.x), uint(c.y), uint(c.z) ^ uint(seed) * 65536u);
-        e_pos = albedo.rgb * gather_diffuse(p, n, turn).rgb;
-        e_neg = albedo.rgb * gather_diffuse(p, -n, turn).rgb;
+        uint s = uint(c.z) ^ (uint(seed) * 131072u);
+        float turn = 6.28318531 * random01(uint(c.x), uint(c.y), s);
+        float jitter = random01(uint(c.x), uint(c.y), s ^ 65536u);
+        e_pos = albedo.rgb * gather_diffuse(p, n, turn, jitter).rgb;
+        e_neg = albedo.rgb * gather_diffuse(p, -n, turn, jitter).rgb;
     }
     // Light leaving along +axis comes from the side whose normal has a positive component on it.
     imageStore(next_px, c, vec4((n.x >= 0.0 ? e_pos : e_neg) * proj.x, 0.0));

@@ -7,9 +7,11 @@
 const int MAX_CONE_STEPS = 96;
 // Sampled voxels are at most this fraction of the distance travelled: grid-aligned blocks as wide as
 // the cone (1.2 t for 6 cones) reach back behind the origin and meet the back of the gatherer's own
-// surface, opaque and dark (a closed box of radiance 1 read 0.31 straight up; 0.9 with this cap).
+// surface, opaque and dark (a closed box of radiance 1 read 0.31 straight up; 0.9 with a cap of 0.25).
+// 0.15 rather than 0.25: blocks that straddle a thin wall blend the far room in (the hard-case thin
+// wall leaked 1.8 % at 0.25, 0.8 % at 0.15; cornell rel_rmse_8 0.172 -> 0.163, gather time x1.4).
 // The cone is then sampled narrower than it is wide: an estimate of its mean radiance from its core.
-const float SIDE_CAP = 0.25;
+const float SIDE_CAP = 0.15;
 #define START_CELLS 0.5
 
 // Trilinear sample of one direction's texture at level `level`, clamped to that level's cells
@@ -94,25 +96,29 @@ void tangent_frame(vec3 n, out vec3 tx, out vec3 ty) {
     ty = vec3(b, s + n.y * n.y * a, -n.y);
 }
 
-// Diffuse gather about normal n at position p (m): `diffuse_cones` cones splitting the hemisphere
-// into equal solid angles (cos theta uniform in (0, 1], a golden-angle spiral in phi), each of solid
-// angle 2 pi / N and weighted by its cos theta; weights sum to 1, so a uniform environment of
-// radiance L returns exactly L. `rotation` (radians) turns the spiral about n: a per-receiver random
-// turn makes the cones' aliasing (bands where a cone edge crosses a wall) unstructured noise, which
-// neighbouring pixels average. Returns (E / pi, the cosine-weighted occlusion).
-vec4 gather_diffuse(vec3 p, vec3 n, float rotation) {
+// Diffuse gather about normal n at position p (m): `diffuse_cones` cones, one per band of equal solid
+// angle 2 pi / N (cos theta in [1 - (i + 1) / N, 1 - i / N]), at cos theta = 1 - (i + jitter) / N and a
+// golden-angle spiral in phi turned by `rotation`; each weighted by its cos theta, the weights
+// normalised to sum 1, so a uniform environment of radiance L returns exactly L. The side cap makes
+// each cone a narrow probe of its band: with fixed elevations the probes never looked along the normal
+// (a small source straight ahead read 0.16 at 24 cells); with the per-receiver jitter and rotation
+// (uniform in [0, 1) and [0, 2 pi)) every direction is probed on average, and neighbouring pixels
+// average the noise. Returns (E / pi, the cosine-weighted opacity).
+vec4 gather_diffuse(vec3 p, vec3 n, float rotation, float jitter) {
     vec3 tx, ty;
     tangent_frame(n, tx, ty);
     vec3 g0 = (p - grid_origin) / cell_size + offset_cells * n;
     float cos_half = 1.0 - 1.0 / float(diffuse_cones);
     float tan_half = sqrt(max(1.0 - cos_half * cos_half, 0.0)) / cos_half;
     vec4 sum = vec4(0.0);
+    float weights = 0.0;
     for (int i = 0; i < diffuse_cones; i++) {
-        float z = 1.0 - (float(i) + 0.5) / float(diffuse_cones);
+        float z = max(1.0 - (float(i) + jitter) / float(diffuse_cones), 1e-3);
         float r = sqrt(max(1.0 - z * z, 0.0));
         float phi = 2.39996323 * float(i) + rotation;
         vec3 d = normalize(tx * (r * cos(phi)) + ty * (r * sin(phi)) + n * z);
-        sum += (2.0 * z / float(diffuse_cones)) * trace_cone(g0, d, tan_half, dot(d, n));
+        sum += z * trace_cone(g0, d, tan_half, dot(d, n));
+        weights += z;
     }
-    return sum;
+    return sum / weights;
 }

@@ -14,7 +14,9 @@ void main() {
         return;
     }
     vec3 n = normalize(texelFetch(gbuf_normal, px, 0).xyz);
-    vec4 e = gather_diffuse(pos.xyz, n, 6.28318531 * random01(uint(px.x), uint(px.y), uint(seed)));
+    uint s = uint(seed) * 2u;
+    vec4 e = gather_diffuse(pos.xyz, n, 6.28318531 * random01(uint(px.x), uint(px.y), s),
+                            random01(uint(px.x), uint(px.y), s + 1u));
     imageStore(indirect, px, vec4(e.rgb, 1.0));
     imageStore(ao, px, vec4(vec3(1.0 - e.a), 1.0));
 }

@@ -46,11 +46,29 @@ KNOWN_DEFECTS = {
 }
 
 
+# Known defects of `vct` (defaults: 64 cells, 16 cones), measured on llvmpipe, 48 px. A voxel holds
+# both faces of a wall thinner than a cell, and a cone passing near it reads the far face's light.
+VCT = "vct: "
+VCT_KNOWN_DEFECTS = {
+    "test_camera_inside_closed_block[vct]": "indirect up to 0.054 inside a closed block (exact 0): its walls are "
+                                            "one cell thick, so their lit outer faces share voxels with the "
+                                            "inner faces the cones pass",
+    "test_light_inside_closed_box_stays_inside[vct]": "indirect outside up to 0.029 x P/(6 pi) (exact 0): the "
+                                                      "box's one-cell walls hold its lit inner faces",
+    "test_light_moving_1mm_per_frame[vct]": "frame-to-frame change 0.0100 against 0.007: a VPL's flux moves a "
+                                            "whole voxel when it crosses a cell border (injection is not "
+                                            "filtered)",
+}
+
+
 def pytest_collection_modifyitems(items):
     for item in items:
         reason = KNOWN_DEFECTS.get(item.name)
         if reason is not None:
             item.add_marker(pytest.mark.xfail(strict=True, reason=LPV_CLASSIC + reason))
+        reason = VCT_KNOWN_DEFECTS.get(item.name)
+        if reason is not None:
+            item.add_marker(pytest.mark.xfail(strict=True, reason=VCT + reason))
 
 
 # Module-level rather than in a session fixture: the outcomes come from the report hook and are only
