@@ -41,8 +41,8 @@ SETTINGS: dict[str, tuple[dict, ...]] = {
     # The published scheme as the baseline row, and the improved transport (docs/LPV.md).
     "lpv": ({"lpv.variant": "classic", "lpv.geometry_volume": True},
             {"lpv.variant": "improved", "lpv.geometry_volume": True}),
-    # The two grid sizes, at the defaults otherwise (16 cones, docs/VCT.md).
-    "vct": ({"vct.voxel_cells": 64}, {"vct.voxel_cells": 128}),
+    # The two grid sizes at the defaults (16 cones, docs/VCT.md), and the half-resolution gather.
+    "vct": ({"vct.voxel_cells": 64}, {"vct.voxel_cells": 64, "vct.gather_scale": 2}, {"vct.voxel_cells": 128}),
 }
 REAL_SCENES = ("sponza", "sibenik", "conference")  # /work/shared/scenes/<name>/<name>.blend
 CURVE_SPP = (1, 4, 16, 64, 256)

@@ -29,6 +29,8 @@ def add_arguments(p) -> None:
     p.add_argument("--step-ratio", type=float, default=1.0, help="cone march step / sampled voxel size (vct)")
     p.add_argument("--cone-offset", type=float, default=1.5, help="cone origins off the surface, in cells (vct)")
     p.add_argument("--radiance", default="anisotropic", help="voxel radiance: anisotropic or isotropic (vct)")
+    p.add_argument("--gather-scale", type=int, default=1,
+                   help="cones at one pixel per n x n block, upsampled along edges (vct)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--repeat", type=int, default=3, help="timed runs after a warm-up (median reported)")
 
@@ -40,7 +42,7 @@ def run(args) -> int:
     lpv = LpvConfig(grid_cells=args.grid, iterations=args.iterations, variant=args.variant,
                     geometry_volume=args.geometry_volume)
     vct = VctConfig(voxel_cells=args.voxel_cells, diffuse_cones=args.cones, step_ratio=args.step_ratio,
-                    offset_cells=args.cone_offset, radiance=args.radiance)
+                    offset_cells=args.cone_offset, radiance=args.radiance, gather_scale=args.gather_scale)
     blend = existing_blend(args.blend)
     out = output_dir(args.out)
     from ..bridge.pipeline import render_file  # imports bpy: only when actually rendering

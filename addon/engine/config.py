@@ -94,6 +94,7 @@ class VctConfig(_Validated):
     diffuse_cones: int = _num(16, 3, 32, "cones per gather point, each 2 pi / n sr of the hemisphere")
     step_ratio: float = _num(1.0, 0.1, 2.0, "march step as a fraction of the sampled voxel's size")
     offset_cells: float = _num(1.5, 0.0, 4.0, "cone origins moved off their surface along the normal, in cells")
+    gather_scale: int = _num(1, 1, 4, "cones at one pixel per n x n block, upsampled along edges (1: every pixel)")
     radiance: str = _choice("anisotropic", ("anisotropic", "isotropic"),
                             "voxel radiance: six directions, or their mean (directional opacity kept)")
 

@@ -229,3 +229,27 @@ def test_wall_one_voxel_thick_stops_light(gl):
     print("wall: open", open_e[0, 0], "blocked", blocked_e[0, 0])
     assert open_e[0, 0] > 0.1
     assert blocked_e[0, 0] <= 0.01 * open_e[0, 0]
+
+
+def test_upsampling_keeps_depth_edges_and_flat_values(gl):
+    """Half-resolution light on two facing planes 10 cells apart in depth (left columns near, right
+    far): every full-size pixel takes its own plane's value, 1 or 5, to 1e-3 (the far plane's weight is
+    exp(-10) ~ 5e-5 of the near one's), and a flat plane's constant comes back unchanged."""
+    w, h, scale = 16, 8, 2
+    pos = np.zeros((h, w, 4), np.float32)
+    pos[..., 3] = 1.0
+    pos[:, :, 0] = np.arange(w) * 0.01
+    pos[:, :, 2] = np.where(np.arange(w) < 7, 0.0, 1.0)[None, :]  # depth step between columns 6 and 7
+    nrm = np.zeros((h, w, 4), np.float32)
+    nrm[..., 2] = 1.0
+    gbuf = {"position": gl.texture((w, h), data=pos), "normal": gl.texture((w, h), data=nrm)}
+    low_w, low_h = vct_gather.low_size((w, h), scale)
+    low_light = np.ones((low_h, low_w, 4), np.float32)
+    source_cols = np.minimum(np.arange(low_w) * scale + scale // 2, w - 1)
+    low_light[:, source_cols >= 7, :3] = 5.0
+    low = (gl.texture((low_w, low_h), data=low_light), gl.texture((low_w, low_h), data=low_light))
+    indirect, ao = gl.texture((w, h)), gl.texture((w, h))
+    vct_gather.upsample(gl, gbuf, low, indirect, ao, scale, cell_size_m=0.1)
+    got = gl.read(indirect)[..., 0]
+    want = np.where(np.arange(w) < 7, 1.0, 5.0)[None, :].repeat(h, axis=0)
+    np.testing.assert_allclose(got, want, rtol=1e-3)

@@ -50,7 +50,7 @@ class LpvMethod(OneBounceMethod):
         # Two snapshot sets (ping-pong; set 0 receives the injection) and the accumulation.
         self.snapshots = [{f"sh_{c}": be.texture(dims) for c in "rgb"} for _ in range(2)]
         self.accumulated = {f"acc_{c}": be.texture(dims) for c in "rgb"}
-        self._inject_targets = lpv_inject.layer_targets(be, self.snapshots[0], self.grid)
+        self.atlas, self.inject_atlas, self._inject_target = lpv_inject.atlas_target(be, self.grid)
         self._points = lpv_inject.texel_points(be, self.rsm_config.resolution)
         self.voxels = None
         if cfg.geometry_volume or self.gi.bounces > 1:
@@ -66,12 +66,11 @@ class LpvMethod(OneBounceMethod):
 
     def clear_products(self) -> None:
         super().clear_products()
-        for target in self._inject_targets:
-            self.backend.clear(target)
+        self.backend.clear(self._inject_target)
 
     def per_light_view(self, view: LightView, timings: dict[str, float]) -> None:
         with self.timed(timings, "lpv_inject"):
-            lpv_inject.run(self.backend, self._inject_targets, self._points, self.rsm, self.grid)
+            lpv_inject.run(self.backend, self._inject_target, self._points, self.rsm, self.grid, self.atlas)
 
     def propagate(self, iterations: int | None = None, accumulated: dict | None = None) -> None:
         """Propagate the injected snapshot (set 0) into `accumulated` (default: the total), overwriting
@@ -100,7 +99,8 @@ class LpvMethod(OneBounceMethod):
             with self.timed(timings, "lpv_propagate"):
                 self.propagate(accumulated=self.bounce_accumulated)
             with self.timed(timings, "lpv_lookup"):
-                lpv_lookup.run(be, self.gbuf, self.bounce_accumulated, self.indirect, grid, accumulate=True)
+                lpv_lookup.run(be, self.gbuf, self.bounce_accumulated, self.indirect, grid, accumulate=True,
+                               vox_normal=self.vox_normal)
             with self.timed(timings, "lpv_reinject"):
                 lpv_reinject.add(be, self.bounce_accumulated, self.accumulated, grid)
             previous = self.bounce_accumulated
@@ -112,9 +112,11 @@ class LpvMethod(OneBounceMethod):
             inner = super().compute(run_gbuffer)
             inner.pop("total", None)
             timings.update(inner)
+            with self.timed(timings, "lpv_inject"):
+                lpv_inject.unpack(be, self.inject_atlas, self.snapshots[0], self.grid, self.atlas)
             with self.timed(timings, "lpv_propagate"):
                 self.propagate()
             with self.timed(timings, "lpv_lookup"):
-                lpv_lookup.run(be, self.gbuf, self.accumulated, self.indirect, self.grid)
+                lpv_lookup.run(be, self.gbuf, self.accumulated, self.indirect, self.grid, vox_normal=self.vox_normal)
             self.add_bounces(timings)
         return timings

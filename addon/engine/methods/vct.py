@@ -50,6 +50,9 @@ class VctMethod(OneBounceMethod):
     def allocate_products(self, size: tuple[int, int]) -> None:
         super().allocate_products(size)
         self.ao = self.backend.texture(size)
+        scale = self.vct_config.gather_scale
+        low = vct_gather.low_size(size, scale)
+        self._low = (self.backend.texture(low), self.backend.texture(low)) if scale > 1 else None
 
     def product_textures(self) -> dict:
         return {**super().product_textures(), "ao": self.ao}
@@ -96,5 +99,5 @@ class VctMethod(OneBounceMethod):
             self.bounce_light(timings)
             with self.timed(timings, "vct_gather"):
                 vct_gather.pixels(self.backend, self.pyramid, self.gbuf, self.indirect, self.ao, self.grid,
-                                  self.vct_config, self.gi.seed)
+                                  self.vct_config, self.gi.seed, self._low)
         return timings

@@ -14,28 +14,36 @@ from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_coun
 from ..grid import Grid
 
 
-def _spec(accumulate: bool) -> ShaderSpec:
+def _spec(accumulate: bool, geometry_volume: bool) -> ShaderSpec:
+    defines = (("ACCUMULATE", "1"),) if accumulate else ()
+    extra = ()
+    if geometry_volume:
+        defines += (("GEOMETRY_VOLUME", "1"),)
+        extra = (Sampler("vox_normal", "3D"),)
     return ShaderSpec(
-        name="lpv_lookup_add" if accumulate else "lpv_lookup",
+        name=("lpv_lookup_add" if accumulate else "lpv_lookup") + ("_gv" if geometry_volume else ""),
         compute="lpv/lookup.comp.glsl",
         local_size=(8, 8, 1),
         samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("acc_r", "3D"),
-                  Sampler("acc_g", "3D"), Sampler("acc_b", "3D")),
+                  Sampler("acc_g", "3D"), Sampler("acc_b", "3D")) + extra,
         images=(Image("indirect", "2D", "RGBA32F", "read_write" if accumulate else "write"),),
         uniforms=(Var("grid_origin", "vec3"), Var("cell_size", "float"), Var("dims", "ivec3"),
                   Var("lookup_offset_cells", "float")),
-        defines=(("ACCUMULATE", "1"),) if accumulate else (),
+        defines=defines,
     )
 
 
-SPEC, ACCUMULATE_SPEC = _spec(False), _spec(True)
+SPECS = {(acc, gv): _spec(acc, gv) for acc in (False, True) for gv in (False, True)}
 
 
 def run(backend: Backend, gbuf: dict, acc: dict, indirect, grid: Grid, offset_cells: float = 0.5,
-        accumulate: bool = False) -> None:
-    """Write `indirect` from `acc`, or with `accumulate` add to it (one later bounce's volume)."""
-    spec = ACCUMULATE_SPEC if accumulate else SPEC
+        accumulate: bool = False, vox_normal=None) -> None:
+    """Write `indirect` from `acc`, or with `accumulate` add to it (one later bounce's volume); with
+    `vox_normal` (the geometry volume) the trilinear corners are weighted by their transmittance."""
+    spec = SPECS[(accumulate, vox_normal is not None)]
     samplers = {"gbuf_position": gbuf["position"], "gbuf_normal": gbuf["normal"], **acc}
+    if vox_normal is not None:
+        samplers["vox_normal"] = vox_normal
     backend.dispatch(backend.program(spec), group_count(indirect.size, spec.local_size),
                      uniforms={"grid_origin": grid.origin_m, "cell_size": grid.cell_size_m, "dims": grid.dims,
                                "lookup_offset_cells": offset_cells},

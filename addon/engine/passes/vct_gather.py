@@ -1,7 +1,9 @@
 """VCT cone gathers through the radiance pyramid (gpu_shaders/vct/cone.glsl).
 
 - pixels: at every G-buffer pixel, `diffuse_cones` cones about the normal -> `indirect` = E / pi
-  (Cycles' Diffuse Indirect units) and `ao` (1 - cosine-weighted cone opacity).
+  (Cycles' Diffuse Indirect units) and `ao` (1 - cosine-weighted cone opacity). With
+  VctConfig.gather_scale = s > 1 the cones run at one pixel per s x s block and an edge-aware
+  upsampling (normal and tangent-plane weights) fills the full-size images.
 - bounce: at every occupied voxel, the same gather on both sides of its surface -> the next bounce's
   level-0 colours (premultiplied radiance by travel direction), albedo x E / pi x projected area.
 
@@ -27,7 +29,17 @@ PIXELS = ShaderSpec(
     local_size=(8, 8, 1),
     samplers=(*_PYRAMID, Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D")),
     images=(Image("indirect", "2D"), Image("ao", "2D")),
-    uniforms=_CONE_UNIFORMS,
+    uniforms=(*_CONE_UNIFORMS, Var("scale", "int")),
+)
+
+UPSAMPLE = ShaderSpec(
+    name="vct_upsample",
+    compute="vct/upsample.comp.glsl",
+    local_size=(8, 8, 1),
+    samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("low_indirect", "2D"),
+              Sampler("low_ao", "2D")),
+    images=(Image("indirect", "2D"), Image("ao", "2D")),
+    uniforms=(Var("scale", "int"), Var("cell_size", "float")),
 )
 
 BOUNCE = ShaderSpec(
@@ -48,12 +60,32 @@ def cone_uniforms(grid: Grid, config: VctConfig, seed: int) -> dict:
             "offset_cells": config.offset_cells}
 
 
+def low_size(size: tuple[int, int], scale: int) -> tuple[int, int]:
+    """The gather's image size at 1/scale (rounded up: every pixel has a texel)."""
+    return (-(-size[0] // scale), -(-size[1] // scale))
+
+
 def pixels(backend: Backend, pyramid: dict, gbuf: dict, indirect, ao, grid: Grid, config: VctConfig,
-           seed: int = 0) -> None:
-    backend.dispatch(backend.program(PIXELS), group_count(indirect.size, PIXELS.local_size),
-                     uniforms=cone_uniforms(grid, config, seed),
+           seed: int = 0, low: tuple | None = None) -> None:
+    """Gather into `indirect` and `ao`; with config.gather_scale > 1, into `low` (two textures of
+    low_size) first, then upsample."""
+    scale = config.gather_scale
+    out = (indirect, ao) if scale == 1 else low
+    backend.dispatch(backend.program(PIXELS), group_count(out[0].size, PIXELS.local_size),
+                     uniforms={**cone_uniforms(grid, config, seed), "scale": scale},
                      samplers={**named(pyramid, "pyr"), "gbuf_position": gbuf["position"],
                                "gbuf_normal": gbuf["normal"]},
+                     images={"indirect": out[0], "ao": out[1]})
+    if scale > 1:
+        upsample(backend, gbuf, low, indirect, ao, scale, grid.cell_size_m)
+
+
+def upsample(backend: Backend, gbuf: dict, low: tuple, indirect, ao, scale: int, cell_size_m: float) -> None:
+    """`low` (indirect, ao at 1/scale) -> `indirect`, `ao` at the G-buffer's size, along its edges."""
+    backend.dispatch(backend.program(UPSAMPLE), group_count(indirect.size, UPSAMPLE.local_size),
+                     uniforms={"scale": scale, "cell_size": cell_size_m},
+                     samplers={"gbuf_position": gbuf["position"], "gbuf_normal": gbuf["normal"],
+                               "low_indirect": low[0], "low_ao": low[1]},
                      images={"indirect": indirect, "ao": ao})
 
 
