@@ -227,44 +227,31 @@ class GpuTimestamps:
 
 # --------------------------------------------------------------------------------------- runs
 
-def configs(vct_available: bool):
-    """(label, GIConfig kwargs, RsmConfig kwargs, LpvConfig / VctConfig kwargs or None)."""
-    rows = [
-        ("direct", {"method": "direct"}, {}, None),
-        ("rsm-256vpl", {"method": "rsm"}, {"vpl_samples": 256}, None),
+def configs():
+    """(label, GIConfig kwargs, RsmConfig kwargs, LpvConfig kwargs, VctConfig kwargs)."""
+    return [
+        ("direct", {"method": "direct"}, {}, {}, {}),
+        ("rsm-256vpl", {"method": "rsm"}, {"vpl_samples": 256}, {}, {}),
         ("rsm-256vpl-voxelvis64", {"method": "rsm"}, {"vpl_samples": 256, "visibility": "voxel",
-                                                       "voxel_cells": 64}, None),
-        ("lpv-improved-gv-32", {"method": "lpv"}, {},
-         {"grid_cells": 32, "variant": "improved", "geometry_volume": True}),
-        ("lpv-improved-gv-64", {"method": "lpv"}, {},
-         {"grid_cells": 64, "variant": "improved", "geometry_volume": True}),
-        ("lpv-classic-32", {"method": "lpv"}, {}, {"grid_cells": 32, "variant": "classic"}),
+                                                       "voxel_cells": 64}, {}, {}),
+        ("lpv-improved-gv-32", {"method": "lpv"}, {}, {"grid_cells": 32, "variant": "improved",
+                                                      "geometry_volume": True}, {}),
+        ("lpv-improved-gv-64", {"method": "lpv"}, {}, {"grid_cells": 64, "variant": "improved",
+                                                      "geometry_volume": True}, {}),
+        ("lpv-classic-32", {"method": "lpv"}, {}, {"grid_cells": 32, "variant": "classic"}, {}),
+        ("vct-64", {"method": "vct"}, {}, {}, {"voxel_cells": 64}),
+        ("vct-64-6cones", {"method": "vct"}, {}, {}, {"voxel_cells": 64, "diffuse_cones": 6}),
+        ("vct-64-6cones-half", {"method": "vct"}, {}, {}, {"voxel_cells": 64, "diffuse_cones": 6,
+                                                           "gather_scale": 2}),
+        ("vct-128", {"method": "vct"}, {}, {}, {"voxel_cells": 128}),
     ]
-    if vct_available:
-        rows += [("vct-64", {"method": "vct"}, {}, {"voxel_cells": 64}),
-                 ("vct-64-6cones", {"method": "vct"}, {}, {"voxel_cells": 64, "diffuse_cones": 6}),
-                 ("vct-128", {"method": "vct"}, {}, {"voxel_cells": 128})]
-    return rows
 
 
-def make_method(be, gi_kw: dict, rsm_kw: dict, extra_kw: dict | None, resolution: int):
-    """The method instance; VCT's config class is looked up by name (VctConfig) since it may not exist
-    yet when this tool was written."""
+def make_method(be, gi_kw: dict, rsm_kw: dict, lpv_kw: dict, vct_kw: dict, resolution: int):
     from addon.engine import config, methods
 
     gi = config.GIConfig(resolution=resolution, **gi_kw)
-    rsm = config.RsmConfig(**rsm_kw)
-    if gi.method == "lpv":
-        return methods.create(be, gi, rsm, config.LpvConfig(**extra_kw))
-    if gi.method == "vct":
-        cls = methods.get("vct")
-        vct_cfg = getattr(config, "VctConfig", None)
-        if vct_cfg is None:
-            return cls(be, gi, rsm)
-        fields = {f.name for f in dataclasses.fields(vct_cfg)}
-        kw = {k: v for k, v in (extra_kw or {}).items() if k in fields}
-        return cls(be, gi, rsm, vct_cfg(**kw))
-    return methods.create(be, gi, rsm)
+    return methods.create(be, gi, config.RsmConfig(**rsm_kw), config.LpvConfig(**lpv_kw), config.VctConfig(**vct_kw))
 
 
 def summary(values: list[float]) -> dict:
@@ -377,20 +364,13 @@ def _patch_gl_library() -> None:
 
 def run(scenes_dir: Path, out: Path, size: tuple[int, int], repeat: int, warmup: int,
         only_scenes: list[str] | None, only_configs: list[str] | None) -> dict:
-    from addon.engine import methods
     from addon.engine.backends.moderngl_backend import ModernGLBackend
-    from addon.engine.errors import ConfigError
 
     _patch_gl_library()
     out.mkdir(parents=True, exist_ok=True)
     be = ModernGLBackend()
     be.ctx.__enter__()  # keep the context current: the backend then skips eglMakeCurrent per call
     stamps = GpuTimestamps()
-    try:
-        methods.get("vct")
-        vct = True
-    except ConfigError:
-        vct = False
     report = {
         "renderer": be.renderer,
         "gl_vendor": be.ctx.info.get("GL_VENDOR"),
@@ -408,7 +388,6 @@ def run(scenes_dir: Path, out: Path, size: tuple[int, int], repeat: int, warmup:
             "wall_profiled": "method.profile=True: perf_counter with glFinish before/after every pass",
         },
         "context": "EGL context kept current for the whole process",
-        "vct": "timed" if vct else "skipped: addon.engine.methods.get('vct') raised ConfigError",
         "scenes": {},
     }
     print(f"renderer: {report['renderer']}; numpy {np.__version__}; gpu timers: {report['timers']['gpu']}",
@@ -420,14 +399,14 @@ def run(scenes_dir: Path, out: Path, size: tuple[int, int], repeat: int, warmup:
         scene = load_scene(stem, size)
         entry = {"triangles": scene.triangle_count, "lights": [light.kind for light in scene.lights], "configs": {}}
         report["scenes"][stem.name] = entry
-        for label, gi_kw, rsm_kw, extra in configs(vct):
+        for label, gi_kw, rsm_kw, lpv_kw, vct_kw in configs():
             if only_configs and label not in only_configs:
                 continue
             t0 = time.perf_counter()
             try:
-                method = make_method(be, gi_kw, rsm_kw, extra, max(size))
+                method = make_method(be, gi_kw, rsm_kw, lpv_kw, vct_kw, max(size))
                 result = time_method(be, method, scene, warmup, repeat, stamps)
-                result["config"] = {"gi": gi_kw, "rsm": rsm_kw, "extra": extra}
+                result["config"] = {"gi": gi_kw, "rsm": rsm_kw, "lpv": lpv_kw, "vct": vct_kw}
                 grid = getattr(method, "grid", None)
                 if grid is not None:
                     result["grid_dims"] = list(grid.dims)
@@ -457,7 +436,7 @@ def markdown(report: dict) -> str:
     w, h = report["size"]
     lines = [f"# GPU timings at {w}x{h}", "",
              f"Renderer: {report['renderer']}; numpy {report['numpy']}, moderngl {report['moderngl']}; "
-             f"{report['warmup']} warm-up + {report['repeat']} timed updates per config; VCT: {report['vct']}.",
+             f"{report['warmup']} warm-up + {report['repeat']} timed updates per config;",
              "",
              "Times in ms, median / p90. " + "; ".join(f"**{k}**: {v}" for k, v in report["timers"].items()) + ".",
              "",
