@@ -3,7 +3,16 @@
 // a surface of normal n is E = max(0, c . cosine_lobe(-n)) / h^2 (the grid stores direction of travel,
 // so the light arriving at the surface travels along -n). Output: E / pi (Cycles' Diffuse Indirect),
 // written, or with ACCUMULATE added to what `indirect` holds.
+// GEOMETRY_VOLUME: the 8 trilinear corners are weighted by their transmittance along n as propagation
+// saw it, 1 - min(1, area * |n_cell . n|), and renormalised: a cell holding the receiving surface (or
+// another surface facing the same way) holds light that entered it through a face its own geometry
+// half-blocked, not the light arriving at the surface (docs/LPV.md, "Lookup").
 #include "common/sh.glsl"
+
+vec4 lobe_dot(ivec3 c, vec4 lobe) {
+    return vec4(dot(texelFetch(acc_r, c, 0), lobe), dot(texelFetch(acc_g, c, 0), lobe),
+                dot(texelFetch(acc_b, c, 0), lobe), 0.0);
+}
 
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
@@ -17,11 +26,35 @@ void main() {
     }
     vec3 n = normalize(texelFetch(gbuf_normal, px, 0).xyz);
     vec3 g = (pos.xyz + (lookup_offset_cells * cell_size) * n - grid_origin) / cell_size;
-    vec3 uvw = g / vec3(dims);  // texel centres at (i + 0.5) / dims: linear filtering is trilinear SH
     vec4 lobe = sh_cosine_lobe(-n);
+#ifdef GEOMETRY_VOLUME
+    vec3 t = g - 0.5;  // cell centres at i + 0.5
+    ivec3 i0 = ivec3(floor(t));
+    vec3 f = t - vec3(i0);
+    vec4 sum_aware = vec4(0.0);
+    vec4 sum_plain = vec4(0.0);
+    float w_aware = 0.0;
+    for (int k = 0; k < 8; ++k) {
+        ivec3 corner = ivec3(k & 1, (k >> 1) & 1, k >> 2);
+        ivec3 c = clamp(i0 + corner, ivec3(0), dims - 1);  // clamp-to-edge, as the sampler does
+        vec3 wv = mix(1.0 - f, f, vec3(corner));
+        float w = wv.x * wv.y * wv.z;
+        vec4 nv = texelFetch(vox_normal, c, 0);
+        float through = 1.0 - min(1.0, nv.w * abs(dot(nv.xyz, n)));
+        vec4 v = lobe_dot(c, lobe);
+        sum_plain += w * v;
+        sum_aware += (w * through) * v;
+        w_aware += w * through;
+    }
+    // Every corner blocked (inside a solid): plain trilinear.
+    vec4 s = w_aware > 1e-4 ? sum_aware / w_aware : sum_plain;
+    vec3 e = max(s.rgb, vec3(0.0));
+#else
+    vec3 uvw = g / vec3(dims);  // texel centres at (i + 0.5) / dims: linear filtering is trilinear SH
     vec3 e = vec3(max(dot(texture(acc_r, uvw), lobe), 0.0),
                   max(dot(texture(acc_g, uvw), lobe), 0.0),
                   max(dot(texture(acc_b, uvw), lobe), 0.0));
+#endif
     vec3 out_e = e / (cell_size * cell_size * SH_A0);
 #ifdef ACCUMULATE
     // One bounce's volume added to the earlier bounces' image: each bounce is clamped on its own, so a

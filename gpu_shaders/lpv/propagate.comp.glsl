@@ -18,18 +18,74 @@
 const float FRONT_SOLID_ANGLE = 0.4006696846;
 const float SIDE_SOLID_ANGLE = 0.4234313544;
 
-// SH coefficient order (1, y, z, x): the index of axis a's coefficient.
-int coeff_of_axis(int a) {
-    return a == 0 ? 3 : a;
-}
+// The coefficient slot of each axis in the order (1, y, z, x), as a unit vec4.
+const vec4 SLOT[3] = vec4[3](vec4(0.0, 0.0, 0.0, 1.0), vec4(0.0, 1.0, 0.0, 0.0), vec4(0.0, 0.0, 1.0, 0.0));
+const vec4 DC = vec4(1.0, 0.0, 0.0, 0.0);
 
-float blocking(ivec3 c, vec3 d) {
+// Blocking of cell c for travel along the axis with unit vector e: nv = the cell's vox_normal.
+float blocking(vec4 nv, vec3 e) {
 #ifdef GEOMETRY_VOLUME
-    vec4 nv = texelFetch(vox_normal, c, 0);
-    return min(1.0, nv.w * abs(dot(nv.xyz, d)));
+    return min(1.0, nv.w * abs(dot(nv.xyz, e)));
 #else
     return 0.0;
 #endif
+}
+
+vec4 vox_at(ivec3 c) {
+#ifdef GEOMETRY_VOLUME
+    return texelFetch(vox_normal, c, 0);
+#else
+    return vec4(0.0);
+#endif
+}
+
+// What neighbour A sends into B along d = sgn * e (axis `axis`, unit vector e): M_d c_A per colour.
+// Written per direction with constant indices (the 6 directions are unrolled by the caller): dynamic
+// indexing into a mat4 or ivec3 spills to local memory on some GPUs.
+void transfer(vec4 ca, int axis, float sgn, inout vec4 acc_out) {
+#ifdef IMPROVED
+    // M_d c = m_side c + (1/6 - m_side) c0 e0 + (m_along - m_side) c_a e_a + sgn m_cross (c_a e0 + c0 e_a)
+    vec4 slot = SLOT[axis];
+    float c0 = ca.x;
+    float c_a = dot(ca, slot);
+    acc_out += m_side * ca + ((1.0 / 6.0 - m_side) * c0 + sgn * m_cross * c_a) * DC
+               + ((m_along - m_side) * c_a + sgn * m_cross * c0) * slot;
+#else
+    vec3 d = vec3(0.0);
+    d[axis] = sgn;
+    for (int f = 0; f < 6; ++f) {
+        vec3 fn = vec3(0.0);
+        fn[f / 2] = (f % 2 == 0) ? 1.0 : -1.0;
+        if (dot(fn, d) < -0.5) {
+            continue;  // the face B shares with A
+        }
+        bool front = dot(fn, d) > 0.5;
+        vec3 w = front ? d : normalize(d + 0.5 * fn);
+        float omega = front ? FRONT_SOLID_ANGLE : SIDE_SOLID_ANGLE;
+        acc_out += dot(ca, sh_basis(w)) * sh_cosine_lobe(fn) * (omega / SH_A0);
+    }
+#endif
+}
+
+// Light of neighbour A = B - sgn * e_axis entering B, scaled by the geometry volume's pass-through.
+void gather(ivec3 b, vec4 vox_b, int axis, float sgn, inout vec4 out_r, inout vec4 out_g, inout vec4 out_b) {
+    ivec3 di = ivec3(0);
+    di[axis] = int(sgn);
+    ivec3 a = b - di;
+    if (any(lessThan(a, ivec3(0))) || any(greaterThanEqual(a, dims))) {
+        return;
+    }
+    vec3 e = vec3(di);
+    float pass_through = 1.0 - 0.5 * (blocking(vox_at(a), e) + blocking(vox_b, e));
+    vec4 r = vec4(0.0);
+    vec4 g = vec4(0.0);
+    vec4 bl = vec4(0.0);
+    transfer(texelFetch(src_r, a, 0), axis, sgn, r);
+    transfer(texelFetch(src_g, a, 0), axis, sgn, g);
+    transfer(texelFetch(src_b, a, 0), axis, sgn, bl);
+    out_r += pass_through * r;
+    out_g += pass_through * g;
+    out_b += pass_through * bl;
 }
 
 void main() {
@@ -40,54 +96,13 @@ void main() {
     vec4 out_r = vec4(0.0);
     vec4 out_g = vec4(0.0);
     vec4 out_b = vec4(0.0);
-    for (int k = 0; k < 6; ++k) {
-        int axis = k / 2;
-        float sgn = (k % 2 == 0) ? 1.0 : -1.0;
-        ivec3 di = ivec3(0);
-        di[axis] = int(sgn);
-        vec3 d = vec3(di);
-        ivec3 a = b - di;
-        if (any(lessThan(a, ivec3(0))) || any(greaterThanEqual(a, dims))) {
-            continue;
-        }
-        vec4 ca_r = texelFetch(src_r, a, 0);
-        vec4 ca_g = texelFetch(src_g, a, 0);
-        vec4 ca_b = texelFetch(src_b, a, 0);
-        float pass_through = 1.0 - 0.5 * (blocking(a, d) + blocking(b, d));
-#ifdef IMPROVED
-        // M_d c: linear, so apply it per channel through a 4x4 matrix built from the symmetric form.
-        int ia = coeff_of_axis(axis);
-        mat4 m = mat4(0.0);  // m[col][row]
-        m[0][0] = 1.0 / 6.0;
-        for (int i = 1; i < 4; ++i) {
-            m[i][i] = m_side;
-        }
-        m[ia][ia] = m_along;
-        m[0][ia] = sgn * m_cross;
-        m[ia][0] = sgn * m_cross;
-        out_r += pass_through * (m * ca_r);
-        out_g += pass_through * (m * ca_g);
-        out_b += pass_through * (m * ca_b);
-#else
-        for (int f = 0; f < 6; ++f) {
-            int faxis = f / 2;
-            float fsgn = (f % 2 == 0) ? 1.0 : -1.0;
-            vec3 fn = vec3(0.0);
-            fn[faxis] = fsgn;
-            if (dot(fn, d) < -0.5) {
-                continue;  // the face B shares with A
-            }
-            bool front = dot(fn, d) > 0.5;
-            vec3 w = front ? d : normalize(d + 0.5 * fn);
-            float omega = front ? FRONT_SOLID_ANGLE : SIDE_SOLID_ANGLE;
-            vec4 basis = sh_basis(w);
-            vec4 lobe = sh_cosine_lobe(fn) * (pass_through * omega / SH_A0);
-            out_r += dot(ca_r, basis) * lobe;
-            out_g += dot(ca_g, basis) * lobe;
-            out_b += dot(ca_b, basis) * lobe;
-        }
-#endif
-    }
+    vec4 vox_b = vox_at(b);
+    gather(b, vox_b, 0, 1.0, out_r, out_g, out_b);
+    gather(b, vox_b, 0, -1.0, out_r, out_g, out_b);
+    gather(b, vox_b, 1, 1.0, out_r, out_g, out_b);
+    gather(b, vox_b, 1, -1.0, out_r, out_g, out_b);
+    gather(b, vox_b, 2, 1.0, out_r, out_g, out_b);
+    gather(b, vox_b, 2, -1.0, out_r, out_g, out_b);
     imageStore(dst_r, b, out_r);
     imageStore(dst_g, b, out_g);
     imageStore(dst_b, b, out_b);

@@ -16,7 +16,7 @@ from addon.engine import sh
 from addon.engine.config import GIConfig, LpvConfig, RsmConfig
 from addon.engine.grid import Grid
 from addon.engine.methods.lpv import LpvMethod
-from addon.engine.passes import lpv_inject, lpv_propagate, lpv_reinject
+from addon.engine.passes import lpv_inject, lpv_lookup, lpv_propagate, lpv_reinject
 from addon.engine.scene import Camera, Light, Scene
 from addon.engine.transforms import look_along, perspective
 
@@ -152,11 +152,12 @@ def test_injection_of_one_vpl_gives_its_lobe(gl):
     nrm[3, 0] = [*n2, 0.01]
     phi[3, 0, :3] = f2
     rsm = {k: gl.texture((res, res), "RGBA32F", a) for k, a in (("position", pos), ("normal", nrm), ("flux", phi))}
-    vols = volumes(gl, grid.dims)
-    targets = lpv_inject.layer_targets(gl, vols, grid)
-    for t in targets:
-        gl.clear(t)
-    lpv_inject.run(gl, targets, lpv_inject.texel_points(gl, res), rsm, grid)
+    vols = volumes(gl, grid.dims, [np.full(tuple(reversed(grid.dims)) + (4,), 7.0, np.float32)] * 3)  # stale
+    atlas, atlas_tex, target = lpv_inject.atlas_target(gl, grid)
+    assert atlas.tiles_x == 2 and atlas.size == (12, 10)  # 4 layers as 2 x 2 tiles: the tiling is exercised
+    gl.clear(target)
+    lpv_inject.run(gl, target, lpv_inject.texel_points(gl, res), rsm, grid, atlas)
+    lpv_inject.unpack(gl, atlas_tex, vols, grid, atlas)
     got = [gl.read(vols[f"sh_{c}"]) for c in "rgb"]
 
     expected = [np.zeros_like(got[0]) for _ in range(3)]
@@ -164,8 +165,7 @@ def test_injection_of_one_vpl_gives_its_lobe(gl):
         x, y, z = np.floor((p + 0.25 * n) / 0.5).astype(int)  # half a cell (0.25 m) along n
         for ch in range(3):
             expected[ch][z, y, x] += f[ch] / np.pi * sh.cosine_lobe_l1(n)
-    # The second VPL (normal -z at z = 1.9 m) moves to z = 1.65 m: layer 3, not 3 - 1 = 2... check both
-    # VPLs land in different layers, so the per-layer culling is exercised.
+    # The two VPLs land in different layers (tiles), and every other cell's stale content is overwritten.
     assert np.floor((p1 + 0.25 * n1) / 0.5)[2] != np.floor((p2 + 0.25 * n2) / 0.5)[2]
     for ch in range(3):
         # fp32 arithmetic of a few products: 1e-6 relative to the largest coefficient.
@@ -285,6 +285,78 @@ def test_point_source_irradiance_along_an_axis(gl):
     # and the border absorbs them along with the positive light. Bound: [0.6, 1.9] on 2..32 cells.
     for r in range(2, 33):
         assert 0.6 <= improved[r] <= 1.9, (r, improved[r])
+
+
+# -- lookup -------------------------------------------------------------------------------------------
+def reference_lookup(acc, vox_normal, grid, pos, nrm, offset_cells=0.5):
+    """numpy twin of lookup.comp.glsl with the geometry volume: E / pi per pixel, the trilinear corners of
+    p = pos + offset h n weighted by 1 - min(1, w |n_cell . n|) and renormalised (plain trilinear when
+    every corner is blocked). acc: per channel (z, y, x, 4); pos, nrm: (k, 3)."""
+    out = np.zeros((len(pos), 3))
+    for k, (p, n) in enumerate(zip(pos, nrm, strict=True)):
+        n = n / np.linalg.norm(n)
+        t = (p + offset_cells * grid.cell_size_m * n - grid.origin_m) / grid.cell_size_m - 0.5  # x, y, z
+        i0 = np.floor(t).astype(int)
+        f = t - i0
+        lobe = sh.cosine_lobe_l1(-n)
+        aware, plain, w_sum = np.zeros(3), np.zeros(3), 0.0
+        for corner in np.ndindex(2, 2, 2):  # x, y, z offsets
+            c = np.clip(i0 + corner, 0, np.array(grid.dims) - 1)
+            w = np.prod([f[a] if corner[a] else 1.0 - f[a] for a in range(3)])
+            nv = vox_normal[c[2], c[1], c[0]]
+            through = 1.0 - min(1.0, nv[3] * abs(nv[:3] @ n))
+            v = np.array([a[c[2], c[1], c[0]] @ lobe for a in acc])
+            plain += w * v
+            aware += w * through * v
+            w_sum += w * through
+        e = aware / w_sum if w_sum > 1e-4 else plain
+        out[k] = np.maximum(e, 0.0) / (grid.cell_size_m**2 * np.pi)
+    return out
+
+
+def test_lookup_skips_the_cells_a_surface_blocks(gl):
+    # A wall (normal +x, 1 cell^2 per cell: blocking 1 along x) in the x = 2 layer of a 6x5x4 grid; the
+    # cells in front of it (x >= 3) hold light travelling towards it, the wall's own cells a quarter of
+    # that. A receiver on the wall, facing +x, samples half a cell out: between its own cell and the one
+    # in front. The geometry-aware lookup reads the cell in front only (the wall cells' weight is 0),
+    # where plain trilinear reads the mean of both, 0.625 of it. Oblique receivers and a partly blocking
+    # cell are checked against the numpy twin.
+    rng = np.random.default_rng(9)
+    grid = Grid(np.array([-1.0, 0.0, 0.0]), 0.5, (6, 5, 4))
+    shape = tuple(reversed(grid.dims))
+    toward_wall = sh.cosine_lobe_l1(np.array([-1.0, 0.0, 0.0])) / np.pi
+    acc = []
+    for ch in range(3):
+        v = np.zeros(shape + (4,), np.float32)
+        v[..., 3:, :] = (ch + 1.0) * toward_wall
+        v[..., :3, :] = 0.25 * (ch + 1.0) * toward_wall
+        v += 0.05 * rng.normal(size=v.shape).astype(np.float32)
+        acc.append(v)
+    vox = np.zeros(shape + (4,), np.float32)
+    vox[..., 2, :] = [1.0, 0.0, 0.0, 1.0]
+    vox[1, 2, 4] = [0.6, 0.8, 0.0, 0.5]  # a partly blocking oblique surface in front of the wall
+    # Receivers: on the wall (x = 0.25 m: mid-cell of layer x = 2; y, z at cell centres) facing +x, and
+    # oblique ones.
+    pos = np.array([[0.25, 1.25, 0.75], [0.25, 0.75, 1.25], [0.7, 1.1, 0.7], [0.9, 1.3, 0.4]], np.float32)
+    nrm = np.array([[1, 0, 0], [1, 0, 0], [0.6, 0.8, 0], [0.5, -0.5, 0.7071]], np.float32)
+    k = len(pos)
+    gbuf = {"position": gl.texture((k, 1), "RGBA32F", np.c_[pos, np.ones(k)].reshape(1, k, 4).astype(np.float32)),
+            "normal": gl.texture((k, 1), "RGBA32F", np.c_[nrm, np.zeros(k)].reshape(1, k, 4).astype(np.float32))}
+    tex = {f"acc_{c}": gl.texture(grid.dims, "RGBA32F", a) for c, a in zip("rgb", acc, strict=True)}
+    out = gl.texture((k, 1))
+    lpv_lookup.run(gl, gbuf, tex, out, grid, vox_normal=gl.texture(grid.dims, "RGBA32F", vox))
+    got = gl.read(out)[0, :, :3]
+    want = reference_lookup(acc, vox, grid, pos.astype(float), nrm.astype(float))
+    # fp32 sums of 8 products; 1e-5 of the largest value.
+    np.testing.assert_allclose(got, want, atol=1e-5 * want.max())
+    lpv_lookup.run(gl, gbuf, tex, out, grid)  # without the geometry volume: plain trilinear
+    plain = gl.read(out)[0, :, :3]
+    # On the wall: exactly the cell in front (x = 3) of each receiver, E / pi = c . lobe(-n) / (h^2 pi).
+    front = np.array([[a[z, y, 3] @ sh.cosine_lobe_l1(np.array([-1.0, 0, 0])) for a in acc]
+                      for z, y in ((1, 2), (2, 1))]) / (0.25 * np.pi)
+    np.testing.assert_allclose(got[:2], front, rtol=1e-5)
+    print(f"on the wall: aware / plain = {got[:2].sum() / plain[:2].sum():.3f}")
+    assert np.all(plain[:2] < 0.8 * got[:2])
 
 
 # -- re-injection (bounces 2..) ----------------------------------------------------------------------
@@ -443,6 +515,7 @@ def first_and_second_bounce_flux(gl, geometry_volume):
                        LpvConfig(grid_cells=16, variant="improved", geometry_volume=geometry_volume))
     method.set_scene(box_scene())
     super(LpvMethod, method).compute()  # the direct method's passes: RSMs and the injection
+    lpv_inject.unpack(gl, method.inject_atlas, method.snapshots[0], method.grid, method.atlas)
     injected = flux([gl.read(method.snapshots[0][f"sh_{c}"]) for c in "rgb"])
     method.propagate()
     method.reinject(method.accumulated)

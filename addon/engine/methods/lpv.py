@@ -1,14 +1,16 @@
 """Method `lpv`: light propagation volume (Kaplanyan 2009, CLPV Kaplanyan & Dachsbacher 2010; seeds 002).
 
 Passes: those of `direct` (G-buffer, per light face: rsm, direct_light), then per RSM face while it is
-bound: lpv_inject; once per update after every face: N x lpv_propagate (ping-pong, accumulated),
-lpv_lookup -> `indirect` (Cycles' Diffuse Indirect units). With LpvConfig.geometry_volume the scene is
-voxelized once per geometry change on the LPV grid and the voxels' surface area x |n.d| blocks each
-transfer. GIConfig.bounces = k > 1 adds k - 1 bounces after the first bounce's lookup, each: lpv_reinject
-(the voxelized surfaces reflect the previous bounce's light into a fresh snapshot), N x lpv_propagate
-into a per-bounce accumulation, lpv_lookup added to `indirect`, lpv_reinject.add into the total; these
-need the voxelizer's albedo and normals, so it runs whenever bounces > 1 (it blocks propagation only
-with geometry_volume). docs/LPV.md derives the normalisation and measures both variants against Cycles.
+bound: lpv_inject (VPLs splatted into a 2D atlas of the grid's layers); once per update after every
+face: lpv_inject.unpack (atlas -> 3D snapshot), N x lpv_propagate (ping-pong, accumulated), lpv_lookup
+-> `indirect` (Cycles' Diffuse Indirect units; improved + geometry volume: geometry-aware corners).
+With LpvConfig.geometry_volume the scene is voxelized once per geometry change on the LPV grid and the
+voxels' surface area x |n.d| blocks each transfer. GIConfig.bounces = k > 1 adds k - 1 bounces after
+the first bounce's lookup, each: lpv_reinject (the voxelized surfaces reflect the previous bounce's
+light into a fresh snapshot), N x lpv_propagate into a per-bounce accumulation, lpv_lookup added to
+`indirect`, lpv_reinject.add into the total; these need the voxelizer's albedo and normals, so it runs
+whenever bounces > 1 (it blocks propagation only with geometry_volume). docs/LPV.md derives the
+normalisation and measures both variants against Cycles.
 
 The grid is fitted to the uploaded (re-centred) geometry: Grid.fit(bounds, max_cells=grid_cells),
 non-cubic for flat scenes. Products: direct, indirect, albedo.
@@ -60,6 +62,9 @@ class LpvMethod(OneBounceMethod):
             self._voxelizer = voxelizer  # keeps its textures alive
         # Blocks propagation only when asked to; later bounces use the voxels as emitters either way.
         self.vox_normal = self.voxels["vox_normal"] if cfg.geometry_volume else None
+        # The improved variant's lookup skips the trilinear corners a surface blocks along its normal;
+        # classic keeps the published plain trilinear lookup (docs/LPV.md, "Lookup").
+        self._lookup_vox = self.vox_normal if cfg.variant == "improved" else None
         # One bounce's accumulation (the total is `accumulated`): what the next bounce re-injects.
         self.bounce_accumulated = ({f"acc_{c}": be.texture(dims) for c in "rgb"} if self.gi.bounces > 1
                                    else None)
@@ -100,7 +105,7 @@ class LpvMethod(OneBounceMethod):
                 self.propagate(accumulated=self.bounce_accumulated)
             with self.timed(timings, "lpv_lookup"):
                 lpv_lookup.run(be, self.gbuf, self.bounce_accumulated, self.indirect, grid, accumulate=True,
-                               vox_normal=self.vox_normal)
+                               vox_normal=self._lookup_vox)
             with self.timed(timings, "lpv_reinject"):
                 lpv_reinject.add(be, self.bounce_accumulated, self.accumulated, grid)
             previous = self.bounce_accumulated
@@ -117,6 +122,6 @@ class LpvMethod(OneBounceMethod):
             with self.timed(timings, "lpv_propagate"):
                 self.propagate()
             with self.timed(timings, "lpv_lookup"):
-                lpv_lookup.run(be, self.gbuf, self.accumulated, self.indirect, self.grid, vox_normal=self.vox_normal)
+                lpv_lookup.run(be, self.gbuf, self.accumulated, self.indirect, self.grid, vox_normal=self._lookup_vox)
             self.add_bounces(timings)
         return timings

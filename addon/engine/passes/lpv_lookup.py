@@ -5,7 +5,10 @@ W/sr per cell, by direction of travel), the Grid. Output: `indirect` (RGBA32F, c
 added to with `accumulate`): E / pi with E = max(0, c(p) . cosine_lobe(-n)) / h^2, c(p) trilinear at
 p = pos + lookup_offset_cells * h * n. Units: Cycles' Diffuse Indirect (docs/LPV.md). With several
 bounces the method runs it once per bounce's volume, the later ones added (`accumulate`): each bounce's
-irradiance is clamped at 0 on its own.
+irradiance is clamped at 0 on its own. With `vox_normal` (the improved variant's geometry volume) the 8
+trilinear corners are weighted by their transmittance along n, 1 - min(1, w |n_cell . n|), and
+renormalised: the cells a surface blocks hold light its own geometry attenuated, not the light arriving
+at it (docs/LPV.md, "Geometry-aware lookup").
 """
 
 from __future__ import annotations

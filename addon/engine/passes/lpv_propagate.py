@@ -14,7 +14,7 @@ Variants (gpu_shaders/lpv/propagate.comp.glsl has the equations; docs/LPV.md the
   flux-conserving, light keeps its direction), the injection snapshot is not accumulated (no light in
   the emitter's own cell), and each snapshot is weighted by PATH_WEIGHT = the mean path length per
   cell visit (cells), so the accumulated sum is fluence x h^2 rather than visits.
-The loops are 6 x 6 iterations per invocation: far below llvmpipe's 65,535 cap.
+The six directions are unrolled; classic loops over 6 faces in each: far below llvmpipe's 65,535 cap.
 """
 
 from __future__ import annotations
