@@ -23,6 +23,10 @@ from ..grid import Grid
 from .vct_inject import DIRECTIONS, Atlas
 
 _GRID = (Var("dims", "ivec3"),)
+# Half floats: the cone gather reads ~100 trilinear samples per cone from these textures, so their
+# bytes are its cost (six 64^3 pyramids are 50 MB in fp32, an H100's whole L2). fp16 keeps 3 decimal
+# digits, far below the gather's own error, and radiance up to 65504 W/m^2/sr.
+PYRAMID_FORMAT = "RGBA16F"
 
 
 def _level0_spec(add: bool, isotropic: bool) -> ShaderSpec:
@@ -34,7 +38,7 @@ def _level0_spec(add: bool, isotropic: bool) -> ShaderSpec:
         local_size=(4, 4, 4),
         samplers=(*(Sampler(f"flux_{d}", "2D") for d in DIRECTIONS), Sampler("vox_projected", "3D"),
                   *((Sampler(f"add_{d}", "3D") for d in DIRECTIONS) if add else ())),
-        images=tuple(Image(f"pyr_{d}", "3D") for d in DIRECTIONS),
+        images=tuple(Image(f"pyr_{d}", "3D", PYRAMID_FORMAT) for d in DIRECTIONS),
         uniforms=(*_GRID, Var("cell_size", "float"), Var("tiles_x", "int"), Var("atlas_weight", "float")),
         defines=defines,
     )
@@ -47,7 +51,7 @@ DOWNSAMPLE = ShaderSpec(
     compute="vct/downsample.comp.glsl",
     local_size=(4, 4, 4),
     samplers=tuple(Sampler(f"src_{d}", "3D") for d in DIRECTIONS),
-    images=tuple(Image(f"pyr_{d}", "3D") for d in DIRECTIONS),
+    images=tuple(Image(f"pyr_{d}", "3D", PYRAMID_FORMAT) for d in DIRECTIONS),
     uniforms=(*_GRID, Var("level", "int")),
 )
 
@@ -91,7 +95,7 @@ def direction_textures(backend: Backend, size: tuple[int, ...]) -> dict:
 
 
 def pyramid_textures(backend: Backend, grid: Grid) -> dict:
-    return direction_textures(backend, texture_size(grid.dims))
+    return {d: backend.texture(texture_size(grid.dims), PYRAMID_FORMAT) for d in DIRECTIONS}
 
 
 def level0(backend: Backend, flux: dict, vox_projected, pyramid: dict, grid: Grid, atlas: Atlas,
