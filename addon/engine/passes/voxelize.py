@@ -63,6 +63,23 @@ def dominant_axis(normals: np.ndarray) -> np.ndarray:
     return np.argmax(np.abs(normals), axis=1)
 
 
+def slab_triangles(positions_m: np.ndarray, grid: Grid, axis: int) -> dict[int, np.ndarray]:
+    """Layer -> indices of the triangles (n, 3, 3) that may write into slab [layer, layer + 1) along
+    `axis`: their extent along it in cells, widened by one cell each side (the fragment shader widens a
+    triangle's depth by at most 0.5 (|n_u| + |n_v|) / |n_w| <= 1 cell for its dominant axis), clamped
+    to the grid. Every triangle appears in each slab it can reach, so nothing is lost."""
+    w = (positions_m[:, :, axis] - grid.origin_m[axis]) / grid.cell_size_m
+    lo = np.clip(np.floor(w.min(axis=1) - 1.0), 0, grid.dims[axis] - 1).astype(np.int64)
+    hi = np.clip(np.floor(w.max(axis=1) + 1.0), 0, grid.dims[axis] - 1).astype(np.int64)
+    counts = hi - lo + 1
+    tri = np.repeat(np.arange(len(w)), counts)
+    layer = np.repeat(lo, counts) + (np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts))
+    order = np.argsort(layer, kind="stable")
+    tri, layer = tri[order], layer[order]
+    starts = np.flatnonzero(np.r_[True, layer[1:] != layer[:-1]])
+    return {int(layer[b]): tri[b:e] for b, e in zip(starts, np.r_[starts[1:], len(layer)], strict=True)}
+
+
 class Voxelizer:
     """Allocates the axis and canonical volumes for a grid and voxelizes a scene into them."""
 
@@ -77,30 +94,35 @@ class Voxelizer:
             vols = {q: be.texture(size) for q in _QUANTITIES}
             self._axis_volumes.append(vols)
             self._layer_targets.append([be.target([(vols[q], k) for q in _QUANTITIES]) for k in range(size[2])])
-        self._meshes: list = [None, None, None]
+        self._meshes: list[dict] = [{}, {}, {}]
 
     def set_scene(self, scene: Scene) -> None:
-        """Upload each triangle to its dominant axis's mesh: three vertices carrying their neighbours."""
+        """Upload each triangle to its dominant axis, once per slab it can touch: three vertices carrying
+        their neighbours. A draw per slab then rasterizes only the triangles near it (drawing every
+        triangle into every slab cost Sponza's 67k triangles x 3 x 128 slabs: 60 ms on an H100)."""
         be = self.backend
         prog = be.program(RASTER)
         pos = scene.positions_m.astype(np.float64)
         normals = triangle_normals(pos)
         axes = dominant_axis(normals)
-        self._meshes = [None, None, None]
+        self._meshes = [{}, {}, {}]
         for axis in range(3):
-            sel = (axes == axis) & np.any(normals != 0, axis=1)
-            if not np.any(sel):
+            sel = np.flatnonzero((axes == axis) & np.any(normals != 0, axis=1))
+            if sel.size == 0:
                 continue
-            p = pos[sel]
-            attrs = {
-                "pos_ws": p,
-                "next_ws": p[:, [1, 2, 0]],
-                "prev_ws": p[:, [2, 0, 1]],
-                "tri_normal": np.repeat(normals[sel][:, None], 3, axis=1),
-                "albedo": np.repeat(scene.albedo[sel][:, None], 3, axis=1),
-                "emission": np.repeat(scene.emission[sel][:, None], 3, axis=1),
-            }
-            self._meshes[axis] = be.mesh(prog, {k: v.reshape(-1, 3) for k, v in attrs.items()}, "triangles")
+            for layer, tris in slab_triangles(pos[sel], self.grid, axis).items():
+                t = sel[tris]
+                p = pos[t]
+                attrs = {
+                    "pos_ws": p,
+                    "next_ws": p[:, [1, 2, 0]],
+                    "prev_ws": p[:, [2, 0, 1]],
+                    "tri_normal": np.repeat(normals[t][:, None], 3, axis=1),
+                    "albedo": np.repeat(scene.albedo[t][:, None], 3, axis=1),
+                    "emission": np.repeat(scene.emission[t][:, None], 3, axis=1),
+                }
+                self._meshes[axis][layer] = be.mesh(prog, {k: v.reshape(-1, 3) for k, v in attrs.items()},
+                                                    "triangles")
 
     def run(self) -> dict:
         be, grid = self.backend, self.grid
@@ -109,9 +131,9 @@ class Voxelizer:
         for axis in range(3):
             for k, target in enumerate(self._layer_targets[axis]):
                 be.clear(target)
-                if self._meshes[axis] is not None:
-                    be.draw(prog, target, self._meshes[axis], uniforms={**uniforms, "axis": axis, "layer": k},
-                            blend="add")
+                mesh = self._meshes[axis].get(k)
+                if mesh is not None:
+                    be.draw(prog, target, mesh, uniforms={**uniforms, "axis": axis, "layer": k}, blend="add")
         samplers = {f"{q}_{'xyz'[a]}": self._axis_volumes[a][q] for q in _QUANTITIES for a in range(3)}
         be.dispatch(be.program(MERGE), group_count(grid.dims, MERGE.local_size), uniforms={"dims": grid.dims},
                     samplers=samplers, images=self.volumes)
