@@ -92,6 +92,7 @@ class VctConfig(_Validated):
 
     voxel_cells: int = _num(64, 8, 256, "voxel grid cells along the scene's longest side")
     diffuse_cones: int = _num(16, 3, 32, "cones per gather point, each 2 pi / n sr of the hemisphere")
+    bounce_cones: int = _num(6, 3, 32, "cones per voxel side for bounces after the first (smoother light)")
     step_ratio: float = _num(1.0, 0.1, 2.0, "march step as a fraction of the sampled voxel's size")
     offset_cells: float = _num(1.5, 0.0, 4.0, "cone origins moved off their surface along the normal, in cells")
     gather_scale: int = _num(1, 1, 4, "cones at one pixel per n x n block, upsampled along edges (1: every pixel)")

@@ -4,7 +4,8 @@
   (Cycles' Diffuse Indirect units) and `ao` (1 - cosine-weighted cone opacity). With
   VctConfig.gather_scale = s > 1 the cones run at one pixel per s x s block and an edge-aware
   upsampling (normal and tangent-plane weights) fills the full-size images.
-- bounce: at every occupied voxel, the same gather on both sides of its surface -> the next bounce's
+- bounce: at every occupied voxel, the same gather (VctConfig.bounce_cones cones: the light it gathers
+  is smooth, and every voxel pays two gathers) on both sides of its surface -> the next bounce's
   level-0 colours (premultiplied radiance by travel direction), albedo x E / pi x projected area.
 
 Inputs: the pyramid (dict by direction), the Grid, VctConfig; G-buffer or the voxelizer's volumes.
@@ -52,11 +53,12 @@ BOUNCE = ShaderSpec(
 )
 
 
-def cone_uniforms(grid: Grid, config: VctConfig, seed: int) -> dict:
+def cone_uniforms(grid: Grid, config: VctConfig, seed: int, cones: int) -> dict:
     """`seed` turns every receiver's cone spiral by its own random angle (GIConfig.seed)."""
-    return {"seed": seed, "grid_origin": grid.origin_m, "cell_size": grid.cell_size_m, "dims": grid.dims,
+    return {"seed": seed, "diffuse_cones": cones, "grid_origin": grid.origin_m, "cell_size": grid.cell_size_m,
+            "dims": grid.dims,
             "levels": level_count(grid.dims), "tex_width": texture_size(grid.dims)[0],
-            "diffuse_cones": config.diffuse_cones, "step_ratio": config.step_ratio,
+            "step_ratio": config.step_ratio,
             "offset_cells": config.offset_cells}
 
 
@@ -72,7 +74,7 @@ def pixels(backend: Backend, pyramid: dict, gbuf: dict, indirect, ao, grid: Grid
     scale = config.gather_scale
     out = (indirect, ao) if scale == 1 else low
     backend.dispatch(backend.program(PIXELS), group_count(out[0].size, PIXELS.local_size),
-                     uniforms={**cone_uniforms(grid, config, seed), "scale": scale},
+                     uniforms={**cone_uniforms(grid, config, seed, config.diffuse_cones), "scale": scale},
                      samplers={**named(pyramid, "pyr"), "gbuf_position": gbuf["position"],
                                "gbuf_normal": gbuf["normal"]},
                      images={"indirect": out[0], "ao": out[1]})
@@ -92,7 +94,7 @@ def upsample(backend: Backend, gbuf: dict, low: tuple, indirect, ao, scale: int,
 def bounce(backend: Backend, pyramid: dict, voxels: dict, next_bounce: dict, grid: Grid, config: VctConfig,
            seed: int = 0) -> None:
     backend.dispatch(backend.program(BOUNCE), group_count(grid.dims, BOUNCE.local_size),
-                     uniforms=cone_uniforms(grid, config, seed),
+                     uniforms=cone_uniforms(grid, config, seed, config.bounce_cones),
                      samplers={**named(pyramid, "pyr"), "vox_albedo": voxels["vox_albedo"],
                                "vox_normal": voxels["vox_normal"], "vox_projected": voxels["vox_projected"]},
                      images=named(next_bounce, "next"))
