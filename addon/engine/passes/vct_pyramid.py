@@ -23,10 +23,10 @@ from ..grid import Grid
 from .vct_inject import DIRECTIONS, Atlas
 
 _GRID = (Var("dims", "ivec3"),)
-# Half floats: the cone gather reads ~100 trilinear samples per cone from these textures, so their
-# bytes are its cost (six 64^3 pyramids are 50 MB in fp32, an H100's whole L2). fp16 keeps 3 decimal
-# digits, far below the gather's own error, and radiance up to 65504 W/m^2/sr.
-PYRAMID_FORMAT = "RGBA16F"
+# Full floats. Half floats would halve the gather's bytes (six 64^3 pyramids are 50 MB in fp32, an
+# H100's whole L2) with no change in cornell's error, but they overflow at 65504 W/m^2/sr: the hard
+# case that scales a light's power by 1e6 then turned to Inf. Half needs an exposure scale first.
+PYRAMID_FORMAT = "RGBA32F"
 
 
 def _level0_spec(add: bool, isotropic: bool) -> ShaderSpec:
