@@ -79,6 +79,9 @@ class LpvConfig(_Validated):
     variant: str = _choice("classic", ("classic", "improved"),
                            "transport: classic CLPV 5-face scheme, or improved (straight, flux-conserving)")
     geometry_volume: bool = field(default=False, metadata={"doc": "occlude propagation by the voxelized surfaces"})
+    cascades: int = _num(1, 1, 4, "nested grids, each finer one half the cell size, the finest around the camera")
+    cell_size_m: float = _num(0.0, 0.0, 1.0e6, "finest cascade's cell in metres when the cascades can cover "
+                              "the scene with it; 0: the coarsest fits the scene")
 
     def __post_init__(self) -> None:
         super().__post_init__()

@@ -7,6 +7,10 @@
 // saw it, 1 - min(1, area * |n_cell . n|), and renormalised: a cell holding the receiving surface (or
 // another surface facing the same way) holds light that entered it through a face its own geometry
 // half-blocked, not the light arriving at the surface (docs/LPV.md, "Lookup").
+// CASCADE: this grid is a finer cascade; `indirect` holds its parent's answer (coarsest first) and is
+// blended towards this one's with weight w = clamp((d - band_start) / band_cells, 0, 1), d the distance
+// in cells from the sample point to the nearest interior face (lpv_cascade.blend_weight is the twin).
+// The weights of a chain of cascades sum to 1, so no light is counted twice.
 #include "common/sh.glsl"
 
 vec4 lobe_dot(ivec3 c, vec4 lobe) {
@@ -26,6 +30,15 @@ void main() {
     }
     vec3 n = normalize(texelFetch(gbuf_normal, px, 0).xyz);
     vec3 g = (pos.xyz + (lookup_offset_cells * cell_size) * n - grid_origin) / cell_size;
+#ifdef CASCADE
+    vec3 d_lo = mix(vec3(1e30), g, bvec3(interior_lo));
+    vec3 d_hi = mix(vec3(1e30), vec3(dims) - g, bvec3(interior_hi));
+    float d = min(min(min(d_lo.x, d_lo.y), d_lo.z), min(min(d_hi.x, d_hi.y), d_hi.z));
+    float w_cascade = clamp((d - band_start) / band_cells, 0.0, 1.0);
+    if (w_cascade == 0.0) {
+        return;  // the parent's answer stands
+    }
+#endif
     vec4 lobe = sh_cosine_lobe(-n);
 #ifdef GEOMETRY_VOLUME
     vec3 t = g - 0.5;  // cell centres at i + 0.5
@@ -60,6 +73,9 @@ void main() {
     // One bounce's volume added to the earlier bounces' image: each bounce is clamped on its own, so a
     // later bounce's negative L1 ringing cannot take light away from an earlier one.
     out_e += imageLoad(indirect, px).rgb;
+#endif
+#ifdef CASCADE
+    out_e = mix(imageLoad(indirect, px).rgb, out_e, w_cascade);
 #endif
     imageStore(indirect, px, vec4(out_e, 1.0));
 }

@@ -13,14 +13,21 @@ whenever bounces > 1 (it blocks propagation only with geometry_volume). docs/LPV
 normalisation and measures both variants against Cycles.
 
 The grid is fitted to the uploaded (re-centred) geometry: Grid.fit(bounds, max_cells=grid_cells),
-non-cubic for flat scenes. Products: direct, indirect, albedo.
+non-cubic for flat scenes. With LpvConfig.cascades = C > 1 (lpv_cascade.place) that grid is the
+coarsest of C nested ones, each finer one half the cell size around the camera (re-placed when the
+camera leaves a parent cell, re-voxelized then). Every cascade gets the same VPLs; coarsest first, each
+propagates on its own after lpv_cascade.inflow has added the light entering it from its parent; the
+lookups run coarsest first, each finer one blended in across its band. Products: direct, indirect, albedo.
 """
 
 from __future__ import annotations
 
+import numpy as np
+
 from ..config import LpvConfig
+from ..errors import ConfigError
 from ..grid import Grid
-from ..passes import lpv_inject, lpv_lookup, lpv_propagate, lpv_reinject
+from ..passes import lpv_cascade, lpv_inject, lpv_lookup, lpv_propagate, lpv_reinject
 from ..passes.light_views import LightView
 from ..passes.voxelize import Voxelizer
 from .direct import OneBounceMethod
@@ -35,6 +42,44 @@ def iterations_for(config: LpvConfig, grid: Grid) -> int:
     return config.iterations
 
 
+class LpvVolume:
+    """One grid's textures: snapshot sets (0 = the injection, kept for a finer cascade's inflow; 1 and 2
+    ping-pong), the accumulation, the injection atlas and, when asked for, the voxels."""
+
+    def __init__(self, method: LpvMethod, cascade: lpv_cascade.Cascade):
+        be = method.backend
+        self.cascade, self.grid = cascade, cascade.grid
+        dims = self.grid.dims
+        self.snapshots = [{f"sh_{c}": be.texture(dims) for c in "rgb"} for _ in range(3)]
+        self.accumulated = {f"acc_{c}": be.texture(dims) for c in "rgb"}
+        self.atlas, self.inject_atlas, self.inject_target = lpv_inject.atlas_target(be, self.grid)
+        # One bounce's accumulation (the total is `accumulated`): what the next bounce re-injects.
+        self.bounce_accumulated = ({f"acc_{c}": be.texture(dims) for c in "rgb"} if method.gi.bounces > 1
+                                   else None)
+        self.geometry_volume = method.lpv_config.geometry_volume
+        self.voxels = None
+        self.voxelize(method)
+
+    def voxelize(self, method: LpvMethod) -> None:
+        cfg = method.lpv_config
+        if not (cfg.geometry_volume or method.gi.bounces > 1):
+            return
+        self._voxelizer = Voxelizer(method.backend, self.grid)  # keeps its textures alive
+        self._voxelizer.set_scene(method.scene)
+        self.voxels = self._voxelizer.run()
+
+    def move(self, method: LpvMethod, cascade: lpv_cascade.Cascade) -> None:
+        """The same dims at another place (the camera moved): re-voxelized; the atlas layout is unchanged."""
+        self.cascade, self.grid = cascade, cascade.grid
+        self.voxelize(method)
+
+    @property
+    def vox_normal(self):
+        """The geometry volume that blocks propagation (only with LpvConfig.geometry_volume; later bounces
+        use the voxels as emitters either way)."""
+        return self.voxels["vox_normal"] if self.voxels is not None and self.geometry_volume else None
+
+
 class LpvMethod(OneBounceMethod):
     name = "lpv"
     max_bounces = 8  # GIConfig's limit: each bounce is one more re-injection and propagation
@@ -42,49 +87,69 @@ class LpvMethod(OneBounceMethod):
     def __init__(self, backend, gi, rsm_config, lpv_config: LpvConfig | None = None):
         super().__init__(backend, gi, rsm_config)
         self.lpv_config = lpv_config if lpv_config is not None else LpvConfig()
-        self.grid: Grid | None = None
+        if self.lpv_config.cascades > 1 and gi.bounces > 1:
+            raise ConfigError(f"LpvConfig.cascades = {self.lpv_config.cascades} with GIConfig.bounces = "
+                              f"{gi.bounces}: later bounces are computed on a single grid only (cascades = 1); "
+                              "re-injecting per cascade needs each cascade's bounce fed from its parent's, "
+                              "which is not implemented")
+        self.levels: list[LpvVolume] = []
+
+    # The finest grid's textures (the only grid when cascades = 1).
+    grid = property(lambda self: self.levels[0].grid)
+    snapshots = property(lambda self: self.levels[0].snapshots)
+    accumulated = property(lambda self: self.levels[0].accumulated)
+    bounce_accumulated = property(lambda self: self.levels[0].bounce_accumulated)
+    atlas = property(lambda self: self.levels[0].atlas)
+    inject_atlas = property(lambda self: self.levels[0].inject_atlas)
+    voxels = property(lambda self: self.levels[0].voxels)
+    vox_normal = property(lambda self: self.levels[0].vox_normal)
+
+    def camera_m(self) -> np.ndarray:
+        """The camera's position in the uploaded geometry's (re-centred) frame."""
+        return self.source.camera.position_m - self.origin_m
+
+    def place_cascades(self) -> list[lpv_cascade.Cascade]:
+        cfg = self.lpv_config
+        return lpv_cascade.place(*self.bounds_m, self.camera_m(), cfg.grid_cells, cfg.cascades, cfg.cell_size_m)
 
     def set_scene(self, scene) -> None:
         super().set_scene(scene)
-        be, cfg = self.backend, self.lpv_config
-        self.grid = Grid.fit(*self.bounds_m, max_cells=cfg.grid_cells)
-        dims = self.grid.dims
-        # Two snapshot sets (ping-pong; set 0 receives the injection) and the accumulation.
-        self.snapshots = [{f"sh_{c}": be.texture(dims) for c in "rgb"} for _ in range(2)]
-        self.accumulated = {f"acc_{c}": be.texture(dims) for c in "rgb"}
-        self.atlas, self.inject_atlas, self._inject_target = lpv_inject.atlas_target(be, self.grid)
-        self._points = lpv_inject.texel_points(be, self.rsm_config.resolution)
-        self.voxels = None
-        if cfg.geometry_volume or self.gi.bounces > 1:
-            voxelizer = Voxelizer(be, self.grid)
-            voxelizer.set_scene(self.scene)
-            self.voxels = voxelizer.run()
-            self._voxelizer = voxelizer  # keeps its textures alive
-        # Blocks propagation only when asked to; later bounces use the voxels as emitters either way.
-        self.vox_normal = self.voxels["vox_normal"] if cfg.geometry_volume else None
-        # The improved variant's lookup skips the trilinear corners a surface blocks along its normal;
-        # classic keeps the published plain trilinear lookup (docs/LPV.md, "Lookup").
-        self._lookup_vox = self.vox_normal if cfg.variant == "improved" else None
-        # One bounce's accumulation (the total is `accumulated`): what the next bounce re-injects.
-        self.bounce_accumulated = ({f"acc_{c}": be.texture(dims) for c in "rgb"} if self.gi.bounces > 1
-                                   else None)
+        self.levels = [LpvVolume(self, c) for c in self.place_cascades()]
+        self._points = lpv_inject.texel_points(self.backend, self.rsm_config.resolution)
+
+    def follow_camera(self) -> None:
+        """Re-place the finer cascades where the camera has moved to another parent cell."""
+        for level, cascade in zip(self.levels, self.place_cascades(), strict=True):
+            if (cascade.parent_offset, cascade.grid.dims) != (level.cascade.parent_offset, level.grid.dims):
+                level.move(self, cascade)
+
+    def lookup_vox(self, level: LpvVolume):
+        """The improved variant's lookup skips the trilinear corners a surface blocks along its normal;
+        classic keeps the published plain trilinear lookup (docs/LPV.md, "Lookup")."""
+        return level.vox_normal if self.lpv_config.variant == "improved" else None
 
     def clear_products(self) -> None:
         super().clear_products()
-        self.backend.clear(self._inject_target)
+        for level in self.levels:
+            self.backend.clear(level.inject_target)
 
     def per_light_view(self, view: LightView, timings: dict[str, float]) -> None:
         with self.timed(timings, "lpv_inject"):
-            lpv_inject.run(self.backend, self._inject_target, self._points, self.rsm, self.grid, self.atlas)
+            for level in self.levels:
+                lpv_inject.run(self.backend, level.inject_target, self._points, self.rsm, level.grid, level.atlas)
 
-    def propagate(self, iterations: int | None = None, accumulated: dict | None = None) -> None:
-        """Propagate the injected snapshot (set 0) into `accumulated` (default: the total), overwriting
-        it; `iterations` overrides the config."""
-        n = iterations_for(self.lpv_config, self.grid) if iterations is None else iterations
-        acc = self.accumulated if accumulated is None else accumulated
+    def propagate(self, iterations: int | None = None, accumulated: dict | None = None,
+                  level: LpvVolume | None = None) -> None:
+        """Propagate a grid's (default: the finest's) snapshot set 0 into `accumulated` (default: its
+        total), overwriting it; set 0 is kept. `iterations` overrides the config."""
+        level = self.levels[0] if level is None else level
+        n = iterations_for(self.lpv_config, level.grid) if iterations is None else iterations
+        acc = level.accumulated if accumulated is None else accumulated
+        sets = level.snapshots
         for i in range(n):
-            lpv_propagate.run(self.backend, self.snapshots[i % 2], self.snapshots[(i + 1) % 2], acc,
-                              self.grid, self.lpv_config.variant, first_step=i == 0, vox_normal=self.vox_normal)
+            src = sets[0] if i == 0 else sets[2 - i % 2]
+            lpv_propagate.run(self.backend, src, sets[1 + i % 2], acc, level.grid, self.lpv_config.variant,
+                              first_step=i == 0, vox_normal=level.vox_normal)
 
     def reinject(self, previous: dict) -> None:
         """The light the surfaces reflect of one bounce's accumulation -> snapshot set 0 (overwritten)."""
@@ -95,7 +160,7 @@ class LpvMethod(OneBounceMethod):
         """Bounces 2..gi.bounces on top of the first bounce (in `accumulated` and `indirect`): each is
         looked up on its own and added to `indirect` (clamped per bounce, so none takes light away),
         and added to `accumulated`, the total a volume bake reads. Afterwards `bounce_accumulated`
-        holds the last bounce alone."""
+        holds the last bounce alone. One grid only (cascades > 1 refuses bounces > 1)."""
         be, grid = self.backend, self.grid
         previous = self.accumulated  # holds bounce 1 alone until the first add
         for _ in range(self.gi.bounces - 1):
@@ -105,7 +170,7 @@ class LpvMethod(OneBounceMethod):
                 self.propagate(accumulated=self.bounce_accumulated)
             with self.timed(timings, "lpv_lookup"):
                 lpv_lookup.run(be, self.gbuf, self.bounce_accumulated, self.indirect, grid, accumulate=True,
-                               vox_normal=self._lookup_vox)
+                               vox_normal=self.lookup_vox(self.levels[0]))
             with self.timed(timings, "lpv_reinject"):
                 lpv_reinject.add(be, self.bounce_accumulated, self.accumulated, grid)
             previous = self.bounce_accumulated
@@ -114,14 +179,32 @@ class LpvMethod(OneBounceMethod):
         be = self.backend
         timings: dict[str, float] = {}
         with self.timed(timings, "total"):
+            if len(self.levels) > 1:
+                with self.timed(timings, "lpv_place"):
+                    self.follow_camera()
             inner = super().compute(run_gbuffer)
             inner.pop("total", None)
             timings.update(inner)
-            with self.timed(timings, "lpv_inject"):
-                lpv_inject.unpack(be, self.inject_atlas, self.snapshots[0], self.grid, self.atlas)
-            with self.timed(timings, "lpv_propagate"):
-                self.propagate()
+            # Coarsest first: a finer cascade's inflow reads its parent's propagated light.
+            for i in reversed(range(len(self.levels))):
+                level = self.levels[i]
+                with self.timed(timings, "lpv_inject"):
+                    lpv_inject.unpack(be, level.inject_atlas, level.snapshots[0], level.grid, level.atlas)
+                    if i + 1 < len(self.levels):
+                        parent = self.levels[i + 1]
+                        lpv_cascade.inflow(be, level.cascade, level.snapshots[0], parent.grid, parent.accumulated,
+                                           parent.snapshots[0], self.lpv_config.variant)
+                with self.timed(timings, "lpv_propagate"):
+                    if len(self.levels) > 1:
+                        with self.timed(timings, f"lpv_propagate_cascade{i}"):
+                            self.propagate(level=level)
+                    else:
+                        self.propagate(level=level)
             with self.timed(timings, "lpv_lookup"):
-                lpv_lookup.run(be, self.gbuf, self.accumulated, self.indirect, self.grid, vox_normal=self._lookup_vox)
+                for i in reversed(range(len(self.levels))):
+                    level = self.levels[i]
+                    lpv_lookup.run(be, self.gbuf, level.accumulated, self.indirect, level.grid,
+                                   vox_normal=self.lookup_vox(level),
+                                   cascade=level.cascade if i + 1 < len(self.levels) else None)
             self.add_bounces(timings)
         return timings

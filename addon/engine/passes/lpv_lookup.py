@@ -8,46 +8,61 @@ bounces the method runs it once per bounce's volume, the later ones added (`accu
 irradiance is clamped at 0 on its own. With `vox_normal` (the improved variant's geometry volume) the 8
 trilinear corners are weighted by their transmittance along n, 1 - min(1, w |n_cell . n|), and
 renormalised: the cells a surface blocks hold light its own geometry attenuated, not the light arriving
-at it (docs/LPV.md, "Geometry-aware lookup").
+at it (docs/LPV.md, "Geometry-aware lookup"). With `cascade` (a finer LPV cascade, lpv_cascade.Cascade)
+`indirect` holds the parent cascades' answer and is blended towards this grid's across the transition
+band inside its interior faces (lpv_cascade.blend_weight); run coarsest first.
 """
 
 from __future__ import annotations
 
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
+from . import lpv_cascade
+from .lpv_cascade import Cascade
 
 
-def _spec(accumulate: bool, geometry_volume: bool) -> ShaderSpec:
+def _spec(accumulate: bool, geometry_volume: bool, cascade: bool) -> ShaderSpec:
     defines = (("ACCUMULATE", "1"),) if accumulate else ()
     extra = ()
+    uniforms = ()
     if geometry_volume:
         defines += (("GEOMETRY_VOLUME", "1"),)
         extra = (Sampler("vox_normal", "3D"),)
+    if cascade:
+        defines += (("CASCADE", "1"),)
+        uniforms = (Var("interior_lo", "ivec3"), Var("interior_hi", "ivec3"), Var("band_start", "float"),
+                    Var("band_cells", "float"))
     return ShaderSpec(
-        name=("lpv_lookup_add" if accumulate else "lpv_lookup") + ("_gv" if geometry_volume else ""),
+        name=("lpv_lookup_add" if accumulate else "lpv_lookup") + ("_gv" if geometry_volume else "")
+        + ("_cascade" if cascade else ""),
         compute="lpv/lookup.comp.glsl",
         local_size=(8, 8, 1),
         samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("acc_r", "3D"),
                   Sampler("acc_g", "3D"), Sampler("acc_b", "3D")) + extra,
-        images=(Image("indirect", "2D", "RGBA32F", "read_write" if accumulate else "write"),),
+        images=(Image("indirect", "2D", "RGBA32F", "read_write" if accumulate or cascade else "write"),),
         uniforms=(Var("grid_origin", "vec3"), Var("cell_size", "float"), Var("dims", "ivec3"),
-                  Var("lookup_offset_cells", "float")),
+                  Var("lookup_offset_cells", "float")) + uniforms,
         defines=defines,
     )
 
 
-SPECS = {(acc, gv): _spec(acc, gv) for acc in (False, True) for gv in (False, True)}
+SPECS = {(acc, gv, cas): _spec(acc, gv, cas) for acc in (False, True) for gv in (False, True)
+         for cas in (False, True) if not (acc and cas)}
 
 
 def run(backend: Backend, gbuf: dict, acc: dict, indirect, grid: Grid, offset_cells: float = 0.5,
-        accumulate: bool = False, vox_normal=None) -> None:
-    """Write `indirect` from `acc`, or with `accumulate` add to it (one later bounce's volume); with
-    `vox_normal` (the geometry volume) the trilinear corners are weighted by their transmittance."""
-    spec = SPECS[(accumulate, vox_normal is not None)]
+        accumulate: bool = False, vox_normal=None, cascade: Cascade | None = None) -> None:
+    """Write `indirect` from `acc`, or with `accumulate` add to it (one later bounce's volume), or with
+    `cascade` (whose grid is `grid`) blend it in across its band; with `vox_normal` (the geometry volume)
+    the trilinear corners are weighted by their transmittance."""
+    spec = SPECS[(accumulate, vox_normal is not None, cascade is not None)]
     samplers = {"gbuf_position": gbuf["position"], "gbuf_normal": gbuf["normal"], **acc}
     if vox_normal is not None:
         samplers["vox_normal"] = vox_normal
-    backend.dispatch(backend.program(spec), group_count(indirect.size, spec.local_size),
-                     uniforms={"grid_origin": grid.origin_m, "cell_size": grid.cell_size_m, "dims": grid.dims,
-                               "lookup_offset_cells": offset_cells},
+    uniforms = {"grid_origin": grid.origin_m, "cell_size": grid.cell_size_m, "dims": grid.dims,
+                "lookup_offset_cells": offset_cells}
+    if cascade is not None:
+        uniforms.update(interior_lo=cascade.interior_lo, interior_hi=cascade.interior_hi,
+                        band_start=lpv_cascade.BAND_START_CELLS, band_cells=lpv_cascade.BAND_CELLS)
+    backend.dispatch(backend.program(spec), group_count(indirect.size, spec.local_size), uniforms=uniforms,
                      samplers=samplers, images={"indirect": indirect})
