@@ -25,6 +25,9 @@ def add_arguments(p) -> None:
     p.add_argument("--iterations", type=int, default=16, help="LPV propagation steps (lpv, classic)")
     p.add_argument("--variant", default="classic", help="LPV transport: classic or improved (lpv)")
     p.add_argument("--geometry-volume", action="store_true", help="LPV: occlude by the voxelized surfaces")
+    p.add_argument("--cascades", type=int, default=1, help="LPV: nested grids, the finest around the camera")
+    p.add_argument("--cell-size", type=float, default=0.0,
+                   help="LPV: finest cascade's cell in metres (0: the coarsest grid fits the scene)")
     p.add_argument("--cones", type=int, default=16, help="diffuse cones per gather point (vct)")
     p.add_argument("--step-ratio", type=float, default=1.0, help="cone march step / sampled voxel size (vct)")
     p.add_argument("--cone-offset", type=float, default=1.5, help="cone origins off the surface, in cells (vct)")
@@ -40,7 +43,7 @@ def run(args) -> int:
     rsm = RsmConfig(resolution=args.rsm_res, vpl_samples=args.vpl_samples, visibility=args.visibility,
                     voxel_cells=args.voxel_cells)
     lpv = LpvConfig(grid_cells=args.grid, iterations=args.iterations, variant=args.variant,
-                    geometry_volume=args.geometry_volume)
+                    geometry_volume=args.geometry_volume, cascades=args.cascades, cell_size_m=args.cell_size)
     vct = VctConfig(voxel_cells=args.voxel_cells, diffuse_cones=args.cones, step_ratio=args.step_ratio,
                     offset_cells=args.cone_offset, radiance=args.radiance, gather_scale=args.gather_scale)
     blend = existing_blend(args.blend)
