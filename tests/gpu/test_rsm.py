@@ -155,3 +155,40 @@ def test_voxel_visibility_follows_the_exact_occluded_integral(gl):
     # deviation 1-3 %, so 5 % is allowed for the mean and 12 % per pixel.
     assert got.mean() == pytest.approx(with_vis.mean(), rel=0.05)
     np.testing.assert_allclose(got, with_vis, rtol=0.12)
+
+
+def test_rsm_reduce_keeps_every_watt(gl):
+    """4 x 4 blocks of a random 16 x 16 RSM face with holes: each output VPL carries exactly its
+    block's flux and area (sums of 16 fp32 values: rtol 1e-6), sits at the flux-weighted mean position
+    with the normalised flux-weighted normal, and an all-empty block stays empty."""
+    from addon.engine.passes import rsm_reduce
+
+    rng = np.random.default_rng(9)
+    n, k = 16, 4
+    pos = np.concatenate([rng.random((n, n, 3)), np.ones((n, n, 1))], axis=-1).astype(np.float32)
+    nrm = rng.normal(size=(n, n, 3))
+    nrm /= np.linalg.norm(nrm, axis=-1, keepdims=True)
+    nrm = np.concatenate([nrm, rng.random((n, n, 1))], axis=-1).astype(np.float32)
+    flux = np.concatenate([rng.random((n, n, 3)), np.zeros((n, n, 1))], axis=-1).astype(np.float32)
+    pos[rng.random((n, n)) < 0.2, 3] = 0.0  # holes: texels the light saw nothing in
+    pos[:k, :k, 3] = 0.0  # one whole empty block
+    flux[pos[..., 3] == 0] = 0.0
+    rsm = {"position": gl.texture((n, n), data=pos), "normal": gl.texture((n, n), data=nrm),
+           "flux": gl.texture((n, n), data=flux)}
+    out = rsm_reduce.textures(gl, n, k)
+    rsm_reduce.run(gl, rsm, out, k)
+    got = {key: gl.read(t) for key, t in out.items()}
+    for by, bx in np.ndindex(n // k, n // k):
+        block = (slice(by * k, by * k + k), slice(bx * k, bx * k + k))
+        valid = pos[block][..., 3] > 0
+        if not valid.any():
+            assert got["position"][by, bx, 3] == 0.0 and not got["flux"][by, bx].any()
+            continue
+        f = flux[block][valid][:, :3].astype(np.float64)
+        w = f @ np.array([0.2126, 0.7152, 0.0722])
+        np.testing.assert_allclose(got["flux"][by, bx, :3], f.sum(axis=0), rtol=1e-6)
+        np.testing.assert_allclose(got["normal"][by, bx, 3], nrm[block][valid][:, 3].sum(), rtol=1e-6)
+        mean_pos = (w[:, None] * pos[block][valid][:, :3]).sum(axis=0) / w.sum()
+        np.testing.assert_allclose(got["position"][by, bx, :3], mean_pos, rtol=1e-5)
+        mean_n = (w[:, None] * nrm[block][valid][:, :3]).sum(axis=0)
+        np.testing.assert_allclose(got["normal"][by, bx, :3], mean_n / np.linalg.norm(mean_n), rtol=1e-4, atol=1e-6)

@@ -27,7 +27,7 @@ import numpy as np
 from ..config import LpvConfig
 from ..errors import ConfigError
 from ..grid import Grid
-from ..passes import lpv_cascade, lpv_inject, lpv_lookup, lpv_propagate, lpv_reinject
+from ..passes import lpv_cascade, lpv_inject, lpv_lookup, lpv_propagate, lpv_reinject, rsm_reduce
 from ..passes.light_views import LightView
 from ..passes.voxelize import Voxelizer
 from .direct import OneBounceMethod
@@ -115,7 +115,10 @@ class LpvMethod(OneBounceMethod):
     def set_scene(self, scene) -> None:
         super().set_scene(scene)
         self.levels = [LpvVolume(self, c) for c in self.place_cascades()]
-        self._points = lpv_inject.texel_points(self.backend, self.rsm_config.resolution)
+        res = self.rsm_config.resolution
+        self._reduce = rsm_reduce.factor_for(res, self.lpv_config.grid_cells)
+        self._vpls = rsm_reduce.textures(self.backend, res, self._reduce) if self._reduce > 1 else None
+        self._points = lpv_inject.texel_points(self.backend, res // self._reduce)
 
     def follow_camera(self) -> None:
         """Re-place the finer cascades where the camera has moved to another parent cell."""
@@ -135,8 +138,12 @@ class LpvMethod(OneBounceMethod):
 
     def per_light_view(self, view: LightView, timings: dict[str, float]) -> None:
         with self.timed(timings, "lpv_inject"):
+            vpls = self.rsm
+            if self._vpls is not None:
+                rsm_reduce.run(self.backend, self.rsm, self._vpls, self._reduce)
+                vpls = self._vpls
             for level in self.levels:
-                lpv_inject.run(self.backend, level.inject_target, self._points, self.rsm, level.grid, level.atlas)
+                lpv_inject.run(self.backend, level.inject_target, self._points, vpls, level.grid, level.atlas)
 
     def propagate(self, iterations: int | None = None, accumulated: dict | None = None,
                   level: LpvVolume | None = None) -> None:
