@@ -239,11 +239,14 @@ def configs():
         ("lpv-improved-gv-64", {"method": "lpv"}, {}, {"grid_cells": 64, "variant": "improved",
                                                       "geometry_volume": True}, {}),
         ("lpv-classic-32", {"method": "lpv"}, {}, {"grid_cells": 32, "variant": "classic"}, {}),
+        ("lpv-improved-gv-32-3cascades", {"method": "lpv"}, {}, {"grid_cells": 32, "variant": "improved",
+                                                                "geometry_volume": True, "cascades": 3}, {}),
         ("vct-64", {"method": "vct"}, {}, {}, {"voxel_cells": 64}),
         ("vct-64-6cones", {"method": "vct"}, {}, {}, {"voxel_cells": 64, "diffuse_cones": 6}),
         ("vct-64-6cones-half", {"method": "vct"}, {}, {}, {"voxel_cells": 64, "diffuse_cones": 6,
                                                            "gather_scale": 2}),
         ("vct-128", {"method": "vct"}, {}, {}, {"voxel_cells": 128}),
+        ("vct-64-2bounces", {"method": "vct", "bounces": 2}, {}, {}, {"voxel_cells": 64}),
     ]
 
 
