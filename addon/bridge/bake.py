@@ -370,6 +370,11 @@ def bake_volume(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, lpv, o
     `cell_size_m` scalar; `dims` (3,) x, y, z. To light a surface with normal n at p: sample the SH
     trilinearly at p + 0.5 cell n (cell centres at origin + (i + 0.5) cell), E = max(0, c . lobe(-n)) /
     cell_size_m^2 with lobe(m) = (0.886227, 1.023327 m.y, m.z, m.x); Cycles' Diffuse Indirect = E / pi.
+    With the geometry volume on (LpvConfig's default) the file also holds `vox_normal` float32
+    (z, y, x, 4): per cell the voxelized surfaces' mean normal (xyz) and area in cells^2 (w); each of
+    the 8 trilinear corners is then weighted by 1 - min(1, w |n_cell . n|) and the weights renormalised
+    (plain trilinear where all are 0): a cell holding a surface facing the receiver holds light its own
+    geometry half-blocked (docs/LPV.md, "Lookup"). The finest cascade is written when there are several.
     """
     from ..engine.methods.lpv import LpvMethod
     from .pipeline import backend as default_backend
@@ -393,8 +398,9 @@ def bake_volume(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, lpv, o
     method.compute()
     sh = {f"sh_{c}": be.read(method.accumulated[f"acc_{c}"]) for c in "rgb"}
     grid = method.grid
-    np.savez_compressed(path, **sh, origin_m=grid.origin_m + method.origin_m, cell_size_m=grid.cell_size_m,
-                        dims=np.array(grid.dims))
+    extra = {} if method.vox_normal is None else {"vox_normal": be.read(method.vox_normal)}
+    np.savez_compressed(path, **sh, **extra, origin_m=grid.origin_m + method.origin_m,
+                        cell_size_m=grid.cell_size_m, dims=np.array(grid.dims))
     summary = {"blend": str(blend), "file": str(path), "dims": list(grid.dims), "cell_size_m": grid.cell_size_m,
                "time_ms": round((time.perf_counter() - t0) * 1e3, 2), "config": {"lpv": method.lpv_config.to_dict()}}
     print(f"{Path(blend).name}: volume {grid.dims[0]}x{grid.dims[1]}x{grid.dims[2]} -> {path}")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 
 from ..engine.config import GIConfig, LpvConfig, RsmConfig, VctConfig
@@ -23,8 +24,9 @@ def add_arguments(p) -> None:
     p.add_argument("--voxel-cells", type=int, default=64, help="voxel cells along the longest side (rsm, vct)")
     p.add_argument("--grid", type=int, default=32, help="LPV cells along the longest side (lpv)")
     p.add_argument("--iterations", type=int, default=16, help="LPV propagation steps (lpv, classic)")
-    p.add_argument("--variant", default="classic", help="LPV transport: classic or improved (lpv)")
-    p.add_argument("--geometry-volume", action="store_true", help="LPV: occlude by the voxelized surfaces")
+    p.add_argument("--variant", default="improved", help="LPV transport: improved or classic (the published one)")
+    p.add_argument("--geometry-volume", action=argparse.BooleanOptionalAction, default=True,
+                   help="LPV: occlude by the voxelized surfaces (default on)")
     p.add_argument("--cascades", type=int, default=1, help="LPV: nested grids, the finest around the camera")
     p.add_argument("--cell-size", type=float, default=0.0,
                    help="LPV: finest cascade's cell in metres (0: the coarsest grid fits the scene)")

@@ -76,9 +76,11 @@ class LpvConfig(_Validated):
 
     grid_cells: int = _num(32, 8, 256, "LPV cells along the scene's longest side")
     iterations: int = _num(16, 1, 256, "propagation steps (classic); improved runs at least the grid's Manhattan span")
-    variant: str = _choice("classic", ("classic", "improved"),
+    # Defaults: the improved transport with occlusion (Cornell rel_rmse_8 0.42); the published scheme
+    # stays a variant for comparison (1.15, no better than a constant: ../shared/BASELINE.md).
+    variant: str = _choice("improved", ("classic", "improved"),
                            "transport: classic CLPV 5-face scheme, or improved (straight, flux-conserving)")
-    geometry_volume: bool = field(default=False, metadata={"doc": "occlude propagation by the voxelized surfaces"})
+    geometry_volume: bool = field(default=True, metadata={"doc": "occlude propagation by the voxelized surfaces"})
     cascades: int = _num(1, 1, 4, "nested grids, each finer one half the cell size, the finest around the camera")
     cell_size_m: float = _num(0.0, 0.0, 1.0e6, "finest cascade's cell in metres when the cascades can cover "
                               "the scene with it; 0: the coarsest fits the scene")

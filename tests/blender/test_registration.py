@@ -134,10 +134,10 @@ def test_mirror_check_catches_a_config_change(registered):
 
     @dataclasses.dataclass(frozen=True)
     class DriftedBool(config.LpvConfig):
-        geometry_volume: bool = dataclasses.field(default=True, metadata={"doc": ""})
+        geometry_volume: bool = dataclasses.field(default=False, metadata={"doc": ""})
 
     problems = _mismatches(bpy.context.scene.bounce.lpv.bl_rna, DriftedBool, config.limits)
-    assert problems == ["geometry_volume: property ('BOOLEAN', False) != config ('BOOLEAN', True)"]
+    assert problems == ["geometry_volume: property ('BOOLEAN', True) != config ('BOOLEAN', False)"]
 
 
 def test_defaults_give_default_configs(registered):
