@@ -3,6 +3,7 @@
 // phi / pi * sh_cosine_lobe(n) (integral over the sphere = 2 sqrt(pi) c0 = phi). It is moved half a
 // cell along n and added to the texel of the cell containing it in the injection atlas (lpv_inject.py:
 // z-layer z is tile (z % tiles_x, z / tiles_x)). Empty texels and points outside the grid are clipped.
+#include "common/atlas.glsl"
 #include "common/sh.glsl"
 
 void main() {
@@ -11,15 +12,7 @@ void main() {
     vec3 n = texelFetch(rsm_normal, t, 0).xyz;
     vec3 phi = texelFetch(rsm_flux, t, 0).rgb;
     vec3 g = (pos.xyz + (0.5 * cell_size) * n - grid_origin) / cell_size;
-    ivec3 cell = ivec3(floor(g));
-    bool inside = all(greaterThanEqual(cell, ivec3(0))) && all(lessThan(cell, dims));
-    if (pos.w == 0.0 || !inside) {
-        gl_Position = vec4(2.0, 2.0, 2.0, 1.0);  // clipped
-    } else {
-        ivec2 tile = ivec2(cell.z % tiles_x, cell.z / tiles_x);
-        vec2 px = vec2(tile * dims.xy + cell.xy) + 0.5;
-        gl_Position = vec4(px / vec2(atlas_size) * 2.0 - 1.0, 0.0, 1.0);
-    }
+    gl_Position = atlas_splat_position(ivec3(floor(g)), pos.w != 0.0, atlas_size);
     vec4 lobe = sh_cosine_lobe(n) * (1.0 / SH_A0);
     v_r = phi.r * lobe;
     v_g = phi.g * lobe;

@@ -6,11 +6,8 @@
 // cell's h^2 cross-section, so its premultiplied radiance is phi |n.t| / (pi h^2): what the atlas
 // summed (phi max(0, n.t)) over pi h^2. ISOTROPIC replaces the six colours by their mean (opacity
 // stays directional).
+#include "common/atlas.glsl"
 #include "vct/pyramid.glsl"
-
-ivec2 atlas_texel(ivec3 c) {
-    return ivec2(c.z % tiles_x, c.z / tiles_x) * dims.xy + c.xy;
-}
 
 void main() {
     ivec3 c = ivec3(gl_GlobalInvocationID);

@@ -16,6 +16,7 @@ from addon.engine import sh
 from addon.engine.config import GIConfig, LpvConfig, RsmConfig
 from addon.engine.grid import Grid
 from addon.engine.methods.lpv import LpvMethod
+from addon.engine.passes import atlas as atlas_pass
 from addon.engine.passes import lpv_cascade, lpv_inject, lpv_lookup, lpv_propagate, lpv_reinject
 from addon.engine.scene import Camera, Light, Scene
 from addon.engine.transforms import look_along, perspective
@@ -156,7 +157,7 @@ def test_injection_of_one_vpl_gives_its_lobe(gl):
     atlas, atlas_tex, target = lpv_inject.atlas_target(gl, grid)
     assert atlas.tiles_x == 2 and atlas.size == (12, 10)  # 4 layers as 2 x 2 tiles: the tiling is exercised
     gl.clear(target)
-    lpv_inject.run(gl, target, lpv_inject.texel_points(gl, res), rsm, grid, atlas)
+    lpv_inject.run(gl, target, atlas_pass.texel_points(gl, res, lpv_inject.SPEC), rsm, grid, atlas)
     lpv_inject.unpack(gl, atlas_tex, vols, grid, atlas)
     got = [gl.read(vols[f"sh_{c}"]) for c in "rgb"]
 

@@ -11,8 +11,10 @@ import pytest
 
 from addon.engine.config import VctConfig
 from addon.engine.grid import Grid
-from addon.engine.passes import lpv_inject, vct_gather, vct_inject, vct_pyramid
-from addon.engine.passes.vct_inject import DIRECTIONS, Atlas
+from addon.engine.passes import atlas as atlas_pass
+from addon.engine.passes import vct_gather, vct_inject, vct_pyramid
+from addon.engine.passes.atlas import Atlas
+from addon.engine.passes.vct_inject import DIRECTIONS
 
 pytestmark = pytest.mark.gpu
 
@@ -116,7 +118,7 @@ def test_injection_splits_flux_by_direction(gl):
         gl.write(rsm[k], a)
     textures = vct_pyramid.direction_textures(gl, atlas.size)
     target = gl.target([textures[d] for d in DIRECTIONS])
-    points = lpv_inject.texel_points(gl, res, vct_inject.SPEC)
+    points = atlas_pass.texel_points(gl, res, vct_inject.SPEC)
     vct_inject.run(gl, target, points, rsm, grid, atlas)
     z = 3
     row, col = (z // atlas.tiles_x) * 3 + 1, (z % atlas.tiles_x) * 4 + 2

@@ -27,7 +27,7 @@ import numpy as np
 from ..config import LpvConfig
 from ..errors import ConfigError
 from ..grid import Grid
-from ..passes import lpv_cascade, lpv_inject, lpv_lookup, lpv_propagate, lpv_reinject, rsm_reduce
+from ..passes import atlas, lpv_cascade, lpv_inject, lpv_lookup, lpv_propagate, lpv_reinject, rsm_reduce
 from ..passes.light_views import LightView
 from ..passes.voxelize import Voxelizer
 from .direct import OneBounceMethod
@@ -118,7 +118,7 @@ class LpvMethod(OneBounceMethod):
         res = self.rsm_config.resolution
         self._reduce = rsm_reduce.factor_for(res, self.lpv_config.grid_cells)
         self._vpls = rsm_reduce.textures(self.backend, res, self._reduce) if self._reduce > 1 else None
-        self._points = lpv_inject.texel_points(self.backend, res // self._reduce)
+        self._points = atlas.texel_points(self.backend, res // self._reduce, lpv_inject.SPEC)
 
     def follow_camera(self) -> None:
         """Re-place the finer cascades where the camera has moved to another parent cell."""

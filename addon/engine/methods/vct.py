@@ -14,9 +14,10 @@ from __future__ import annotations
 
 from ..config import VctConfig
 from ..grid import Grid
-from ..passes import lpv_inject, vct_gather, vct_inject, vct_pyramid
+from ..passes import atlas, vct_gather, vct_inject, vct_pyramid
+from ..passes.atlas import Atlas
 from ..passes.light_views import LightView
-from ..passes.vct_inject import DIRECTIONS, Atlas
+from ..passes.vct_inject import DIRECTIONS
 from ..passes.voxelize import Voxelizer
 from .direct import OneBounceMethod
 
@@ -41,7 +42,7 @@ class VctMethod(OneBounceMethod):
         self.atlas = Atlas.for_grid(self.grid)
         self.flux = vct_pyramid.direction_textures(be, self.atlas.size)
         self._flux_target = be.target([self.flux[d] for d in DIRECTIONS])
-        self._points = lpv_inject.texel_points(be, self.rsm_config.resolution, vct_inject.SPEC)
+        self._points = atlas.texel_points(be, self.rsm_config.resolution, vct_inject.SPEC)
         self.pyramid = vct_pyramid.pyramid_textures(be, self.grid)
         if self.gi.bounces > 1:
             self.next_bounce = vct_pyramid.direction_textures(be, self.grid.dims)

@@ -10,18 +10,16 @@ the cell containing pos + 0.5 cell * n; the cell's flux is the integral of the i
 2 sqrt(pi) * c0 (docs/LPV.md derives the units).
 
 Portable scatter (ARCHITECTURE.md section 3): additive point splats, no atomics. The z-layers are tiles
-of one 2D atlas (vct_inject.Atlas: layer z is tile (z % tiles_x, z // tiles_x), one texel per cell), so
+of one 2D atlas (passes/atlas.py: layer z is tile (z % tiles_x, z // tiles_x), one texel per cell), so
 a face costs one draw of its texels; one per z-layer (the earlier form) cost texels x layers vertex
 invocations, and made injection the dearest LPV pass on a GPU (docs/LPV.md, "Speed").
 """
 
 from __future__ import annotations
 
-import numpy as np
-
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
-from .vct_inject import Atlas
+from .atlas import Atlas, splat
 
 SPEC = ShaderSpec(
     name="lpv_inject",
@@ -45,14 +43,6 @@ UNPACK = ShaderSpec(
 )
 
 
-def texel_points(backend: Backend, resolution: int, spec: ShaderSpec = SPEC):
-    """The point mesh: one vertex per RSM texel (its integer coordinates, attribute `texel`), made once
-    per RSM size for the splatting program `spec` (LPV's or VCT's injection)."""
-    j, i = np.mgrid[0:resolution, 0:resolution]
-    texels = np.stack([i.ravel(), j.ravel()], axis=1).astype(np.float32)
-    return backend.mesh(backend.program(spec), {"texel": texels}, "points")
-
-
 def atlas_target(backend: Backend, grid: Grid) -> tuple[Atlas, dict, object]:
     """(Atlas, its three textures keyed sh_r/g/b, the framebuffer with them attached), made once per grid."""
     atlas = Atlas.for_grid(grid)
@@ -62,11 +52,7 @@ def atlas_target(backend: Backend, grid: Grid) -> tuple[Atlas, dict, object]:
 
 def run(backend: Backend, target, points, rsm: dict, grid: Grid, atlas: Atlas) -> None:
     """Add one RSM face's VPLs to the atlas behind `target` (cleared by the caller per update)."""
-    backend.draw(backend.program(SPEC), target, points,
-                 uniforms={"grid_origin": grid.origin_m, "cell_size": grid.cell_size_m, "dims": grid.dims,
-                           "tiles_x": atlas.tiles_x, "atlas_size": atlas.size},
-                 samplers={"rsm_position": rsm["position"], "rsm_normal": rsm["normal"], "rsm_flux": rsm["flux"]},
-                 blend="add")
+    splat(backend, SPEC, target, points, rsm, grid, atlas)
 
 
 def unpack(backend: Backend, atlas_textures: dict, volumes: dict, grid: Grid, atlas: Atlas) -> None:

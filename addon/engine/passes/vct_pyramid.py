@@ -20,7 +20,8 @@ import math
 
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
-from .vct_inject import DIRECTIONS, Atlas
+from .atlas import Atlas
+from .vct_inject import DIRECTIONS
 
 _GRID = (Var("dims", "ivec3"),)
 # Full floats. Half floats would halve the gather's bytes (six 64^3 pyramids are 50 MB in fp32, an

@@ -1,0 +1,47 @@
+"""The layers-as-tiles atlas shared by the LPV and VCT injections (gpu_shaders/common/atlas.glsl).
+
+A grid's z-layer z is tile (z % tiles_x, z // tiles_x) of one 2D texture, one texel per cell, so an
+RSM face's VPLs are splatted into every layer with one point draw (additive blending; portable, no
+atomics) instead of one draw per layer. Compute passes read cells back with atlas_texel().
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..backends.base import Backend, ShaderSpec
+from ..grid import Grid
+
+
+@dataclass(frozen=True)
+class Atlas:
+    """Near square, so 128^3 fits in 1536 x 1408 texels (a strip of layers would need 16,384 rows)."""
+
+    tiles_x: int
+    size: tuple[int, int]
+
+    @classmethod
+    def for_grid(cls, grid: Grid) -> Atlas:
+        nx, ny, nz = grid.dims
+        tiles_x = math.ceil(math.sqrt(nz))
+        return cls(tiles_x, (tiles_x * nx, math.ceil(nz / tiles_x) * ny))
+
+
+def texel_points(backend: Backend, resolution: int, spec: ShaderSpec):
+    """The point mesh: one vertex per RSM texel (its integer coordinates, attribute `texel`), made once
+    per RSM size for the splatting program `spec`."""
+    j, i = np.mgrid[0:resolution, 0:resolution]
+    texels = np.stack([i.ravel(), j.ravel()], axis=1).astype(np.float32)
+    return backend.mesh(backend.program(spec), {"texel": texels}, "points")
+
+
+def splat(backend: Backend, spec: ShaderSpec, target, points, rsm: dict, grid: Grid, atlas: Atlas) -> None:
+    """Draw one RSM face's VPLs with `spec` into the atlas textures behind `target`, added."""
+    backend.draw(backend.program(spec), target, points,
+                 uniforms={"grid_origin": grid.origin_m, "cell_size": grid.cell_size_m, "dims": grid.dims,
+                           "tiles_x": atlas.tiles_x, "atlas_size": atlas.size},
+                 samplers={"rsm_position": rsm["position"], "rsm_normal": rsm["normal"], "rsm_flux": rsm["flux"]},
+                 blend="add")
