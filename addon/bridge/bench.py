@@ -315,7 +315,9 @@ def _cache_blend(name: str, src: Path | None, cache: Path) -> Path:
     else:
         bpy.ops.wm.open_mainfile(filepath=str(src), load_ui=False)
         bpy.ops.file.find_missing_files(directory=str(src.parent))
-        bpy.ops.wm.save_as_mainfile(filepath=str(dst), relative_remap=False)
+        # The found paths are relative to the source's folder: remap them to the cache's, or the copy
+        # loses its textures again (it did: Cycles rendered Sponza's and Sibenik's references pink).
+        bpy.ops.wm.save_as_mainfile(filepath=str(dst), relative_remap=True)
     return dst
 
 

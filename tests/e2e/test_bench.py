@@ -172,3 +172,34 @@ def test_quick_bench_on_cornell(tmp_path):
         assert a["spp"] == b["spp"]
         for k in ("rel_rmse", "rel_rmse_8", "bias"):
             assert a[k] == pytest.approx(b[k], rel=1e-9), (k, a, b)
+
+
+@pytest.mark.blender
+def test_cached_real_scene_keeps_its_textures(tmp_path):
+    """A scene whose image paths point elsewhere (as the shared Sponza's do) but whose textures lie in
+    its own folder: the bench's cached copy must resolve them from the cache's folder. Before the
+    relative remap it did not, and Cycles rendered Sponza's and Sibenik's references pink (magenta
+    albedo on 90 % of Sponza's pixels)."""
+    import os
+
+    import bpy
+    import numpy as np
+
+    src_dir = tmp_path / "scene"
+    src_dir.mkdir()
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    image = bpy.data.images.new("tex", 4, 4)
+    image.pixels[:] = np.full(4 * 4 * 4, 0.5, np.float32)
+    image.filepath_raw = str(src_dir / "tex.png")
+    image.file_format = "PNG"
+    image.save()
+    image.filepath = "//../nowhere/tex.png"  # a stored path that no longer resolves
+    image.use_fake_user = True  # kept in the file without a material
+    src = src_dir / "scene.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(src))
+
+    cached = bench._cache_blend("scene", src, tmp_path / "cache")
+    bpy.ops.wm.open_mainfile(filepath=str(cached), load_ui=False)
+    path = bpy.path.abspath(bpy.data.images["tex"].filepath)
+    assert cached.parent == tmp_path / "cache" / "scenes"
+    assert os.path.exists(path), path
