@@ -1,7 +1,9 @@
 // Merges the three axis volumes (each stored with its slab axis as layers) into the canonical grid and
 // divides out the weights: albedo (rgb, a = occupancy 0/1), normal (xyz unit or 0, w = surface area
-// in cell units^2), emission (rgb radiance, a = occupancy); projected (xyz = sum of area x |n| per axis,
-// w = area, both in cell units^2: sums, not divided).
+// in cell units^2), emission (rgb radiance, a = occupancy); projected (per axis, the larger of the
+// areas projected by the surfaces facing + and - along it, max(P+, P-) = (sum area |n| + |sum area n|)
+// / 2, cell units^2; w = area). A line of sight crosses a closed object's surface twice: the sum of
+// |n| counted a thin column twice, and VCT's opacity with it; a one-sided wall keeps its whole area.
 
 ivec3 permuted(ivec3 c, int axis) {
     return axis == 0 ? c.yzx : (axis == 1 ? c.zxy : c);
@@ -32,5 +34,5 @@ void main() {
     imageStore(vox_albedo, c, vec4(a.rgb / weight, 1.0));
     imageStore(vox_normal, c, vec4(len_n > 1e-6 * weight ? n.xyz / len_n : vec3(0.0), weight));
     imageStore(vox_emission, c, vec4(e.rgb / weight, 1.0));
-    imageStore(vox_projected, c, p);
+    imageStore(vox_projected, c, vec4(0.5 * (p.xyz + abs(n.xyz)), p.w));
 }

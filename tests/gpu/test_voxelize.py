@@ -116,3 +116,19 @@ def test_slab_buckets_change_nothing(gl, monkeypatch):
     for key in bucketed:
         np.testing.assert_array_equal(bucketed[key], everything[key], err_msg=key)
     assert np.count_nonzero(bucketed["vox_albedo"][..., 3]) > 10_000
+
+
+def test_projected_area_counts_a_closed_object_once(gl):
+    """A closed axis-aligned cube of side 0.5 inside cell (1, 1, 1): along each axis its faces facing +
+    and - each project 0.25 cell^2, its silhouette; the opacity area is max(P+, P-) = 0.25 (the sum of
+    |n| gave 0.5). A lone quad facing +x (0.6 x 0.6) keeps its whole area 0.36 along x and 0 along y, z.
+    Exact up to fp32 sums of a few fragments (atol 1e-5)."""
+    lo, hi = 1.25, 1.75
+    corners = np.array([[x, y, z] for x in (lo, hi) for y in (lo, hi) for z in (lo, hi)])
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    tris = [[corners[q[0]], corners[q[i]], corners[q[i + 1]]] for q in quads for i in (1, 2)]
+    vols = voxelize(gl, scene(tris, [[0.5] * 3] * 12), Grid(np.zeros(3), 1.0, (3, 3, 3)))
+    np.testing.assert_allclose(vols["vox_projected"][1, 1, 1, :3], [0.25, 0.25, 0.25], atol=1e-5)
+    quad = [[[1.5, 1.2, 1.2], [1.5, 1.8, 1.2], [1.5, 1.8, 1.8]], [[1.5, 1.2, 1.2], [1.5, 1.8, 1.8], [1.5, 1.2, 1.8]]]
+    vols = voxelize(gl, scene(quad, [[0.5] * 3] * 2), Grid(np.zeros(3), 1.0, (3, 3, 3)))
+    np.testing.assert_allclose(vols["vox_projected"][1, 1, 1, :3], [0.36, 0.0, 0.0], atol=1e-5)

@@ -3,9 +3,10 @@
 Inputs: scene triangles; a Grid. Outputs (RGBA32F 3D textures of grid.dims, canonical x, y, z layout):
 `vox_albedo` (diffuse albedo, a = occupancy 0/1), `vox_normal` (area-weighted mean normal, w = surface
 area in the cell in cell units^2), `vox_emission` (emitted radiance W/m^2/sr, a = occupancy),
-`vox_projected` (xyz = the surface's projected area along each axis, sum of area x |n_axis|, in cell
-units^2; unlike the mean normal it does not cancel where both sides of a thin wall share a cell: VCT's
-directional opacity; w = surface area).
+`vox_projected` (xyz = per axis the larger of the areas the surfaces facing + and - project along it,
+in cell units^2: a one-sided wall its area, both faces of a thin wall one of them, a closed column its
+silhouette; unlike the mean normal it does not cancel in thin walls: VCT's directional opacity;
+w = surface area).
 
 Portable scatter (ARCHITECTURE.md section 3): each triangle is drawn along its dominant axis into the
 layers of that axis's volumes with additive blending (conservative coverage, see voxelize.vert.glsl),
