@@ -10,10 +10,10 @@ void main() {
     vec3 n = texelFetch(rsm_normal, t, 0).xyz;
     vec3 phi = texelFetch(rsm_flux, t, 0).rgb;
     gl_Position = atlas_splat_position(ivec3(floor((pos.xyz - grid_origin) / cell_size)), pos.w != 0.0, atlas_size);
-    v_pos = phi * max(n.x, 0.0);
-    v_neg = phi * max(-n.x, 0.0);
-    v_pos_y = phi * max(n.y, 0.0);
-    v_neg_y = phi * max(-n.y, 0.0);
-    v_pos_z = phi * max(n.z, 0.0);
-    v_neg_z = phi * max(-n.z, 0.0);
+    v_px = phi * max(n.x, 0.0);
+    v_nx = phi * max(-n.x, 0.0);
+    v_py = phi * max(n.y, 0.0);
+    v_ny = phi * max(-n.y, 0.0);
+    v_pz = phi * max(n.z, 0.0);
+    v_nz = phi * max(-n.z, 0.0);
 }

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..backends.base import Backend, ShaderSpec
+from ..backends.base import Backend, Sampler, ShaderSpec, Var
 from ..grid import Grid
 
 
@@ -28,6 +28,22 @@ class Atlas:
         nx, ny, nz = grid.dims
         tiles_x = math.ceil(math.sqrt(nz))
         return cls(tiles_x, (tiles_x * nx, math.ceil(nz / tiles_x) * ny))
+
+
+def splat_spec(name: str, vertex: str, fragment: str, varyings: tuple, outputs: tuple) -> ShaderSpec:
+    """A splatting program's declaration: the RSM samplers, grid and atlas uniforms and the texel
+    attribute that `splat` and `texel_points` provide, plus the program's own varyings and outputs."""
+    return ShaderSpec(
+        name=name,
+        vertex=vertex,
+        fragment=fragment,
+        samplers=(Sampler("rsm_position", "2D"), Sampler("rsm_normal", "2D"), Sampler("rsm_flux", "2D")),
+        uniforms=(Var("grid_origin", "vec3"), Var("cell_size", "float"), Var("dims", "ivec3"),
+                  Var("tiles_x", "int"), Var("atlas_size", "ivec2")),
+        attributes=(Var("texel", "vec2"),),
+        varyings=varyings,
+        outputs=outputs,
+    )
 
 
 def texel_points(backend: Backend, resolution: int, spec: ShaderSpec):

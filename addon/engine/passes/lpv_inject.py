@@ -19,19 +19,11 @@ from __future__ import annotations
 
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
-from .atlas import Atlas, splat
+from .atlas import Atlas, splat, splat_spec
 
-SPEC = ShaderSpec(
-    name="lpv_inject",
-    vertex="lpv/inject.vert.glsl",
-    fragment="lpv/inject.frag.glsl",
-    samplers=(Sampler("rsm_position", "2D"), Sampler("rsm_normal", "2D"), Sampler("rsm_flux", "2D")),
-    uniforms=(Var("grid_origin", "vec3"), Var("cell_size", "float"), Var("dims", "ivec3"), Var("tiles_x", "int"),
-              Var("atlas_size", "ivec2")),
-    attributes=(Var("texel", "vec2"),),
-    varyings=(Var("v_r", "vec4"), Var("v_g", "vec4"), Var("v_b", "vec4")),
-    outputs=(Var("out_r", "vec4"), Var("out_g", "vec4"), Var("out_b", "vec4")),
-)
+SPEC = splat_spec("lpv_inject", "lpv/inject.vert.glsl", "lpv/inject.frag.glsl",
+                  varyings=(Var("v_r", "vec4"), Var("v_g", "vec4"), Var("v_b", "vec4")),
+                  outputs=(Var("out_r", "vec4"), Var("out_g", "vec4"), Var("out_b", "vec4")))
 
 UNPACK = ShaderSpec(
     name="lpv_unpack",

@@ -12,24 +12,15 @@ Portable scatter (ARCHITECTURE.md section 3): additive point splats into the lay
 
 from __future__ import annotations
 
-from ..backends.base import Backend, Sampler, ShaderSpec, Var
+from ..backends.base import Backend, Var
 from ..grid import Grid
-from .atlas import Atlas, splat
+from .atlas import Atlas, splat, splat_spec
 
 DIRECTIONS = ("px", "nx", "py", "ny", "pz", "nz")  # travel along +x, -x, +y, -y, +z, -z
 
-SPEC = ShaderSpec(
-    name="vct_inject",
-    vertex="vct/inject.vert.glsl",
-    fragment="vct/inject.frag.glsl",
-    samplers=(Sampler("rsm_position", "2D"), Sampler("rsm_normal", "2D"), Sampler("rsm_flux", "2D")),
-    uniforms=(Var("grid_origin", "vec3"), Var("cell_size", "float"), Var("dims", "ivec3"), Var("tiles_x", "int"),
-              Var("atlas_size", "ivec2")),
-    attributes=(Var("texel", "vec2"),),
-    varyings=(Var("v_pos", "vec3"), Var("v_neg", "vec3"), Var("v_pos_y", "vec3"), Var("v_neg_y", "vec3"),
-              Var("v_pos_z", "vec3"), Var("v_neg_z", "vec3")),
-    outputs=tuple(Var(f"out_{d}", "vec4") for d in DIRECTIONS),
-)
+SPEC = splat_spec("vct_inject", "vct/inject.vert.glsl", "vct/inject.frag.glsl",
+                  varyings=tuple(Var(f"v_{d}", "vec3") for d in DIRECTIONS),
+                  outputs=tuple(Var(f"out_{d}", "vec4") for d in DIRECTIONS))
 
 
 def run(backend: Backend, target, points, rsm: dict, grid: Grid, atlas: Atlas) -> None:
