@@ -61,3 +61,23 @@ def test_compile_error_names_file_and_line(gl, tmp_path, monkeypatch):
 
 def test_programs_are_cached(gl):
     assert gl.program(selftest.SCALE_OFFSET) is gl.program(selftest.SCALE_OFFSET)
+
+
+def test_dropped_gl_objects_are_released(gl):
+    """Textures and meshes whose handles are dropped are released at the next allocation, inside the
+    backend's own context: moderngl queues them (gc_mode "context_gc") and the queue is empty again
+    after one more texture. Without it every new scene or re-voxelization leaked its GPU memory."""
+    import gc
+
+    from addon.engine.passes import gbuffer
+
+    prog = gl.program(gbuffer.SPEC)
+    attrs = {v.name: np.zeros((3, 4 if v.name == "specular" else 3), np.float32) for v in gbuffer.SPEC.attributes}
+    for _ in range(10):
+        gl.mesh(prog, attrs, "triangles")
+        gl.texture((4, 4))
+    gc.collect()
+    assert len(gl.ctx._objects) > 0  # queued, not yet released
+    kept = gl.texture((4, 4))
+    assert len(gl.ctx._objects) == 0
+    assert kept.gl.glo > 0

@@ -109,6 +109,11 @@ class ModernGLBackend(Backend):
             except Exception as exc:
                 raise BackendUnavailable(f"no EGL OpenGL 4.3 context: {exc}") from exc
         self.ctx = ctx
+        # GL objects whose Python handles die are queued and released by _collect() inside our own
+        # context: with moderngl's default (None) nothing is ever released, and every re-voxelization
+        # or new scene leaked its buffers and textures; "auto" would release from __del__, possibly
+        # while Blender's context is current, deleting its objects of the same names.
+        ctx.gc_mode = "context_gc"
         self._egl = _EglCurrent()
         with ctx:
             current = self._egl.save()
@@ -127,8 +132,13 @@ class ModernGLBackend(Backend):
         return f"OpenGL {info['GL_VERSION']} / {info['GL_RENDERER']} (moderngl)"
 
     # -- textures -----------------------------------------------------------------------------------
+    def _collect(self) -> None:
+        """Release the GL objects dropped since the last allocation (call inside our context)."""
+        self.ctx.gc()
+
     @_in_own_context
     def texture(self, size, fmt="RGBA32F", data=None) -> Texture:
+        self._collect()
         comps = FORMATS[fmt]
         dtype = _DTYPE[fmt]
         if len(size) == 3:
@@ -217,6 +227,7 @@ class ModernGLBackend(Backend):
     # -- drawing ------------------------------------------------------------------------------------
     @_in_own_context
     def mesh(self, program, attributes, primitive) -> _Mesh:
+        self._collect()
         buffers, content, count = [], [], None
         for var in program.spec.attributes:
             arr = np.ascontiguousarray(attributes[var.name], dtype=np.float32)
