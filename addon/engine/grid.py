@@ -31,6 +31,11 @@ class Grid:
         origin = center - dims * cell / 2.0
         return cls(origin, cell, tuple(int(d) for d in dims))
 
+    def same_cells(self, other: Grid | None) -> bool:
+        """The same cells in the same place (dataclass == cannot compare the origin arrays)."""
+        return (other is not None and self.dims == other.dims and self.cell_size_m == other.cell_size_m
+                and np.array_equal(self.origin_m, other.origin_m))
+
     def to_grid(self, p_m: np.ndarray) -> np.ndarray:
         return (np.asarray(p_m, np.float64) - self.origin_m) / self.cell_size_m
 

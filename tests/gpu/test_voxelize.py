@@ -100,7 +100,7 @@ def test_grid_fit_is_not_cubic_for_flat_scenes():
 
 
 def test_slab_buckets_change_nothing(gl, monkeypatch):
-    """Drawing each slab's bucket (slab_triangles) gives exactly the volumes of drawing every triangle
+    """Drawing each slab's bucket (slab_range) gives exactly the volumes of drawing every triangle
     into every slab: 3000 random triangles of every size and slope, 40-cell grid (measured: equal to
     the bit; additive blending of the same fragments in the same order)."""
     from addon.engine.passes import voxelize as vox
@@ -111,7 +111,8 @@ def test_slab_buckets_change_nothing(gl, monkeypatch):
     sc = scene(tris, rng.random((3000, 3)))
     grid = Grid.fit(*sc.bounds_m(), max_cells=40)
     bucketed = voxelize(gl, sc, grid)
-    monkeypatch.setattr(vox, "slab_triangles", lambda p, g, axis: {k: np.arange(len(p)) for k in range(g.dims[axis])})
+    monkeypatch.setattr(vox, "slab_range", lambda p, g, axis: (np.zeros(len(p), np.int64),
+                                                               np.full(len(p), g.dims[axis] - 1, np.int64)))
     everything = voxelize(gl, sc, grid)
     for key in bucketed:
         np.testing.assert_array_equal(bucketed[key], everything[key], err_msg=key)
@@ -132,3 +133,139 @@ def test_projected_area_counts_a_closed_object_once(gl):
     quad = [[[1.5, 1.2, 1.2], [1.5, 1.8, 1.2], [1.5, 1.8, 1.8]], [[1.5, 1.2, 1.2], [1.5, 1.8, 1.8], [1.5, 1.2, 1.8]]]
     vols = voxelize(gl, scene(quad, [[0.5] * 3] * 2), Grid(np.zeros(3), 1.0, (3, 3, 3)))
     np.testing.assert_allclose(vols["vox_projected"][1, 1, 1, :3], [0.36, 0.0, 0.0], atol=1e-5)
+
+
+# Incremental re-voxelization (Voxelizer.update). Why each result is exact: a layer that is not redrawn
+# holds only unchanged triangles, drawn from the same mesh as before; a redrawn layer gets the triangles
+# a full set_scene gives it, in the same order, and additive blending of the same fragments in the same
+# (primitive) order gives the same bits. So every comparison below is np.array_equal, no tolerance.
+
+INCREMENTAL_GRID = Grid(np.zeros(3), 1.0, (16, 16, 16))
+
+
+def box(lo, hi):
+    """12 outward-wound triangles of the axis-aligned box [lo, hi]."""
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    return [[corners[q[0]], corners[q[i]], corners[q[i + 1]]] for q in quads for i in (1, 2)]
+
+
+def boxes_scene(small_box_lo=(3.3, 3.2, 3.4)):
+    """A floor quad at z = 0.5 (triangles 0, 1), a large box (2..13), an emissive small box (14..25)."""
+    floor = [[[0.5, 0.5, 0.5], [15.5, 0.5, 0.5], [15.5, 15.5, 0.5]],
+             [[0.5, 0.5, 0.5], [15.5, 15.5, 0.5], [0.5, 15.5, 0.5]]]
+    small_lo = np.asarray(small_box_lo)
+    tris = np.array(floor + box((8.2, 7.6, 0.5), (13.4, 12.7, 6.3)) + box(small_lo, small_lo + 1.6), np.float32)
+    n = len(tris)
+    albedo = np.tile(np.float32([[0.8, 0.8, 0.8]]), (n, 1))
+    albedo[2:14] = [0.2, 0.6, 0.3]
+    emission = np.zeros((n, 3), np.float32)
+    emission[14:] = [4.0, 2.0, 1.0]
+    return Scene(tris, np.zeros_like(tris), albedo, emission)
+
+
+def incremental(gl, before, after):
+    """Voxelize `before` fully, then `after` through update: (volumes, changed triangles, layers drawn)."""
+    v = Voxelizer(gl, INCREMENTAL_GRID)
+    v.set_scene(before)
+    v.run()
+    assert v.layers_drawn == sum(INCREMENTAL_GRID.dims)
+    changed = v.update(after)
+    vols = v.run()
+    return {k: gl.read(t) for k, t in vols.items()}, changed, v.layers_drawn
+
+
+def assert_volumes_equal(got, expected):
+    for key in expected:
+        assert np.array_equal(got[key], expected[key]), key
+
+
+def test_incremental_moved_box_equals_full_voxelization(gl):
+    """Moving the small box redraws only the slabs its faces reached before or reach now, and the
+    result is bitwise that of voxelizing the moved scene from scratch (why exact: see above)."""
+    before, after = boxes_scene(), boxes_scene(small_box_lo=(4.1, 3.2, 3.9))
+    vols, changed, layers = incremental(gl, before, after)
+    expected = voxelize(gl, after, INCREMENTAL_GRID)
+    assert not np.array_equal(expected["vox_albedo"], voxelize(gl, before, INCREMENTAL_GRID)["vox_albedo"])
+    assert_volumes_equal(vols, expected)
+    assert changed == 12
+    # Box [3.3, 4.9] -> [4.1, 5.7] along x: x faces reach layers 2..5 and 3..6; y faces (3.2 -> 3.2 + 1.6,
+    # unchanged along y) layers 2..5; z faces [3.4, 5.0] -> [3.9, 5.5]: layers 2..6 and 2..6.
+    assert layers == 5 + 4 + 5
+    assert layers < sum(INCREMENTAL_GRID.dims)
+
+
+def test_incremental_albedo_change_redraws_its_slabs_only(gl):
+    """Changing one floor triangle's albedo redraws the two z layers it reaches (z = 0.5 widened by a
+    cell: layers 0 and 1); exact because those layers get the same triangle list, the rest is untouched."""
+    before = boxes_scene()
+    after = boxes_scene()
+    after.albedo[0] = [0.1, 0.9, 0.4]
+    vols, changed, layers = incremental(gl, before, after)
+    assert_volumes_equal(vols, voxelize(gl, after, INCREMENTAL_GRID))
+    assert not np.array_equal(vols["vox_albedo"], voxelize(gl, before, INCREMENTAL_GRID)["vox_albedo"])
+    assert (changed, layers) == (1, 2)
+
+
+def test_incremental_nothing_changed_draws_nothing(gl):
+    """An identical scene changes no triangle: no layer is redrawn, and the volumes (untouched axis
+    volumes merged again by the same deterministic compute pass) equal the full voxelization."""
+    vols, changed, layers = incremental(gl, boxes_scene(), boxes_scene())
+    assert (changed, layers) == (0, 0)
+    assert_volumes_equal(vols, voxelize(gl, boxes_scene(), INCREMENTAL_GRID))
+
+
+def test_incremental_other_triangle_count_falls_back(gl):
+    """Removing the small box leaves no row correspondence: update falls back to set_scene and the run
+    redraws every layer, which is a full voxelization (the same code path, so exact)."""
+    before = boxes_scene()
+    after = Scene(before.positions_m[:14], before.normals[:14], before.albedo[:14], before.emission[:14])
+    vols, changed, layers = incremental(gl, before, after)
+    assert (changed, layers) == (14, sum(INCREMENTAL_GRID.dims))
+    assert_volumes_equal(vols, voxelize(gl, after, INCREMENTAL_GRID))
+
+
+def test_incremental_dominant_axis_change_dirties_both_axes(gl):
+    """The small box's top face triangle (normal +z, in z layers) rotated to face +x (drawn along x)
+    must leave the z layers it reached and enter the x layers it reaches: both are redrawn, and the
+    result is exact (same triangle lists per redrawn layer, the others untouched)."""
+    before = boxes_scene()
+    top = next(i for i in range(14, 26)
+               if np.allclose(before.positions_m[i][:, 2], before.positions_m[i][0, 2])
+               and before.positions_m[i][0, 2] > 4.0)
+    tri = before.positions_m[top].astype(np.float64)
+    # Rotate 90 degrees about the y axis through the triangle's centroid: z <-> x.
+    c = tri.mean(axis=0)
+    rotated = np.stack([c[0] + (tri[:, 2] - c[2]), tri[:, 1], c[2] - (tri[:, 0] - c[0])], axis=1)
+    after = Scene(before.positions_m.copy(), before.normals, before.albedo, before.emission)
+    after.positions_m[top] = rotated
+    vols, changed, layers = incremental(gl, before, after)
+    assert_volumes_equal(vols, voxelize(gl, after, INCREMENTAL_GRID))
+    # An axis-aligned plane at w (not near the grid's edge) reaches layers floor(w) - 1 .. floor(w) + 1:
+    # 3 z layers before (z = 5.0), 3 x layers after (x = the centroid's x).
+    assert changed == 1
+    assert layers == 3 + 3
+
+
+def test_incremental_random_edits_equal_full_voxelization(gl):
+    """3000 random triangles of every size and slope (the slab test's scene); 40 of them moved,
+    recoloured, made emissive or collapsed to a point (degenerate: no longer drawn). Exact for the
+    reasons above; covers triangles clamped at the grid's faces and ones leaving every slab."""
+    rng = np.random.default_rng(2)
+    centres = rng.random((3000, 1, 3)) * 10
+    tris = (centres + rng.normal(size=(3000, 3, 3)) * rng.random((3000, 1, 1)) * 1.5).astype(np.float32)
+    before = Scene(tris, np.zeros_like(tris), rng.random((3000, 3)).astype(np.float32), np.zeros((3000, 3), np.float32))
+    grid = Grid.fit(*before.bounds_m(), max_cells=40)
+    after = Scene(tris.copy(), before.normals, before.albedo.copy(), before.emission.copy())
+    edited = rng.choice(3000, 40, replace=False)
+    after.positions_m[edited[:25]] += rng.normal(size=(25, 1, 3)).astype(np.float32)
+    after.albedo[edited[25:32]] = 0.5
+    after.emission[edited[32:39]] = 3.0
+    after.positions_m[edited[39]] = after.positions_m[edited[39], 0]
+    v = Voxelizer(gl, grid)
+    v.set_scene(before)
+    v.run()
+    assert v.update(after) == 40
+    vols = {k: gl.read(t) for k, t in v.run().items()}
+    assert_volumes_equal(vols, voxelize(gl, after, grid))
+    assert v.layers_drawn < sum(grid.dims)
