@@ -201,6 +201,29 @@ def material_values(mat, images: dict | None = None, textures: list | None = Non
     return np.clip(albedo, 0.0, 1.0), np.maximum(emission, 0.0), warn
 
 
+def material_glossy(mat, images: dict | None = None) -> tuple[np.ndarray, float]:
+    """(F0, roughness) of a material's GGX lobe (Scene.specular / roughness); (0, 1) where it has none.
+
+    Principled BSDF: metals reflect their base colour; the dielectric layer ((ior - 1) / (ior + 1))^2 x
+    2 x Specular IOR Level (0.5: the IOR's own F0) x Specular Tint, over what is not metal. Other
+    surfaces (Diffuse, Emission, unsupported) carry no glossy lobe here."""
+    images = {} if images is None else images
+    tree = getattr(mat, "node_tree", None)
+    node = _surface_node(tree, "OUTPUT_MATERIAL", "Surface") if tree is not None else None
+    if node is None or node.type != "BSDF_PRINCIPLED":
+        return np.zeros(3), 1.0
+    problems: list[str] = []  # material_values reports the same inputs' problems once
+    base = _input_color(node, "Base Color", problems, images)
+    metallic = min(max(_input_float(node, "Metallic", problems), 0.0), 1.0)
+    ior = max(_input_float(node, "IOR", problems), 1.0)
+    level = max(_input_float(node, "Specular IOR Level", problems), 0.0)
+    tint = _input_color(node, "Specular Tint", problems, images)
+    dielectric = min(((ior - 1.0) / (ior + 1.0)) ** 2 * 2.0 * level, 1.0) * tint
+    f0 = metallic * base + (1.0 - metallic) * dielectric
+    rough = min(max(_input_float(node, "Roughness", problems), 0.0), 1.0)
+    return np.clip(f0, 0.0, 1.0), rough
+
+
 def world_color(world, warnings: list[str]) -> np.ndarray:
     """Constant world radiance: Background colour x strength (textures -> their average + a warning)."""
     if world is None:
@@ -399,6 +422,7 @@ class SceneCache:
         seen: dict[tuple, _Block] = {}
         lights: list[Light] = []
         mats: dict[str, tuple] = {}
+        glossy: dict[str, tuple] = {}
         parts: list[tuple] = []
         for inst in depsgraph.object_instances:
             obj = inst.object
@@ -438,7 +462,8 @@ class SceneCache:
             # light, as in Cycles: the G-buffer leaves these triangles out, the RSMs keep them.
             seen_by_camera = obj.original.visible_camera and (
                 not inst.is_instance or inst.parent.original.visible_camera)
-            parts.append((*self._material_arrays(block, slots, mats), seen_by_camera))
+            parts.append((*self._material_arrays(block, slots, mats), *self._glossy_arrays(block, slots, glossy),
+                          seen_by_camera))
         self.blocks = seen
         out.lights = lights
         dropped = sum(b.world[3] for b in seen.values())
@@ -459,7 +484,9 @@ class SceneCache:
             out.normals = np.concatenate([p[1] for p in parts])
             out.albedo = np.concatenate([p[2] for p in parts]).astype(np.float32)
             out.emission = np.concatenate([p[3] for p in parts]).astype(np.float32)
-            out.camera_visible = np.concatenate([np.full(len(p[0]), p[4], bool) for p in parts])
+            out.specular = np.concatenate([p[4] for p in parts]).astype(np.float32)
+            out.roughness = np.concatenate([p[5] for p in parts]).astype(np.float32)
+            out.camera_visible = np.concatenate([np.full(len(p[0]), p[6], bool) for p in parts])
         self.scene = out
         return out
 
@@ -489,11 +516,23 @@ class SceneCache:
         return pos, nrm, albedo, np.asarray(table_e).reshape(-1, 3)[idx]
 
 
+    def _glossy_arrays(self, block: _Block, slots: list, glossy: dict) -> tuple:
+        """Per-triangle F0 (n, 3) and roughness (n,) from the block's material slots."""
+        table = []
+        for mat in slots or [None]:
+            key = mat.name if mat is not None else None
+            if key not in glossy:
+                glossy[key] = material_glossy(mat, self.images)
+            table.append(glossy[key])
+        idx = np.clip(block.mat_index[block.world[2]], 0, len(table) - 1)
+        return np.asarray([t[0] for t in table]).reshape(-1, 3)[idx], np.asarray([t[1] for t in table])[idx]
+
+
 def capture(depsgraph, width: int | None = None, height: int | None = None) -> Scene:
     """The whole scene of an evaluated depsgraph (see the module docstring); width/height: image size
     for the camera (default: render resolution x percentage). No camera -> Scene.camera is None."""
     return SceneCache().update(depsgraph, width, height)
 
 
-__all__ = ["capture", "camera_for", "image_size", "SceneCache", "material_values", "specular_layer_factor",
-           "world_color", "NEUTRAL_ALBEDO"]
+__all__ = ["capture", "camera_for", "image_size", "SceneCache", "material_values", "material_glossy",
+           "specular_layer_factor", "world_color", "NEUTRAL_ALBEDO"]

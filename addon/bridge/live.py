@@ -7,7 +7,7 @@ Why it is shaped like this:
   flight: the handler registers the timer only when it is not registered already.
 - What changed is decided by comparing the new capture with the previous one, not by classifying
   `depsgraph.updates`: those also arrive for settings edits, and a moved mesh, a new material colour or
-  a deleted object all show up differently. Geometry (positions, normals, albedo, emission) bumps
+  a deleted object all show up differently. Geometry (positions, normals, albedo, emission, glossy lobe) bumps
   `geometry_version` (the overlay re-uploads); lights or the world bump `lights_version` (the overlay
   re-runs the light passes only). The cache re-reads no mesh for a light change (`geometry_reads`).
 - The timer does no GPU work: a GPU context is only certain inside a draw callback (on every Blender
@@ -88,7 +88,7 @@ def _same_arrays(a: tuple, b: tuple) -> bool:
 
 
 def _geometry(scene: Scene) -> tuple:
-    return scene.positions_m, scene.normals, scene.albedo, scene.emission
+    return scene.positions_m, scene.normals, scene.albedo, scene.emission, scene.specular_f0(), scene.glossy_roughness()
 
 
 def _lights(scene: Scene) -> list:

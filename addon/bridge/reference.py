@@ -7,6 +7,10 @@ transparent film so that Combined alpha is the geometry mask.
 
 Output of render_reference(): out_dir/indirect.exr, direct.exr, albedo.exr, each RGBA float32 with
 A = Combined alpha (geometry mask; `compare` uses it when the file is the reference), and stats.json.
+With glossy=True also glossy.exr: Glossy Color x Glossy Indirect, the light glossy lobes add to the
+image after one glossy bounce (glossy_bounces = 1; its second vertex is lit by `bounces` - 1 diffuse
+bounces and direct light), the `vct` method's `glossy` product. Without it glossy_bounces = 0: the
+glossy lobes still reflect lights directly (no bounce is needed for that), not other surfaces.
 """
 
 from __future__ import annotations
@@ -24,6 +28,7 @@ from . import images
 from .capture import image_size
 
 PASSES = {"indirect": "Diffuse Indirect", "direct": "Diffuse Direct", "albedo": "Diffuse Color"}
+GLOSSY_PASSES = ("Glossy Indirect", "Glossy Color")  # multiplied into glossy.exr
 
 
 def check_settings(spp: int, bounces: int, res: int) -> None:
@@ -73,7 +78,7 @@ def _use_gpu_if_any(bpy, scene) -> str:
     return "CPU"
 
 
-def _configure(bpy, scene, spp, bounces, width, height, seed, exr_path) -> dict:
+def _configure(bpy, scene, spp, bounces, width, height, seed, exr_path, glossy: bool = False) -> dict:
     r, c = scene.render, scene.cycles
     r.engine = "CYCLES"
     r.resolution_x, r.resolution_y, r.resolution_percentage = width, height, 100
@@ -90,7 +95,8 @@ def _configure(bpy, scene, spp, bounces, width, height, seed, exr_path) -> dict:
     c.use_denoising = False
     c.seed, c.use_animated_seed = seed, False
     c.diffuse_bounces = c.max_bounces = bounces
-    c.glossy_bounces = c.transmission_bounces = c.volume_bounces = c.transparent_max_bounces = 0
+    c.transmission_bounces = c.volume_bounces = c.transparent_max_bounces = 0
+    c.glossy_bounces = 1 if glossy else 0
     c.caustics_reflective = c.caustics_refractive = False
     c.sample_clamp_indirect = 0.0  # default 10 clips bright indirect paths: a bias
     c.sample_clamp_direct = 0.0
@@ -100,6 +106,7 @@ def _configure(bpy, scene, spp, bounces, width, height, seed, exr_path) -> dict:
     vl = bpy.context.view_layer
     vl.use_pass_combined = True
     vl.use_pass_diffuse_direct = vl.use_pass_diffuse_indirect = vl.use_pass_diffuse_color = True
+    vl.use_pass_glossy_indirect = vl.use_pass_glossy_color = glossy
     im = r.image_settings
     im.media_type = "MULTI_LAYER_IMAGE"  # 5.0: must come before the file format (FACTS.md)
     im.file_format = "OPEN_EXR_MULTILAYER"
@@ -136,7 +143,7 @@ def _render(bpy, exr_path) -> float:
 
 
 def render_reference(blend_path, out_dir, spp: int = 1024, bounces: int = 1, res: int = 256,
-                     seed: int = 0) -> dict:
+                     seed: int = 0, glossy: bool = False) -> dict:
     """Render the Cycles reference of `blend_path` into `out_dir` (see module docstring).
 
     Returns the stats dict also written to out_dir/stats.json. Raises ConfigError for values out of
@@ -150,15 +157,18 @@ def render_reference(blend_path, out_dir, spp: int = 1024, bounces: int = 1, res
     width, height = image_size(scene, res)
     with tempfile.TemporaryDirectory(prefix="bounce_ref_") as tmp:
         exr = Path(tmp) / "passes.exr"
-        info = _configure(bpy, scene, spp, bounces, width, height, seed, exr)
+        info = _configure(bpy, scene, spp, bounces, width, height, seed, exr, glossy)
         render_time = _render(bpy, exr)
         layers = images.read_multilayer(exr)
-    missing = [p for p in (*PASSES.values(), "Combined") if p not in layers]
+    missing = [p for p in (*PASSES.values(), "Combined", *(GLOSSY_PASSES if glossy else ())) if p not in layers]
     if missing:
         raise SceneError(f"the render has no {', '.join(missing)} pass (found {sorted(layers)})")
     alpha = layers["Combined"][:, :, 3:4]
     for name, pass_name in PASSES.items():
         images.write_exr(out / f"{name}.exr", np.concatenate([layers[pass_name][:, :, :3], alpha], axis=2))
+    if glossy:
+        light = layers[GLOSSY_PASSES[0]][:, :, :3] * layers[GLOSSY_PASSES[1]][:, :, :3]
+        images.write_exr(out / "glossy.exr", np.concatenate([light, alpha], axis=2))
     stats = {
         "renderer": "cycles",
         "blend": str(Path(blend_path).resolve()),
@@ -169,6 +179,7 @@ def render_reference(blend_path, out_dir, spp: int = 1024, bounces: int = 1, res
         "width": width,
         "height": height,
         "seed": seed,
+        "glossy": glossy,
         "blender_version": bpy.app.version_string,
         **info,
     }

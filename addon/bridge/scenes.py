@@ -1,6 +1,6 @@
 """Procedural benchmark scenes, built with bpy into a fresh empty file. Deterministic (no randomness),
-metres, pure-Lambert materials and explicitly set light parameters, so that every method can be
-compared with Cycles' diffuse passes on exactly the same input.
+metres, pure-Lambert materials (cornell-glossy adds glossy layers) and explicitly set light parameters,
+so that every method can be compared with Cycles' diffuse passes on exactly the same input.
 
 `SCENES` maps a name to its builder; `build(name)` makes the scene, `save(name, path)` writes it.
 Each scene records its name in the custom property `scene["bounce_scene"]`.
@@ -100,15 +100,18 @@ def _light(name: str, kind: str, location, energy: float, direction=(0.0, 0.0, -
 
 # ---------------------------------------------------------------------------------------- materials
 
-def _material(name: str, color=(0.0, 0.0, 0.0), image=None, emission: float = 0.0):
-    """Principled BSDF made pure Lambert: no specular layer (Specular IOR Level 0 removes the ~3 %
-    it takes from the diffuse lobe), roughness 1, metallic 0. Base colour from `color` or `image`."""
+def _material(name: str, color=(0.0, 0.0, 0.0), image=None, emission: float = 0.0, specular_level: float = 0.0,
+              roughness: float = 1.0):
+    """Principled BSDF made pure Lambert by default: no specular layer (Specular IOR Level 0 removes the
+    ~3 % it takes from the diffuse lobe), roughness 1, metallic 0. Base colour from `color` or `image`.
+    `specular_level` > 0 adds the dielectric glossy layer (IOR 1.5: F0 = 0.08 x level) of `roughness`."""
     mat = bpy.data.materials.new(name)
     bsdf = mat.node_tree.nodes["Principled BSDF"]
     bsdf.inputs["Base Color"].default_value = (*color, 1.0)
     bsdf.inputs["Metallic"].default_value = 0.0
-    bsdf.inputs["Roughness"].default_value = 1.0
-    bsdf.inputs["Specular IOR Level"].default_value = 0.0
+    bsdf.inputs["Roughness"].default_value = roughness
+    bsdf.inputs["IOR"].default_value = 1.5
+    bsdf.inputs["Specular IOR Level"].default_value = specular_level
     if image is not None:
         tex = mat.node_tree.nodes.new("ShaderNodeTexImage")
         tex.image = image
@@ -238,7 +241,8 @@ def _wall_with_opening(name: str, lo, hi, axis_a: int, axis_b: int, opening_a, o
 
 # ------------------------------------------------------------------------------------- the scenes
 
-def _cornell(name: str, ceiling_hole=None, textured: bool = False, overhang: float = 0.0) -> None:
+def _cornell(name: str, ceiling_hole=None, textured: bool = False, overhang: float = 0.0,
+             glossy: bool = False) -> None:
     """Cornell box: interior x, y in [-1, 1], z in [0, 2], open at y = -1 where the camera looks in.
     Walls are single-sided rectangles meeting exactly at their edges, normals into the room.
     `textured`: floor and back wall take their albedo from a packed checker image. `overhang` extends
@@ -248,14 +252,18 @@ def _cornell(name: str, ceiling_hole=None, textured: bool = False, overhang: flo
     white = _material("White", WHITE)
     red, green = _material("Red", RED), _material("Green", GREEN)
     floor_mat = back_mat = _material("Checker", WHITE, image=_checker_image()) if textured else white
+    box_mat = white
+    if glossy:  # F0 0.08: a polished floor, satin boxes
+        floor_mat = _material("GlossyFloor", WHITE, specular_level=1.0, roughness=0.2)
+        box_mat = _material("SatinBox", WHITE, specular_level=1.0, roughness=0.45)
     _rect("Floor", (-1, -1, 0), (2, 0, 0), (0, 2, 0), floor_mat)
     o = overhang
     _rect("Ceiling", (-1 - o, -1, 2), (0, 2 + o, 0), (2 + 2 * o, 0, 0), white, hole=ceiling_hole)
     _rect("BackWall", (-1, 1, 0), (2, 0, 0), (0, 0, 2), back_mat)
     _rect("LeftWall", (-1, -1, 0), (0, 2, 0), (0, 0, 2), red)
     _rect("RightWall", (1, -1, 0), (0, 0, 2), (0, 2, 0), green)
-    _box("ShortBox", (0.6, 0.6, 0.6), white, (0.33, -0.3, 0.3), rot_z_deg=-17.0)
-    _box("TallBox", (0.6, 0.6, 1.2), white, (-0.33, 0.3, 0.6), rot_z_deg=17.0)
+    _box("ShortBox", (0.6, 0.6, 0.6), box_mat, (0.33, -0.3, 0.3), rot_z_deg=-17.0)
+    _box("TallBox", (0.6, 0.6, 1.2), box_mat, (-0.33, 0.3, 0.6), rot_z_deg=17.0)
     # atan(1 / 2.4) = 22.6 deg: a 45 deg view from y = -3.4 just fills the frame with the open face.
     _camera((0.0, -3.4, 1.0), (0.0, 0.0, 1.0), 45.0)
 
@@ -292,6 +300,12 @@ def build_cornell_area() -> None:
 def build_textured() -> None:
     """The spot-lit Cornell box with an image-textured floor and back wall (UVs span each wall)."""
     _cornell_spot("textured", textured=True)
+
+
+def build_cornell_glossy() -> None:
+    """The spot-lit Cornell box with a polished floor (F0 0.08, roughness 0.2) and satin boxes (0.45):
+    the scene of the `vct` method's glossy product (reference --glossy)."""
+    _cornell_spot("cornell-glossy", glossy=True)
 
 
 def build_emissive() -> None:
@@ -338,6 +352,7 @@ SCENES = {
     "cornell-sun": build_cornell_sun,
     "cornell-point": build_cornell_point,
     "cornell-area": build_cornell_area,
+    "cornell-glossy": build_cornell_glossy,
     "textured": build_textured,
     "window-room": build_window_room,
     "thin-wall": build_thin_wall,

@@ -3,8 +3,8 @@
 Per region and quality an `Overlay` owns a method instance (direct, rsm or lpv) on the Blender gpu backend,
 rendered with the region's own camera: view = `region_data.view_matrix`, projection =
 `region_data.window_matrix`, at the region's size capped to `gi.resolution` on its long side (halved in
-preview quality). The draw adds albedo x (indirect [+ direct]) x 2^exposure x strength with
-(ONE, ONE) blending over whatever the viewport drew.
+preview quality). The draw adds (albedo x (indirect [+ direct]) [+ glossy]) x 2^exposure x strength
+with (ONE, ONE) blending over whatever the viewport drew.
 
 Depth: no depth test. The overlay's G-buffer is the scene as captured, so where it saw no geometry the
 albedo is 0 and nothing is added; what the viewport draws on top of the scene (gizmos, objects hidden
@@ -39,8 +39,10 @@ PRESENT = ShaderSpec(
     name="present",
     vertex="present/present.vert.glsl",
     fragment="present/present.frag.glsl",
-    samplers=(Sampler("albedo_tex", "2D"), Sampler("direct_tex", "2D"), Sampler("indirect_tex", "2D")),
-    uniforms=(Var("scale", "float"), Var("w_direct", "float"), Var("w_indirect", "float"), Var("use_albedo", "float")),
+    samplers=(Sampler("albedo_tex", "2D"), Sampler("direct_tex", "2D"), Sampler("indirect_tex", "2D"),
+              Sampler("glossy_tex", "2D")),
+    uniforms=(Var("scale", "float"), Var("w_direct", "float"), Var("w_indirect", "float"), Var("use_albedo", "float"),
+              Var("w_glossy", "float")),
     attributes=(Var("pos_ndc", "vec2"),),
     varyings=(Var("uv", "vec2"),),
     outputs=(Var("frag_color", "vec4"),),
@@ -157,7 +159,8 @@ _present_batch = None
 
 
 def present(method, view_mode: str, exposure: float, strength: float) -> None:
-    """Add albedo x (w_d direct + w_i indirect) x 2^exposure x strength to the bound framebuffer."""
+    """Add (albedo x (w_d direct + w_i indirect) + w_i glossy) x 2^exposure x strength to the bound
+    framebuffer; glossy (vct's reflected light, already radiance) only where the method has it."""
     global _present_batch
     prog = backend().program(PRESENT)
     if _present_batch is None:
@@ -172,6 +175,9 @@ def present(method, view_mode: str, exposure: float, strength: float) -> None:
         indirect = getattr(method, "indirect", None)
     if indirect is None:  # a method without indirect light: the sampler needs some texture
         indirect, w_indirect = method.direct, 0.0
+    glossy, w_glossy = getattr(method, "glossy", None), (w_indirect if view_mode != "VOXELS" else 0.0)
+    if glossy is None:
+        glossy, w_glossy = method.direct, 0.0
     shader = prog.gl
     with _restored_gpu_state():
         gpu.state.blend_set("ADDITIVE_PREMULT")  # (ONE, ONE); 'ADDITIVE' would scale by alpha
@@ -182,9 +188,11 @@ def present(method, view_mode: str, exposure: float, strength: float) -> None:
         shader.uniform_float("w_direct", w_direct)
         shader.uniform_float("w_indirect", w_indirect)
         shader.uniform_float("use_albedo", use_albedo)
+        shader.uniform_float("w_glossy", w_glossy)
         shader.uniform_sampler("albedo_tex", method.gbuf["albedo"].gl)
         shader.uniform_sampler("direct_tex", method.direct.gl)
         shader.uniform_sampler("indirect_tex", indirect.gl)
+        shader.uniform_sampler("glossy_tex", glossy.gl)
         _present_batch.draw(shader)
 
 

@@ -70,7 +70,11 @@ class Camera:
 class Scene:
     """Triangles (n, 3 corners, 3) with per-corner normals, per-triangle diffuse albedo and emitted
     radiance (W/m^2/sr, emission colour x strength), lights, the world colour (constant radiance) and
-    the camera. Empty scenes are valid: zero triangles, zero lights."""
+    the camera. Empty scenes are valid: zero triangles, zero lights.
+
+    The glossy lobe (optional, None = none): per triangle `specular` (n, 3), the GGX lobe's reflectance
+    at normal incidence F0 (metals: their base colour; dielectrics ((ior - 1) / (ior + 1))^2 x 2 x
+    Specular IOR Level), and `roughness` (n,), Blender's Roughness (GGX alpha = roughness^2)."""
 
     positions_m: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 3), np.float32))
     normals: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 3), np.float32))
@@ -83,6 +87,20 @@ class Scene:
     # Per triangle: False where the object is hidden from the camera but still reflects light (the
     # G-buffer skips it, the RSMs keep it). None means every triangle is visible.
     camera_visible: np.ndarray | None = None
+    specular: np.ndarray | None = None
+    roughness: np.ndarray | None = None
+
+    def specular_f0(self) -> np.ndarray:
+        """(n, 3) float32 F0 of every triangle's glossy lobe; zeros when the scene has none."""
+        if self.specular is None:
+            return np.zeros((self.triangle_count, 3), np.float32)
+        return np.asarray(self.specular, np.float32)
+
+    def glossy_roughness(self) -> np.ndarray:
+        """(n,) float32 roughness in [0, 1]; 1 (the widest lobe) when the scene gives none."""
+        if self.roughness is None:
+            return np.ones(self.triangle_count, np.float32)
+        return np.asarray(self.roughness, np.float32)
 
     def seen_by_camera(self) -> np.ndarray:
         if self.camera_visible is None:
@@ -114,7 +132,8 @@ class Scene:
         if not np.all(keep):
             warnings.append(f"{int((~keep).sum())} triangles with non-finite corners or zero area were ignored")
         kept = replace(self, positions_m=pos[keep], normals=self.normals[keep], albedo=self.albedo[keep],
-                       emission=self.emission[keep], warnings=warnings, camera_visible=self.seen_by_camera()[keep])
+                       emission=self.emission[keep], warnings=warnings, camera_visible=self.seen_by_camera()[keep],
+                       specular=self.specular_f0()[keep], roughness=self.glossy_roughness()[keep])
         lo, hi = kept.bounds_m()
         origin = (lo + hi) / 2.0
         # Geometry only: lights and camera stay in world space and are shifted per update by the method.

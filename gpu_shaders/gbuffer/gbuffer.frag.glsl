@@ -8,4 +8,5 @@ void main() {
     out_position = vec4(v_pos_ws, 1.0);  // w = 1 marks geometry (coverage)
     out_normal = vec4(n, 0.0);
     out_albedo = vec4(v_albedo, 1.0);
+    out_specular = v_specular;
 }

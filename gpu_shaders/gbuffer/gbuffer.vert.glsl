@@ -1,7 +1,8 @@
-// Camera G-buffer: world-space position, normal and diffuse albedo per pixel.
+// Camera G-buffer: world-space position, normal, diffuse albedo and glossy lobe per pixel.
 void main() {
     gl_Position = view_projection * vec4(pos_ws, 1.0);
     v_pos_ws = pos_ws;
     v_normal_ws = normal_ws;
     v_albedo = albedo;
+    v_specular = specular;
 }

@@ -3,7 +3,7 @@
 // largest projected area) and re-emits albedo * E / pi from each side. Premultiplied radiance leaving
 // along travel direction t (as level0.comp.glsl): albedo * (E_side / pi) * projected area along t's
 // axis / h^2, from the side facing t. Outputs the next bounce's level-0 colours (a unused, 0).
-#include "vct/cone.glsl"
+#include "vct/diffuse.glsl"
 
 void main() {
     ivec3 c = ivec3(gl_GlobalInvocationID);

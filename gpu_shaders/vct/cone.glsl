@@ -1,6 +1,6 @@
 // Cone tracing through the radiance pyramid (samplers pyr_px .. pyr_nz, vct/pyramid.glsl's layout).
 // Uniforms used: grid_origin, cell_size (m), dims (level 0), levels, tex_width (x size of the
-// textures), diffuse_cones, step_ratio, offset_cells. Positions `g` are in level-0 cell units.
+// textures), step_ratio, offset_cells, seed. Positions `g` are in level-0 cell units.
 #include "vct/pyramid.glsl"
 #include "common/hash.glsl"
 
@@ -54,7 +54,7 @@ vec4 sample_directional(vec3 g, float lod, vec3 d) {
 // Front-to-back compositing along one cone from g0 (cell units) in direction d with half-angle tangent
 // tan_half: returns (mean radiance over the cone, W/m^2/sr; accumulated opacity). The sampled voxel's
 // side is the cone diameter scaled to the same cross-section area (sqrt(pi)/2: a disc of diameter D
-// covers pi D^2 / 4), so a voxel of radiance L filling the cone reads L; capped by SIDE_CAP and by the
+// covers pi D^2 / 4), so a voxel of radiance L filling the cone reads L; capped by side_cap x t and by the
 // height over the receiver's own surface less a cell (`rise` = d.n): a coarse block that reached down
 // to that surface would show a low cone its back side, opaque and dark (corners read 0.3 of Cycles).
 // Opacity accumulates linearly, a += a_s dt / s (s the sampled voxel's side), and each step adds its
@@ -62,7 +62,7 @@ vec4 sample_directional(vec3 g, float lod, vec3 d) {
 // of width 2s whose samples sum to 1 at any phase, so the wall stops the cone; the usual
 // a += (1 - a)(1 - (1 - a_s)^(dt/s)) let 19 % through it (tests/gpu/test_vct.py) and 10 % of a closed
 // box's light out.
-vec4 trace_cone(vec3 g0, vec3 d, float tan_half, float rise) {
+vec4 trace_cone(vec3 g0, vec3 d, float tan_half, float rise, float side_cap) {
     vec3 colour = vec3(0.0);
     float alpha = 0.0;
     float t = START_CELLS;
@@ -73,7 +73,7 @@ vec4 trace_cone(vec3 g0, vec3 d, float tan_half, float rise) {
             break;
         }
         float above = offset_cells + t * rise;  // height over the receiver's own surface, cells
-        float side = max(1.0, min(min(0.88622693 * 2.0 * t * tan_half, SIDE_CAP * t), above - 1.0));
+        float side = max(1.0, min(min(0.88622693 * 2.0 * t * tan_half, side_cap * t), above - 1.0));
         float lod = min(log2(side), max_lod);
         vec4 s = sample_directional(g, lod, d);
         float dt = step_ratio * side;
@@ -94,31 +94,4 @@ void tangent_frame(vec3 n, out vec3 tx, out vec3 ty) {
     float b = n.x * n.y * a;
     tx = vec3(1.0 + s * n.x * n.x * a, s * b, -s * n.x);
     ty = vec3(b, s + n.y * n.y * a, -n.y);
-}
-
-// Diffuse gather about normal n at position p (m): `diffuse_cones` cones, one per band of equal solid
-// angle 2 pi / N (cos theta in [1 - (i + 1) / N, 1 - i / N]), at cos theta = 1 - (i + jitter) / N and a
-// golden-angle spiral in phi turned by `rotation`; each weighted by its cos theta, the weights
-// normalised to sum 1, so a uniform environment of radiance L returns exactly L. The side cap makes
-// each cone a narrow probe of its band: with fixed elevations the probes never looked along the normal
-// (a small source straight ahead read 0.16 at 24 cells); with the per-receiver jitter and rotation
-// (uniform in [0, 1) and [0, 2 pi)) every direction is probed on average, and neighbouring pixels
-// average the noise. Returns (E / pi, the cosine-weighted opacity).
-vec4 gather_diffuse(vec3 p, vec3 n, float rotation, float jitter) {
-    vec3 tx, ty;
-    tangent_frame(n, tx, ty);
-    vec3 g0 = (p - grid_origin) / cell_size + offset_cells * n;
-    float cos_half = 1.0 - 1.0 / float(diffuse_cones);
-    float tan_half = sqrt(max(1.0 - cos_half * cos_half, 0.0)) / cos_half;
-    vec4 sum = vec4(0.0);
-    float weights = 0.0;
-    for (int i = 0; i < diffuse_cones; i++) {
-        float z = max(1.0 - (float(i) + jitter) / float(diffuse_cones), 1e-3);
-        float r = sqrt(max(1.0 - z * z, 0.0));
-        float phi = 2.39996323 * float(i) + rotation;
-        vec3 d = normalize(tx * (r * cos(phi)) + ty * (r * sin(phi)) + n * z);
-        sum += z * trace_cone(g0, d, tan_half, dot(d, n));
-        weights += z;
-    }
-    return sum / weights;
 }

@@ -2,7 +2,7 @@
 // diffuse cones about the G-buffer normal; ambient occlusion (the cosine-weighted opacity) in `ao`.
 // With scale > 1 the images are 1/scale of the G-buffer's size and each texel gathers at the centre
 // pixel of its scale x scale block (upsample.comp.glsl brings them back to full size).
-#include "vct/cone.glsl"
+#include "vct/diffuse.glsl"
 
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);

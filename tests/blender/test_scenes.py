@@ -30,6 +30,7 @@ EXPECTED_OBJECTS = {
     "cornell-sun": CORNELL | {"Sun"},
     "cornell-point": CORNELL | {"Point"},
     "cornell-area": CORNELL | {"Area"},
+    "cornell-glossy": CORNELL | {"Spot"},
     "textured": CORNELL | {"Spot"},
     "emissive": CORNELL | {"EmissivePanel"},
     "window-room": ROOM | {f"NorthWall.{p}" for p in ("Below", "Above", "Left", "Right")} | {"Sun", "Camera"},
@@ -144,10 +145,14 @@ def test_scene_builds_complete(fresh_blend, name):
         assert tuple(light.color) == (1.0, 1.0, 1.0) and light.energy > 0
         if light.type in {"POINT", "SPOT"}:
             assert light.shadow_soft_size == 0.0  # a true point light, as an RSM models it
-    for mat in bpy.data.materials:  # pure Lambert: what Cycles' Diffuse passes compare with
+    # Pure Lambert (what Cycles' Diffuse passes compare with), but cornell-glossy's glossy layers.
+    glossy = {"GlossyFloor": (1.0, 0.2), "SatinBox": (1.0, 0.45)} if name == "cornell-glossy" else {}
+    for mat in bpy.data.materials:
         bsdf = mat.node_tree.nodes["Principled BSDF"].inputs
-        assert bsdf["Specular IOR Level"].default_value == 0.0
-        assert bsdf["Roughness"].default_value == 1.0 and bsdf["Metallic"].default_value == 0.0
+        level, roughness = glossy.get(mat.name, (0.0, 1.0))
+        assert bsdf["Specular IOR Level"].default_value == level
+        assert bsdf["Roughness"].default_value == pytest.approx(roughness)
+        assert bsdf["Metallic"].default_value == 0.0
 
     for obj in _mesh_objects():
         assert len(obj.data.uv_layers) == 1, obj.name  # bakes and textures need UVs everywhere

@@ -37,6 +37,12 @@ def test_bake_matches_cycles_bake(tmp_path):
             ours[name, pass_name] = images.read_exr(out / f"{name}_{pass_name}.exr")
             ours_ms[name, pass_name] = summary["objects"][name]["time_ms"]
         ours_ms["setup", pass_name] = summary["setup_ms"]
+    vct_out = tmp_path / "vct"
+    summary = bake_file(blend, vct_out, list(OBJECTS), SIZE, GIConfig(method="vct"), RsmConfig(), "indirect",
+                        progress=False)
+    for name in OBJECTS:
+        assert summary["objects"][name]["status"] == "ok", summary["objects"][name]
+        ours[name, "vct"] = images.read_exr(vct_out / f"{name}_indirect.exr")
 
     bpy.ops.wm.open_mainfile(filepath=str(blend))
     figures = {}
@@ -55,6 +61,9 @@ def test_bake_matches_cycles_bake(tmp_path):
                 ref2, _ = cycles_bake(name, flt, SPP, seed=1, size=SIZE)
                 floor = metrics.compare(ref2[..., :3], ref[..., :3], mask)
                 line += f"; Cycles noise floor rel_rmse_8 {floor['rel_rmse_8']:.4f} rel_rmse {floor['rel_rmse']:.4f}"
+                figures[name, "vct"] = metrics.compare(ours[name, "vct"][..., :3], ref[..., :3], mask)
+                line += (f"; vct rel_rmse_8 {figures[name, 'vct']['rel_rmse_8']:.4f} "
+                         f"bias {figures[name, 'vct']['bias']:.4f}")
             print(line)
     # Measured (64 x 64 texels, RSM 256, 1024 VPLs, 128 voxel cells; Cycles CPU 256 spp, seeds 0/1;
     # 2-core CPU, llvmpipe):

@@ -29,8 +29,8 @@ class Result:
 
 
 def triangle_attributes(scene: Scene, select: np.ndarray | None = None) -> dict[str, np.ndarray] | None:
-    """Per-vertex arrays for the raster passes: three vertices per triangle, flat albedo; `select`
-    picks triangles (None: all). None when nothing is left to draw."""
+    """Per-vertex arrays for the raster passes: three vertices per triangle, flat albedo and glossy lobe
+    (specular: F0, roughness); `select` picks triangles (None: all). None when nothing is left to draw."""
     sel = np.ones(scene.triangle_count, bool) if select is None else select
     n = int(sel.sum())
     if n == 0:
@@ -39,6 +39,7 @@ def triangle_attributes(scene: Scene, select: np.ndarray | None = None) -> dict[
         "pos_ws": scene.positions_m[sel].reshape(n * 3, 3).astype(np.float32),
         "normal_ws": scene.normals[sel].reshape(n * 3, 3).astype(np.float32),
         "albedo": np.repeat(scene.albedo[sel].astype(np.float32), 3, axis=0),
+        "specular": np.repeat(np.c_[scene.specular_f0()[sel], scene.glossy_roughness()[sel]], 3, axis=0),
     }
 
 
@@ -102,9 +103,8 @@ class DirectMethod:
             return
         be = self.backend
         self._size = size
-        self.gbuf = {k: be.texture(size) for k in ("position", "normal", "albedo")}
-        self.gbuf_target = be.target([self.gbuf["position"], self.gbuf["normal"], self.gbuf["albedo"]],
-                                     be.depth_texture(size))
+        self.gbuf = {k: be.texture(size) for k in gbuffer.CHANNELS}
+        self.gbuf_target = be.target([self.gbuf[k] for k in gbuffer.CHANNELS], be.depth_texture(size))
         self.allocate_products(size)
 
     def allocate_products(self, size: tuple[int, int]) -> None:

@@ -4,10 +4,12 @@ Passes: those of `direct` (G-buffer, per light face: rsm, direct_light), then pe
 bound: vct_inject (flux into the atlas); once per update: vct_pyramid.level0 + downsample, and for
 each bounce after the first: vct_gather.bounce (voxels gather and re-emit) -> accumulate -> a pyramid
 of that bounce alone for the next; finally the pyramid of every bounce's light and vct_gather.pixels
--> `indirect` (Cycles' Diffuse Indirect units) and `ao`. The scene is voxelized once per geometry
-change (set_scene). docs/VCT.md derives the units and measures the settings against Cycles.
+-> `indirect` (Cycles' Diffuse Indirect units) and `ao`, and vct_gather.glossy -> `glossy` (the light
+glossy lobes reflect, cones sampling each GGX lobe: Cycles' Glossy Color x Glossy Indirect). The scene is
+voxelized per geometry change (set_scene): only the slabs that changed triangles reach, while the grid
+(fitted to the bounds) stays the same. docs/VCT.md derives the units and measures the settings.
 
-Products: direct, indirect, ao, albedo.
+Products: direct, indirect, ao, albedo, glossy.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from .direct import OneBounceMethod
 
 class VctMethod(OneBounceMethod):
     name = "vct"
-    products = ("direct", "indirect", "ao", "albedo")
+    products = ("direct", "indirect", "ao", "albedo", "glossy")
     max_bounces = 8
 
     def __init__(self, backend, gi, rsm_config, vct_config: VctConfig | None = None):
@@ -33,9 +35,17 @@ class VctMethod(OneBounceMethod):
         self.grid: Grid | None = None
 
     def set_scene(self, scene) -> None:
+        """Upload the scene; when its bounds (so the grid) did not change, as when an object moves inside
+        a room, the voxelizer redraws only the slabs the changed triangles reach (bitwise the same
+        volumes, tests/gpu/test_voxelize.py) and the grid's other textures are kept."""
         super().set_scene(scene)
         be, cfg = self.backend, self.vct_config
-        self.grid = Grid.fit(*self.bounds_m, max_cells=cfg.voxel_cells)
+        grid = Grid.fit(*self.bounds_m, max_cells=cfg.voxel_cells)
+        if grid.same_cells(self.grid):
+            self.voxelizer.update(self.scene)
+            self.voxels = self.voxelizer.run()
+            return
+        self.grid = grid
         self.voxelizer = Voxelizer(be, self.grid)
         self.voxelizer.set_scene(self.scene)
         self.voxels = self.voxelizer.run()
@@ -51,12 +61,14 @@ class VctMethod(OneBounceMethod):
     def allocate_products(self, size: tuple[int, int]) -> None:
         super().allocate_products(size)
         self.ao = self.backend.texture(size)
+        self.glossy = self.backend.texture(size)
+        self._lobe_albedo = vct_gather.split_albedo_texture(self.backend)
         scale = self.vct_config.gather_scale
         low = vct_gather.low_size(size, scale)
         self._low = (self.backend.texture(low), self.backend.texture(low)) if scale > 1 else None
 
     def product_textures(self) -> dict:
-        return {**super().product_textures(), "ao": self.ao}
+        return {**super().product_textures(), "ao": self.ao, "glossy": self.glossy}
 
     def clear_products(self) -> None:
         super().clear_products()
@@ -101,4 +113,7 @@ class VctMethod(OneBounceMethod):
             with self.timed(timings, "vct_gather"):
                 vct_gather.pixels(self.backend, self.pyramid, self.gbuf, self.indirect, self.ao, self.grid,
                                   self.vct_config, self.gi.seed, self._low)
+            with self.timed(timings, "vct_glossy"):
+                vct_gather.glossy(self.backend, self.pyramid, self.gbuf, self._lobe_albedo, self.glossy, self.grid,
+                                  self.vct_config, self.camera().position_m, self.gi.seed)
         return timings

@@ -2,7 +2,8 @@
 
 Inputs: the scene's triangles (mesh attributes pos_ws, normal_ws, albedo). Uniforms: view_projection,
 camera_pos_ws. Outputs (RGBA32F, camera resolution, GL row 0 = bottom): position (world, m; w = 1 where
-geometry), normal (world, unit, flipped towards the camera), albedo (diffuse, linear). Depth: 32F.
+geometry), normal (world, unit, flipped towards the camera), albedo (diffuse, linear), specular (rgb = the
+glossy lobe's F0, a = roughness; Scene.specular). Depth: 32F.
 """
 
 from __future__ import annotations
@@ -15,10 +16,14 @@ SPEC = ShaderSpec(
     vertex="gbuffer/gbuffer.vert.glsl",
     fragment="gbuffer/gbuffer.frag.glsl",
     uniforms=(Var("view_projection", "mat4"), Var("camera_pos_ws", "vec3")),
-    attributes=(Var("pos_ws", "vec3"), Var("normal_ws", "vec3"), Var("albedo", "vec3")),
-    varyings=(Var("v_pos_ws", "vec3"), Var("v_normal_ws", "vec3"), Var("v_albedo", "vec3")),
-    outputs=(Var("out_position", "vec4"), Var("out_normal", "vec4"), Var("out_albedo", "vec4")),
+    attributes=(Var("pos_ws", "vec3"), Var("normal_ws", "vec3"), Var("albedo", "vec3"), Var("specular", "vec4")),
+    varyings=(Var("v_pos_ws", "vec3"), Var("v_normal_ws", "vec3"), Var("v_albedo", "vec3"), Var("v_specular", "vec4")),
+    outputs=(Var("out_position", "vec4"), Var("out_normal", "vec4"), Var("out_albedo", "vec4"),
+             Var("out_specular", "vec4")),
 )
+
+
+CHANNELS = ("position", "normal", "albedo", "specular")  # the outputs' textures, in order
 
 
 def run(backend: Backend, target, mesh, camera: Camera) -> None:

@@ -4,6 +4,10 @@
   (Cycles' Diffuse Indirect units) and `ao` (1 - cosine-weighted cone opacity). With
   VctConfig.gather_scale = s > 1 the cones run at one pixel per s x s block and an edge-aware
   upsampling (normal and tangent-plane weights) fills the full-size images.
+- glossy: at every G-buffer pixel with a glossy lobe (Scene.specular > 0), VctConfig.specular_cones
+  cones sampling the GGX lobe about the view's mirror direction, each as wide as its share of the lobe
+  -> `glossy`, the light the lobe reflects to the camera (Cycles' Glossy Color x Glossy Indirect); the
+  lobe's albedo comes from brdf.split_albedo_table().
 - bounce: at every occupied voxel, the same gather (VctConfig.bounce_cones cones: the light it gathers
   is smooth, and every voxel pays two gathers) on both sides of its surface -> the next bounce's
   level-0 colours (premultiplied radiance by travel direction), albedo x E / pi x projected area.
@@ -14,6 +18,7 @@ Inputs: the pyramid (dict by direction), the Grid, VctConfig; G-buffer or the vo
 from __future__ import annotations
 
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
+from ..brdf import split_albedo_table
 from ..config import VctConfig
 from ..grid import Grid
 from .vct_inject import DIRECTIONS
@@ -21,8 +26,9 @@ from .vct_pyramid import level_count, named, texture_size
 
 _PYRAMID = tuple(Sampler(f"pyr_{d}", "3D") for d in DIRECTIONS)
 _CONE_UNIFORMS = (Var("grid_origin", "vec3"), Var("cell_size", "float"), Var("dims", "ivec3"), Var("levels", "int"),
-                  Var("tex_width", "int"), Var("diffuse_cones", "int"), Var("step_ratio", "float"),
-                  Var("offset_cells", "float"), Var("seed", "int"))
+                  Var("tex_width", "int"), Var("step_ratio", "float"), Var("offset_cells", "float"),
+                  Var("seed", "int"))
+_DIFFUSE_UNIFORMS = (*_CONE_UNIFORMS, Var("diffuse_cones", "int"))
 
 PIXELS = ShaderSpec(
     name="vct_gather",
@@ -30,7 +36,7 @@ PIXELS = ShaderSpec(
     local_size=(8, 8, 1),
     samplers=(*_PYRAMID, Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D")),
     images=(Image("indirect", "2D"), Image("ao", "2D")),
-    uniforms=(*_CONE_UNIFORMS, Var("scale", "int")),
+    uniforms=(*_DIFFUSE_UNIFORMS, Var("scale", "int")),
 )
 
 UPSAMPLE = ShaderSpec(
@@ -43,19 +49,30 @@ UPSAMPLE = ShaderSpec(
     uniforms=(Var("scale", "int"), Var("cell_size", "float")),
 )
 
+GLOSSY = ShaderSpec(
+    name="vct_glossy",
+    compute="vct/glossy.comp.glsl",
+    local_size=(8, 8, 1),
+    samplers=(*_PYRAMID, Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"),
+              Sampler("gbuf_specular", "2D"), Sampler("split_albedo", "2D")),
+    images=(Image("glossy", "2D"),),
+    uniforms=(*_CONE_UNIFORMS, Var("camera_pos_ws", "vec3"), Var("specular_cones", "int"),
+              Var("aperture_scale", "float"), Var("side_cap", "float")),
+)
+
 BOUNCE = ShaderSpec(
     name="vct_bounce",
     compute="vct/bounce.comp.glsl",
     local_size=(4, 4, 4),
     samplers=(*_PYRAMID, Sampler("vox_albedo", "3D"), Sampler("vox_normal", "3D"), Sampler("vox_projected", "3D")),
     images=tuple(Image(f"next_{d}", "3D") for d in DIRECTIONS),
-    uniforms=_CONE_UNIFORMS,
+    uniforms=_DIFFUSE_UNIFORMS,
 )
 
 
-def cone_uniforms(grid: Grid, config: VctConfig, seed: int, cones: int) -> dict:
+def cone_uniforms(grid: Grid, config: VctConfig, seed: int) -> dict:
     """`seed` turns every receiver's cone spiral by its own random angle (GIConfig.seed)."""
-    return {"seed": seed, "diffuse_cones": cones, "grid_origin": grid.origin_m, "cell_size": grid.cell_size_m,
+    return {"seed": seed, "grid_origin": grid.origin_m, "cell_size": grid.cell_size_m,
             "dims": grid.dims,
             "levels": level_count(grid.dims), "tex_width": texture_size(grid.dims)[0],
             "step_ratio": config.step_ratio,
@@ -74,7 +91,8 @@ def pixels(backend: Backend, pyramid: dict, gbuf: dict, indirect, ao, grid: Grid
     scale = config.gather_scale
     out = (indirect, ao) if scale == 1 else low
     backend.dispatch(backend.program(PIXELS), group_count(out[0].size, PIXELS.local_size),
-                     uniforms={**cone_uniforms(grid, config, seed, config.diffuse_cones), "scale": scale},
+                     uniforms={**cone_uniforms(grid, config, seed), "diffuse_cones": config.diffuse_cones,
+                               "scale": scale},
                      samplers={**named(pyramid, "pyr"), "gbuf_position": gbuf["position"],
                                "gbuf_normal": gbuf["normal"]},
                      images={"indirect": out[0], "ao": out[1]})
@@ -91,10 +109,30 @@ def upsample(backend: Backend, gbuf: dict, low: tuple, indirect, ao, scale: int,
                      images={"indirect": indirect, "ao": ao})
 
 
+def split_albedo_texture(backend: Backend):
+    """brdf.split_albedo_table() as a 2D texture sampled at (n.v, roughness)."""
+    table = split_albedo_table()
+    return backend.texture((table.shape[1], table.shape[0]), data=table)
+
+
+def glossy(backend: Backend, pyramid: dict, gbuf: dict, lobe_albedo, out, grid: Grid, config: VctConfig,
+           camera_pos_m, seed: int = 0) -> None:
+    """The specular cones at every pixel into `out` (G-buffer sized); `lobe_albedo` from
+    split_albedo_texture; camera_pos_m in the G-buffer's frame."""
+    backend.dispatch(backend.program(GLOSSY), group_count(out.size, GLOSSY.local_size),
+                     uniforms={**cone_uniforms(grid, config, seed), "camera_pos_ws": camera_pos_m,
+                               "specular_cones": config.specular_cones, "aperture_scale": config.specular_aperture,
+                               "side_cap": config.specular_side_cap},
+                     samplers={**named(pyramid, "pyr"), "gbuf_position": gbuf["position"],
+                               "gbuf_normal": gbuf["normal"], "gbuf_specular": gbuf["specular"],
+                               "split_albedo": lobe_albedo},
+                     images={"glossy": out})
+
+
 def bounce(backend: Backend, pyramid: dict, voxels: dict, next_bounce: dict, grid: Grid, config: VctConfig,
            seed: int = 0) -> None:
     backend.dispatch(backend.program(BOUNCE), group_count(grid.dims, BOUNCE.local_size),
-                     uniforms=cone_uniforms(grid, config, seed, config.bounce_cones),
+                     uniforms={**cone_uniforms(grid, config, seed), "diffuse_cones": config.bounce_cones},
                      samplers={**named(pyramid, "pyr"), "vox_albedo": voxels["vox_albedo"],
                                "vox_normal": voxels["vox_normal"], "vox_projected": voxels["vox_projected"]},
                      images=named(next_bounce, "next"))
