@@ -105,7 +105,7 @@ class VctConfig(_Validated):
                             "voxel radiance: six directions, or their mean (directional opacity kept)")
     specular_cones: int = _num(8, 1, 32, "cones sampling each glossy lobe (GGX, importance sampled)")
     specular_aperture: float = _num(1.0, 0.25, 4.0, "each specular cone's solid angle, x its share of the lobe")
-    specular_side_cap: float = _num(0.15, 0.05, 1.0, "specular cone's sampled voxel side at most this x distance")
+    specular_side_cap: float = _num(0.05, 0.02, 1.0, "specular cone's sampled voxel side at most this x distance")
 
 
 @dataclass(frozen=True)

@@ -172,7 +172,7 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
     from addon.engine import methods
     from addon.engine.config import GIConfig, LpvConfig, RsmConfig, VctConfig
 
-    scenes.build("cornell")
+    scenes.build("cornell-glossy" if name == "vct" else "cornell")  # vct: its glossy product too
     scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 64, 48)
     gi, rsm = GIConfig(method=name, resolution=64), RsmConfig(resolution=128, vpl_samples=64)
     results = []
@@ -184,10 +184,11 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
     a, b = results
     assert set(a) == set(b) == set(methods.get(name).products)
     for key in a:
-        assert a[key].max() > 0, key
-        # Same GLSL bodies, same Mesa rasterizer and fp32 maths on both: equal to float32 rounding
-        # (rtol 1e-5), the gather's hash gives both the same VPLs.
-        np.testing.assert_allclose(b[key], a[key], rtol=1e-5, atol=1e-6, err_msg=key)
+        assert a[key][..., :3].max() > 0, key  # light, not just the coverage in alpha
+        # Same GLSL bodies, same Mesa rasterizer and fp32 maths on both: equal to float32 rounding,
+        # the gather's hash gives both the same VPLs. rtol 1e-4: vct on cornell-glossy differs in 24 of
+        # 12288 values by up to 4.5e-5 (rounding accumulated over cones and steps); the rest by < 1e-5.
+        np.testing.assert_allclose(b[key], a[key], rtol=1e-4, atol=1e-6, err_msg=key)
 
 
 def test_voxels_view_shows_the_grid_on_the_surfaces(cornell):

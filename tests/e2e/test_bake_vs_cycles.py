@@ -1,5 +1,5 @@
-"""Bounce's bake (method rsm, voxel visibility) against Cycles' own bake of the Cornell box's Floor and
-BackWall, texel by texel (64 x 64 lightmaps over the walls' 0..1 UVs).
+"""Bounce's bake (method rsm with voxel visibility, and method vct for indirect) against Cycles' own bake
+of the Cornell box's Floor and BackWall, texel by texel (64 x 64 lightmaps over the walls' 0..1 UVs).
 
 Cycles: `bpy.ops.object.bake(type='DIFFUSE', pass_filter={'INDIRECT'})` (then {'DIRECT'}) without
 'COLOR' gives the light alone, the units of the Diffuse Indirect / Direct passes, which is what Bounce's
@@ -75,6 +75,14 @@ def test_bake_matches_cycles_bake(tmp_path):
     # too bright: VPLs 1.5 cm away on the meeting wall, the gather's near-field singularity); the direct
     # error at the spot cone's and the boxes' shadow edges (Cycles jitters samples over each texel, we
     # point-sample its centre).
+    # vct's bake (64 cells, 16 cones, the same lightmap texels): Floor rel_rmse_8 0.147 bias 0.913,
+    # BackWall 0.234 / 0.823 -- the back wall's light comes from the floor's spot, 2 m away through
+    # coarse voxels that straddle the open front (docs/VCT.md: light escapes the box; bias < 1 on the
+    # camera image too). Bounds: the figures + ~20 %, bias never above 1 (nothing adds light).
+    for name in OBJECTS:
+        v = figures[name, "vct"]
+        assert v["rel_rmse_8"] <= VCT_BOUNDS[name]["indirect_rmse8"], (name, v)
+        assert VCT_BOUNDS[name]["bias_min"] <= v["bias"] <= 1.0, (name, v)
     for name in OBJECTS:
         ind, dirc = figures[name, "indirect"], figures[name, "direct"]
         assert ind["rel_rmse_8"] <= BOUNDS[name]["indirect_rmse8"], (name, ind)
@@ -83,6 +91,10 @@ def test_bake_matches_cycles_bake(tmp_path):
         assert abs(dirc["bias"] - 1.0) <= 0.03, (name, dirc)
 
 
+VCT_BOUNDS = {
+    "Floor": {"indirect_rmse8": 0.18, "bias_min": 0.85},
+    "BackWall": {"indirect_rmse8": 0.28, "bias_min": 0.75},
+}
 BOUNDS = {
     "Floor": {"indirect_rmse8": 0.18, "direct_rmse8": 0.035},
     "BackWall": {"indirect_rmse8": 0.06, "direct_rmse8": 0.09},
