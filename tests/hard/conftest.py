@@ -43,10 +43,6 @@ KNOWN_DEFECTS = {
                                     "(classic 0.15)",
     "test_million_triangle_floor[lpv]": "indirect up to 0.021 on a lone floor that cannot light itself "
                                         "(self-illumination; classic: 3e-7 splat-order differences)",
-    "test_scale_invariance[0.001-lpv]": "0.45 relative L1 between scales (classic 0.36): a metre-valued term "
-                                        "in injection or lookup, not yet found",
-    "test_scale_invariance[10000.0-lpv]": "0.48 relative L1 between scales: as above",
-    "test_indirect_scale_invariance[lpv]": "0.45 relative L1 between scales: as above",
     "test_light_moving_1mm_per_frame[lpv]": "frame-to-frame change 0.0099 against 0.007: VPLs change cells "
                                             "as the light moves (grid-aligned popping)",
 }
