@@ -45,7 +45,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-SCENES = ("cornell", "sponza")
+SCENES = ("cornell", "cornell-glossy", "sponza")
 SPONZA = Path("/work/shared/scenes/sponza/sponza.blend")
 EXPORT_SIZE = (1920, 1080)
 LPV_PASSES = ("lpv_inject", "lpv_propagate", "lpv_lookup")
@@ -74,6 +74,8 @@ def save_scene(scene, path_stem: Path, meta: dict | None = None) -> dict:
         albedo=np.asarray(scene.albedo, np.float32),
         emission=np.asarray(scene.emission, np.float32),
         camera_visible=np.asarray(visible, bool),
+        specular=scene.specular_f0(),
+        roughness=scene.glossy_roughness(),
     )
     info = {
         "lights": [{f.name: _jsonable(getattr(light, f.name)) for f in dataclasses.fields(light)}
@@ -120,7 +122,8 @@ def load_scene(path_stem: Path, size: tuple[int, int] | None = None):
     return Scene(positions_m=arrays["positions_m"], normals=arrays["normals"], albedo=arrays["albedo"],
                  emission=arrays["emission"], lights=lights,
                  world_color=np.array(info["world_color"], np.float32), camera=camera,
-                 warnings=list(info.get("warnings", [])), camera_visible=arrays["camera_visible"])
+                 warnings=list(info.get("warnings", [])), camera_visible=arrays["camera_visible"],
+                 specular=arrays.get("specular"), roughness=arrays.get("roughness"))  # absent in older exports
 
 
 def export(out: Path, names: list[str]) -> None:
@@ -245,6 +248,9 @@ def configs():
         ("vct-64-6cones", {"method": "vct"}, {}, {}, {"voxel_cells": 64, "diffuse_cones": 6}),
         ("vct-64-6cones-half", {"method": "vct"}, {}, {}, {"voxel_cells": 64, "diffuse_cones": 6,
                                                            "gather_scale": 2}),
+        ("vct-64-6cones-quarter", {"method": "vct"}, {}, {}, {"voxel_cells": 64, "diffuse_cones": 6,
+                                                              "gather_scale": 4}),
+        ("vct-64-4specular", {"method": "vct"}, {}, {}, {"voxel_cells": 64, "specular_cones": 4}),
         ("vct-128", {"method": "vct"}, {}, {}, {"voxel_cells": 128}),
         ("vct-64-2bounces", {"method": "vct", "bounces": 2}, {}, {}, {"voxel_cells": 64}),
     ]

@@ -22,14 +22,16 @@ def _scene() -> Scene:
                  lights=[Light("SPOT", [0, 0, 2], [0, 0, -1], [1, 1, 1], power_w=300.0, spot_size_rad=1.2,
                                spot_blend=0.15, name="Spot")],
                  world_color=np.array([0.1, 0.2, 0.3], np.float32),
-                 camera=Camera(np.eye(4), proj, 1920, 1080), camera_visible=np.array([True, False]))
+                 camera=Camera(np.eye(4), proj, 1920, 1080), camera_visible=np.array([True, False]),
+                 specular=np.array([[0.04] * 3, [0.9, 0.6, 0.2]], np.float32), roughness=np.array([0.5, 0.1], np.float32))
 
 
 def test_scene_round_trip(tmp_path):
     scene = _scene()
     gpu_timing.save_scene(scene, tmp_path / "s", {"name": "s"})
     back = gpu_timing.load_scene(tmp_path / "s")
-    for name in ("positions_m", "normals", "albedo", "emission", "camera_visible", "world_color"):
+    for name in ("positions_m", "normals", "albedo", "emission", "camera_visible", "world_color", "specular",
+                 "roughness"):
         np.testing.assert_array_equal(getattr(back, name), getattr(scene, name))
     assert back.positions_m.dtype == np.float32
     (light,), (orig,) = back.lights, scene.lights
