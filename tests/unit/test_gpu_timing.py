@@ -23,7 +23,8 @@ def _scene() -> Scene:
                                spot_blend=0.15, name="Spot")],
                  world_color=np.array([0.1, 0.2, 0.3], np.float32),
                  camera=Camera(np.eye(4), proj, 1920, 1080), camera_visible=np.array([True, False]),
-                 specular=np.array([[0.04] * 3, [0.9, 0.6, 0.2]], np.float32), roughness=np.array([0.5, 0.1], np.float32))
+                 specular=np.array([[0.04] * 3, [0.9, 0.6, 0.2]], np.float32),
+                 roughness=np.array([0.5, 0.1], np.float32))
 
 
 def test_scene_round_trip(tmp_path):
