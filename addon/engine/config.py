@@ -100,7 +100,6 @@ class VctConfig(_Validated):
     bounce_cones: int = _num(6, 3, 32, "cones per voxel side for bounces after the first (smoother light)")
     step_ratio: float = _num(1.0, 0.1, 2.0, "march step as a fraction of the sampled voxel's size")
     offset_cells: float = _num(1.5, 0.0, 4.0, "cone origins moved off their surface along the normal, in cells")
-    inject_offset_cells: float = _num(0.4, 0.0, 2.0, "VPLs injected this far along their normal, in cells")
     gather_scale: int = _num(1, 1, 4, "cones at one pixel per n x n block, upsampled along edges (1: every pixel)")
     radiance: str = _choice("anisotropic", ("anisotropic", "isotropic"),
                             "voxel radiance: six directions, or their mean (directional opacity kept)")

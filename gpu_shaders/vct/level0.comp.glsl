@@ -1,10 +1,7 @@
 // Level 0 of the radiance pyramid from the flux atlas (and, with ADD, plus premultiplied radiance
 // from later bounces): per cell and travel direction t,
 //   colour  c_t = atlas_weight * flux_t / (pi h^2) + add_t
-//   opacity a_t = max(min(1, projected area of the cell's surface along t's axis / h^2),
-//                     min(1, atlas_weight * lit area_t / h^2)).
-// The lit area (the injected surfels' cross-section facing t) gives the cells VPLs were moved into
-// (vct_inject) the opacity of the surface they stand for; elsewhere the geometry's covers it.
+//   opacity a_t = min(1, projected area of the cell's surface along t's axis / h^2).
 // A Lambertian surfel of flux phi has radiance phi / (pi A); seen along t it covers A |n.t| of the
 // cell's h^2 cross-section, so its premultiplied radiance is phi |n.t| / (pi h^2): what the atlas
 // summed (phi max(0, n.t)) over pi h^2. ISOTROPIC replaces the six colours by their mean (opacity
@@ -41,17 +38,10 @@ void main() {
     }
 #endif
     vec3 opacity = min(texelFetch(vox_projected, c, 0).xyz, vec3(1.0));
-    float lit[6];
-    lit[0] = texelFetch(flux_px, at, 0).a * atlas_weight;
-    lit[1] = texelFetch(flux_nx, at, 0).a * atlas_weight;
-    lit[2] = texelFetch(flux_py, at, 0).a * atlas_weight;
-    lit[3] = texelFetch(flux_ny, at, 0).a * atlas_weight;
-    lit[4] = texelFetch(flux_pz, at, 0).a * atlas_weight;
-    lit[5] = texelFetch(flux_nz, at, 0).a * atlas_weight;
-    imageStore(pyr_px, c, vec4(col[0], max(opacity.x, min(lit[0], 1.0))));
-    imageStore(pyr_nx, c, vec4(col[1], max(opacity.x, min(lit[1], 1.0))));
-    imageStore(pyr_py, c, vec4(col[2], max(opacity.y, min(lit[2], 1.0))));
-    imageStore(pyr_ny, c, vec4(col[3], max(opacity.y, min(lit[3], 1.0))));
-    imageStore(pyr_pz, c, vec4(col[4], max(opacity.z, min(lit[4], 1.0))));
-    imageStore(pyr_nz, c, vec4(col[5], max(opacity.z, min(lit[5], 1.0))));
+    imageStore(pyr_px, c, vec4(col[0], opacity.x));
+    imageStore(pyr_nx, c, vec4(col[1], opacity.x));
+    imageStore(pyr_py, c, vec4(col[2], opacity.y));
+    imageStore(pyr_ny, c, vec4(col[3], opacity.y));
+    imageStore(pyr_pz, c, vec4(col[4], opacity.z));
+    imageStore(pyr_nz, c, vec4(col[5], opacity.z));
 }

@@ -1,11 +1,54 @@
 // Writes the fragment into layer `layer` of the axis volume if the triangle's depth range over this
 // pixel overlaps the layer's slab [layer, layer + 1). Additive: value x weight and weight, divided out by
-// the merge. The weight approximates the surface area in the cell: a pixel is a whole cell, so a
-// triangle smaller than a pixel weighs its own projected area, a larger one one pixel; / |n_w| turns
-// projected area into surface area; x the share of the plane's depth range over the pixel that lies in
+// the merge. The weight is the surface area in the cell: the area of the triangle clipped to the pixel
+// (a pixel is a whole cell; exact, by clipping the polygon to the pixel's four sides), / |n_w| to turn
+// projected area into surface area, x the share of the plane's depth range over the pixel that lies in
 // this slab (a tilted surface spans two slabs per pixel: weighing each 1 gave the slab it barely
 // touches a whole cell of opacity, a dark occluder in front of its lit VPLs in VCT, and the Cornell
-// box's surfaces 27 % too much area).
+// box's surfaces 27 % too much area). Conservative rasterization also emits the pixels a triangle only
+// grazes: before the clipping each weighed a whole pixel (min(triangle area, 1)), so meshes of many
+// small triangles counted every edge twice and more.
+
+// Area (pixel units) of triangle (p0, p1, p2) inside the square [lo, lo + 1]^2: Sutherland-Hodgman
+// against the four sides (at most 7 corners), then the shoelace formula.
+float area_in_pixel(vec2 p0, vec2 p1, vec2 p2, vec2 lo) {
+    vec2 hi = lo + 1.0;
+    vec2 poly[8];
+    vec2 next[8];
+    poly[0] = p0;
+    poly[1] = p1;
+    poly[2] = p2;
+    int n = 3;
+    for (int side = 0; side < 4; side++) {
+        int m = 0;
+        for (int i = 0; i < n; i++) {
+            vec2 a = poly[i];
+            vec2 b = poly[i + 1 < n ? i + 1 : 0];
+            float da = side == 0 ? a.x - lo.x : (side == 1 ? hi.x - a.x : (side == 2 ? a.y - lo.y : hi.y - a.y));
+            float db = side == 0 ? b.x - lo.x : (side == 1 ? hi.x - b.x : (side == 2 ? b.y - lo.y : hi.y - b.y));
+            if (da >= 0.0) {
+                next[m] = a;
+                m++;
+            }
+            if ((da >= 0.0) != (db >= 0.0)) {
+                next[m] = a + (b - a) * (da / (da - db));
+                m++;
+            }
+        }
+        n = m;
+        for (int i = 0; i < n; i++) {
+            poly[i] = next[i];
+        }
+    }
+    float twice = 0.0;
+    for (int i = 0; i < n; i++) {
+        vec2 a = poly[i];
+        vec2 b = poly[i + 1 < n ? i + 1 : 0];
+        twice += a.x * b.y - a.y * b.x;
+    }
+    return 0.5 * abs(twice);
+}
+
 void main() {
     vec2 uv = v_uvw.xy;
     if (any(lessThan(uv, v_bbox.xy)) || any(greaterThan(uv, v_bbox.zw))) {
@@ -25,7 +68,8 @@ void main() {
         ? clamp((min(w + spread, float(layer + 1)) - max(w - spread, float(layer))) / (2.0 * spread), 0.0, 1.0)
         : 1.0;
     // A fragment that overlaps the slab keeps a tiny weight at least: occupancy (a > 0) stays conservative.
-    float weight = max(min(v_wrange.z, 1.0) / nw * share, 1e-6);
+    float covered = area_in_pixel(v_corners01.xy, v_corners01.zw, v_corner2, floor(uv));
+    float weight = max(covered / nw * share, 1e-6);
     out_albedo = vec4(v_albedo * weight, weight);
     out_normal = vec4(v_normal * weight, weight);
     out_emission = vec4(v_emission * weight, weight);

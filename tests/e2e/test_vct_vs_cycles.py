@@ -1,7 +1,7 @@
 """Method `vct` against Cycles' Diffuse Indirect on the Cornell box (64 px), one and two bounces.
 
-The issue's target is rel_rmse_8 <= 0.15 with bias 0.9..1.1 (one bounce); measured here: 0.138 /
-0.936 (docs/VCT.md lists what each change earned). The bounds are the measured figures (in comments)
+The issue's target is rel_rmse_8 <= 0.15 with bias 0.9..1.1 (one bounce); measured here: 0.146 /
+0.971 (docs/VCT.md lists what each change earned). The bounds are the measured figures (in comments)
 with a margin; the references (256 spp) have rel_rmse_8 ~0.02 on their own, far below every bound.
 """
 
@@ -49,9 +49,9 @@ def test_vct_on_cornell_one_and_two_bounces(tmp_path):
     one, t1 = render_vct(blend, GIConfig(method="vct", resolution=RES), VctConfig())
     e1 = metrics.compare(one, refs[1], mask)
     print(f"vct 1 bounce, 64 cells, 16 cones: {e1}, total {t1['total']:.0f} ms")
-    # Measured (llvmpipe): rel_rmse 0.56 (per-pixel noise of the jittered cones), rel_rmse_8 0.138,
-    # bias 0.936 (0.150 / 0.925 before the injection offset; isotropic radiance, before the jitter:
-    # 1.13 / 0.80). rsm without visibility scores 0.19 / 1.14 here.
+    # Measured (llvmpipe): rel_rmse 0.58 (per-pixel noise of the jittered cones), rel_rmse_8 0.146,
+    # bias 0.971 (0.150 / 0.925 before the voxelizer weighed fragments by their exact coverage;
+    # isotropic radiance, before the jitter: 1.13 / 0.80). rsm without visibility scores 0.19 / 1.14.
     assert e1["rel_rmse_8"] <= 0.18
     assert 0.88 <= e1["bias"] <= 1.0
 
@@ -64,18 +64,19 @@ def test_vct_on_cornell_one_and_two_bounces(tmp_path):
     print(f"vct 2 bounces, 32 cells: {e2}, total {t2['total']:.0f} ms; 1 bounce vs the 2-bounce reference: "
           f"{e1_vs_2}")
     assert np.isfinite(two).all() and (two >= 0).all()
-    # Measured: rel_rmse_8 0.150, bias 0.903 against Cycles at diffuse_bounces = 2 (0.136 / 0.924
-    # before the injection offset); one bounce reads bias 0.65 against that reference, outside the
-    # band, so a missing second bounce fails here.
+    # Measured: rel_rmse_8 0.139, bias 1.003 against Cycles at diffuse_bounces = 2 (0.136 / 0.924
+    # before the voxelizer weighed fragments by their exact coverage); one bounce reads bias 0.67
+    # against that reference, outside the band, so a missing second bounce fails here. Bias bounds:
+    # the issue's 0.9..1.1 widened below by 0.05.
     assert e2["rel_rmse_8"] <= 0.18
-    assert 0.85 <= e2["bias"] <= 1.0
+    assert 0.85 <= e2["bias"] <= 1.1
     assert not 0.85 <= e1_vs_2["bias"]
 
 
 def test_vct_glossy_on_cornell_glossy(tmp_path):
     """The `glossy` product against Cycles' Glossy Color x Glossy Indirect (reference --glossy, one
     glossy bounce) on cornell-glossy: a polished floor (F0 0.08, roughness 0.2) and satin boxes (0.45).
-    Measured (64 px, 64 cells, 8 specular cones): rel_rmse_8 0.399, bias 0.874 (one cone as wide as the
+    Measured (64 px, 64 cells, 8 specular cones): rel_rmse_8 0.388, bias 0.868 (one cone as wide as the
     lobe: 1.18 / 0.76; 128 cells: 0.34 / 0.89); the reference's own noise 0.030 (seed 0 vs 1). Bounds:
     rel_rmse_8 <= 0.5, bias 0.75..1.0 (the pyramid is darker than Cycles, as for diffuse light)."""
     import numpy as np

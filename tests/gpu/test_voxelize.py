@@ -135,6 +135,43 @@ def test_projected_area_counts_a_closed_object_once(gl):
     np.testing.assert_allclose(vols["vox_projected"][1, 1, 1, :3], [0.36, 0.0, 0.0], atol=1e-5)
 
 
+def test_surface_area_is_exact_for_finely_tessellated_and_partial_surfaces(gl):
+    """The weight of a fragment is the triangle's area clipped to its cell, so a surface's area per cell
+    does not depend on how it is tessellated, and a surface covering part of a cell counts that part.
+    A 3 x 3 square over x, y in [0.5, 3.5] at z = 1.5, cut into 2 x 18 x 18 triangles whose edges cross
+    every cell: area 1 in the cells it covers, 0.5 in those it half covers, 0.25 in its corners (before
+    the clipping every pixel a triangle grazed weighed a whole pixel; this test then failed by 0.49).
+    atol 1e-4: fp32 sums of up to ~100 fragments. A quad tilted by atan(0.4) over x, y in [0.25, 2.25]:
+    each cell's area is its exact share, integrated numerically here (4e6 samples: atol 2e-3)."""
+    n = 18
+    xs = 0.5 + 3.0 * np.arange(n + 1) / n
+    tris = []
+    for i in range(n):
+        for j in range(n):
+            a, b = [xs[i], xs[j], 1.5], [xs[i + 1], xs[j], 1.5]
+            c, d = [xs[i + 1], xs[j + 1], 1.5], [xs[i], xs[j + 1], 1.5]
+            tris += [[a, b, c], [a, c, d]]
+    vols = voxelize(gl, scene(tris, [[0.5] * 3] * len(tris)), Grid(np.zeros(3), 1.0, (4, 4, 4)))
+    area = vols["vox_normal"][..., 3]
+    share = np.array([0.5, 1.0, 1.0, 0.5])
+    np.testing.assert_allclose(area[1], np.outer(share, share), atol=1e-4)
+    assert area.sum() == pytest.approx(9.0, abs=1e-3)
+    # A tilted quad: z = 1.2 + 0.4 x over x, y in [0.25, 2.25] (normal dominant along z).
+    def z_of(x):
+        return 1.2 + 0.4 * x
+    quad = np.array([[0.25, 0.25], [2.25, 0.25], [2.25, 2.25], [0.25, 2.25]])
+    corners = [[x, y, z_of(x)] for x, y in quad]
+    tilted = [[corners[0], corners[1], corners[2]], [corners[0], corners[2], corners[3]]]
+    vols = voxelize(gl, scene(tilted, [[0.5] * 3] * 2), Grid(np.zeros(3), 1.0, (3, 3, 3)))
+    # Expected area per cell: sample the quad finely (surface element sqrt(1 + 0.4^2) per unit of x, y).
+    u = (np.arange(2000) + 0.5) / 2000 * 2.0 + 0.25
+    x, y = np.meshgrid(u, u, indexing="ij")
+    cells = np.stack([np.floor(x), np.floor(y), np.floor(z_of(x))], axis=-1).astype(int).reshape(-1, 3)
+    expected = np.zeros((3, 3, 3))
+    np.add.at(expected, (cells[:, 2], cells[:, 1], cells[:, 0]), (2.0 / 2000) ** 2 * np.sqrt(1 + 0.4**2))
+    np.testing.assert_allclose(vols["vox_normal"][..., 3], expected, atol=2e-3)
+
+
 # Incremental re-voxelization (Voxelizer.update). Why each result is exact: a layer that is not redrawn
 # holds only unchanged triangles, drawn from the same mesh as before; a redrawn layer gets the triangles
 # a full set_scene gives it, in the same order, and additive blending of the same fragments in the same

@@ -76,8 +76,7 @@ class VctMethod(OneBounceMethod):
 
     def per_light_view(self, view: LightView, timings: dict[str, float]) -> None:
         with self.timed(timings, "vct_inject"):
-            vct_inject.run(self.backend, self._flux_target, self._points, self.rsm, self.grid, self.atlas,
-                           self.vct_config.inject_offset_cells)
+            vct_inject.run(self.backend, self._flux_target, self._points, self.rsm, self.grid, self.atlas)
 
     def _build(self, atlas_weight: float, add: dict | None) -> None:
         be, iso = self.backend, self.vct_config.radiance == "isotropic"

@@ -30,18 +30,16 @@ class Atlas:
         return cls(tiles_x, (tiles_x * nx, math.ceil(nz / tiles_x) * ny))
 
 
-def splat_spec(name: str, vertex: str, fragment: str, varyings: tuple, outputs: tuple,
-               uniforms: tuple = ()) -> ShaderSpec:
+def splat_spec(name: str, vertex: str, fragment: str, varyings: tuple, outputs: tuple) -> ShaderSpec:
     """A splatting program's declaration: the RSM samplers, grid and atlas uniforms and the texel
-    attribute that `splat` and `texel_points` provide, plus the program's own varyings, outputs and
-    uniforms (given to `splat`)."""
+    attribute that `splat` and `texel_points` provide, plus the program's own varyings and outputs."""
     return ShaderSpec(
         name=name,
         vertex=vertex,
         fragment=fragment,
         samplers=(Sampler("rsm_position", "2D"), Sampler("rsm_normal", "2D"), Sampler("rsm_flux", "2D")),
         uniforms=(Var("grid_origin", "vec3"), Var("cell_size", "float"), Var("dims", "ivec3"),
-                  Var("tiles_x", "int"), Var("atlas_size", "ivec2"), *uniforms),
+                  Var("tiles_x", "int"), Var("atlas_size", "ivec2")),
         attributes=(Var("texel", "vec2"),),
         varyings=varyings,
         outputs=outputs,
@@ -56,12 +54,10 @@ def texel_points(backend: Backend, resolution: int, spec: ShaderSpec):
     return backend.mesh(backend.program(spec), {"texel": texels}, "points")
 
 
-def splat(backend: Backend, spec: ShaderSpec, target, points, rsm: dict, grid: Grid, atlas: Atlas,
-          uniforms: dict | None = None) -> None:
-    """Draw one RSM face's VPLs with `spec` into the atlas textures behind `target`, added; `uniforms`:
-    the program's own (splat_spec's `uniforms`)."""
+def splat(backend: Backend, spec: ShaderSpec, target, points, rsm: dict, grid: Grid, atlas: Atlas) -> None:
+    """Draw one RSM face's VPLs with `spec` into the atlas textures behind `target`, added."""
     backend.draw(backend.program(spec), target, points,
                  uniforms={"grid_origin": grid.origin_m, "cell_size": grid.cell_size_m, "dims": grid.dims,
-                           "tiles_x": atlas.tiles_x, "atlas_size": atlas.size, **(uniforms or {})},
+                           "tiles_x": atlas.tiles_x, "atlas_size": atlas.size},
                  samplers={"rsm_position": rsm["position"], "rsm_normal": rsm["normal"], "rsm_flux": rsm["flux"]},
                  blend="add")
