@@ -75,8 +75,8 @@ def test_bake_matches_cycles_bake(tmp_path):
     # too bright: VPLs 1.5 cm away on the meeting wall, the gather's near-field singularity); the direct
     # error at the spot cone's and the boxes' shadow edges (Cycles jitters samples over each texel, we
     # point-sample its centre).
-    # vct's bake (64 cells, 16 cones, the same lightmap texels): Floor rel_rmse_8 0.147 bias 0.913,
-    # BackWall 0.234 / 0.823 -- the back wall's light comes from the floor's spot, 2 m away through
+    # vct's bake (64 cells, 16 cones, the same lightmap texels): Floor rel_rmse_8 0.135 bias 0.930,
+    # BackWall 0.184 / 0.868 -- the back wall's light comes from the floor's spot, 2 m away through
     # coarse voxels that straddle the open front (docs/VCT.md: light escapes the box; bias < 1 on the
     # camera image too). Bounds: the figures + ~20 %, bias never above 1 (nothing adds light).
     for name in OBJECTS:
