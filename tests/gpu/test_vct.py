@@ -99,7 +99,8 @@ def test_levels_fit_side_by_side(dims):
 
 # -- passes --------------------------------------------------------------------------------------------
 def test_injection_splits_flux_by_direction(gl):
-    """Two VPLs in one cell: each adds phi * max(0, n.t) to direction t, exactly (a sum of 2 floats)."""
+    """Two VPLs in one cell: each adds (phi, A / h^2) * max(0, n.t) to direction t, exactly (a sum of 2
+    floats)."""
     grid = Grid(np.zeros(3), 1.0, (4, 3, 5))
     atlas = Atlas.for_grid(grid)
     res = 2
@@ -109,10 +110,10 @@ def test_injection_splits_flux_by_direction(gl):
     flux = np.zeros((res, res, 4), np.float32)
     n1 = np.array([0.6, 0.0, -0.8])
     pos[0, 0] = [2.5, 1.5, 3.5, 1]
-    nrm[0, 0, :3] = n1
+    nrm[0, 0] = [*n1, 0.25]
     flux[0, 0, :3] = [1.0, 2.0, 4.0]
     pos[0, 1] = [2.2, 1.1, 3.9, 1]
-    nrm[0, 1, :3] = [0, 1, 0]
+    nrm[0, 1] = [0, 1, 0, 0.5]
     flux[0, 1, :3] = [0.5, 0.5, 0.5]
     for k, a in (("position", pos), ("normal", nrm), ("flux", flux)):
         gl.write(rsm[k], a)
@@ -122,13 +123,39 @@ def test_injection_splits_flux_by_direction(gl):
     vct_inject.run(gl, target, points, rsm, grid, atlas)
     z = 3
     row, col = (z // atlas.tiles_x) * 3 + 1, (z % atlas.tiles_x) * 4 + 2
-    expected = {"px": 0.6 * flux[0, 0, :3], "nx": 0, "py": flux[0, 1, :3], "ny": 0, "pz": 0,
-                "nz": 0.8 * flux[0, 0, :3]}
+    expected = {"px": [*(0.6 * flux[0, 0, :3]), 0.6 * 0.25], "nx": 0, "py": [*flux[0, 1, :3], 0.5], "ny": 0,
+                "pz": 0, "nz": [*(0.8 * flux[0, 0, :3]), 0.8 * 0.25]}
     for d in DIRECTIONS:
         got = gl.read(textures[d])
-        np.testing.assert_allclose(got[row, col, :3], np.broadcast_to(expected[d], 3), rtol=1e-6, atol=1e-7,
+        np.testing.assert_allclose(got[row, col], np.broadcast_to(expected[d], 4), rtol=1e-6, atol=1e-7,
                                    err_msg=d)
-        assert np.count_nonzero(got[..., :3]) == np.count_nonzero(got[row, col, :3])  # nothing elsewhere
+        assert np.count_nonzero(got) == np.count_nonzero(got[row, col])  # nothing elsewhere
+
+
+def test_add_light_caps_flux_where_footprints_overhang_the_geometry(gl):
+    """flux += F x min(1, 4 P / S) per cell and direction, added to what the atlas holds: F = 2 with
+    S = 0.5 and P = 1 adds 2 (fits); S = 8, P = 0.5 adds 2 x 4 x 0.5 / 8 = 0.5 (overhangs 16x, capped
+    at 4x); S = 0 adds nothing. Exact in fp32 (products of powers of two)."""
+    grid = Grid(np.zeros(3), 1.0, (3, 1, 1))
+    atlas = Atlas.for_grid(grid)
+    light = {d: gl.texture(atlas.size) for d in DIRECTIONS}
+    flux = {d: gl.texture(atlas.size) for d in DIRECTIONS}
+    scratch = np.zeros((atlas.size[1], atlas.size[0], 4), np.float32)
+    scratch[0, 0] = [2.0, 2.0, 2.0, 0.5]
+    scratch[0, 1] = [2.0, 2.0, 2.0, 8.0]
+    scratch[0, 2] = [2.0, 2.0, 2.0, 0.0]
+    for d in DIRECTIONS:
+        gl.write(light[d], scratch)
+        gl.write(flux[d], np.full_like(scratch, 1.0))
+    projected = np.zeros((1, 1, 3, 4), np.float32)
+    projected[0, 0, 0, :3] = 1.0
+    projected[0, 0, 1, :3] = 0.5
+    projected[0, 0, 2, :3] = 1.0
+    vct_inject.add_light(gl, light, flux, gl.texture(grid.dims, data=projected), grid, atlas)
+    for d in DIRECTIONS:
+        got = gl.read(flux[d])[0, :3]
+        np.testing.assert_array_equal(got[:, 0], [3.0, 1.5, 1.0], err_msg=d)
+        np.testing.assert_array_equal(got[:, 3], [1.0, 1.0, 1.0], err_msg=d)  # alpha untouched
 
 
 def test_level0_and_downsample_match_numpy(gl):

@@ -1,7 +1,9 @@
 """Method `vct`: voxel cone tracing (Crassin et al. 2011; seeds 003), dense pyramid, N diffuse bounces.
 
 Passes: those of `direct` (G-buffer, per light face: rsm, direct_light), then per RSM face while it is
-bound: vct_inject (flux into the atlas); once per update: vct_pyramid.level0 + downsample, and for
+bound: vct_inject.run (VPL flux and surfel areas into a light's scratch atlas), per light
+vct_inject.add_light (into the flux atlas, capped where a footprint overhangs the geometry); once per
+update: vct_pyramid.level0 + downsample, and for
 each bounce after the first: vct_gather.bounce (voxels gather and re-emit) -> accumulate -> a pyramid
 of that bounce alone for the next; finally the pyramid of every bounce's light and vct_gather.pixels
 -> `indirect` (Cycles' Diffuse Indirect units) and `ao`, and vct_gather.glossy -> `glossy` (the light
@@ -52,6 +54,10 @@ class VctMethod(OneBounceMethod):
         self.atlas = Atlas.for_grid(self.grid)
         self.flux = vct_pyramid.direction_textures(be, self.atlas.size)
         self._flux_target = be.target([self.flux[d] for d in DIRECTIONS])
+        # One light's VPLs (all its RSM faces) before vct_inject.add_light adds them to `flux`.
+        self.light_flux = vct_pyramid.direction_textures(be, self.atlas.size)
+        self._light_target = be.target([self.light_flux[d] for d in DIRECTIONS])
+        self._pending_light: int | None = None
         self._points = atlas.texel_points(be, self.rsm_config.resolution, vct_inject.SPEC)
         self.pyramid = vct_pyramid.pyramid_textures(be, self.grid)
         if self.gi.bounces > 1:
@@ -73,10 +79,23 @@ class VctMethod(OneBounceMethod):
     def clear_products(self) -> None:
         super().clear_products()
         self.backend.clear(self._flux_target)
+        self.backend.clear(self._light_target)
+        self._pending_light = None
 
     def per_light_view(self, view: LightView, timings: dict[str, float]) -> None:
+        """Views come grouped by light: a new light first hands the previous one's VPLs to `flux`."""
         with self.timed(timings, "vct_inject"):
-            vct_inject.run(self.backend, self._flux_target, self._points, self.rsm, self.grid, self.atlas)
+            if self._pending_light is not None and view.light_index != self._pending_light:
+                self._flush_light()
+            vct_inject.run(self.backend, self._light_target, self._points, self.rsm, self.grid, self.atlas)
+            self._pending_light = view.light_index
+
+    def _flush_light(self) -> None:
+        """The pending light's scratch atlas, capped by the voxelized geometry, added to `flux`."""
+        vct_inject.add_light(self.backend, self.light_flux, self.flux, self.voxels["vox_projected"], self.grid,
+                             self.atlas)
+        self.backend.clear(self._light_target)
+        self._pending_light = None
 
     def _build(self, atlas_weight: float, add: dict | None) -> None:
         be, iso = self.backend, self.vct_config.radiance == "isotropic"
@@ -109,6 +128,9 @@ class VctMethod(OneBounceMethod):
             inner = super().compute(run_gbuffer)
             inner.pop("total", None)
             timings.update(inner)
+            if self._pending_light is not None:
+                with self.timed(timings, "vct_inject"):
+                    self._flush_light()
             self.bounce_light(timings)
             with self.timed(timings, "vct_gather"):
                 vct_gather.pixels(self.backend, self.pyramid, self.gbuf, self.indirect, self.ao, self.grid,
