@@ -47,6 +47,34 @@ def _principled(name, **inputs):
     return mat
 
 
+def _plane_head_on(tmp_path, inputs: dict, spp: int, pass_name: str):
+    """A 100 m Principled plane (`inputs`) filling a 16 x 16 Cycles render from 10 m above: returns the
+    capture and the render's layers, with `pass_name` ("Diffuse Color" or "Glossy Color") enabled."""
+    from addon.bridge.images import read_multilayer
+
+    plane = _obj("Plane", [(-50, -50, 0), (50, -50, 0), (50, 50, 0), (-50, 50, 0)], [(0, 1, 2, 3)])
+    plane.data.materials.append(_principled("M", **inputs))
+    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
+    cam.data.lens = 200
+    cam.location = (0, 0, 10)
+    sc = bpy.context.scene
+    sc.collection.objects.link(cam)
+    sc.camera = cam
+    r = sc.render
+    r.engine, r.resolution_x, r.resolution_y, r.resolution_percentage = "CYCLES", 16, 16, 100
+    sc.cycles.samples, sc.cycles.use_denoising, sc.cycles.use_adaptive_sampling = spp, False, False
+    sc.cycles.filter_width = 0.01
+    setattr(bpy.context.view_layer, {"Diffuse Color": "use_pass_diffuse_color",
+                                     "Glossy Color": "use_pass_glossy_color"}[pass_name], True)
+    r.image_settings.media_type = "MULTI_LAYER_IMAGE"  # 5.0: before the file format
+    r.image_settings.file_format = "OPEN_EXR_MULTILAYER"
+    r.image_settings.color_depth = "32"
+    r.filepath, r.use_file_extension = str(tmp_path / "r.exr"), False
+    s = cap.capture(_dg())
+    bpy.ops.render.render(write_still=True)
+    return s, read_multilayer(tmp_path / "r.exr")
+
+
 def test_plane_and_cube_triangles_positions_normals(fresh_blend):
     _plane_cube()
     s = cap.capture(_dg())
@@ -255,30 +283,10 @@ def test_albedo_matches_cycles_diffuse_color(fresh_blend, tmp_path, level, metal
     Tolerance 0.002 absolute: the pass is noise-free for a plane, and over this narrow view (< 3 degrees
     off the normal) the dielectric factor varies < 0.001; our table fits the measurement to < 0.001.
     """
-    from addon.bridge.images import read_multilayer
-
     base = (0.6, 0.3, 0.1, 1)
-    plane = _obj("Plane", [(-50, -50, 0), (50, -50, 0), (50, 50, 0), (-50, 50, 0)], [(0, 1, 2, 3)])
-    plane.data.materials.append(_principled("M", **{"Base Color": base, "Specular IOR Level": level,
-                                                    "Metallic": metallic}))
-    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
-    cam.data.lens = 200
-    cam.location = (0, 0, 10)
-    sc = bpy.context.scene
-    sc.collection.objects.link(cam)
-    sc.camera = cam
-    r = sc.render
-    r.engine, r.resolution_x, r.resolution_y, r.resolution_percentage = "CYCLES", 16, 16, 100
-    sc.cycles.samples, sc.cycles.use_denoising, sc.cycles.use_adaptive_sampling = 1, False, False
-    sc.cycles.filter_width = 0.01
-    bpy.context.view_layer.use_pass_diffuse_color = True
-    r.image_settings.media_type = "MULTI_LAYER_IMAGE"  # 5.0: before the file format
-    r.image_settings.file_format = "OPEN_EXR_MULTILAYER"
-    r.image_settings.color_depth = "32"
-    r.filepath, r.use_file_extension = str(tmp_path / "r.exr"), False
-    s = cap.capture(_dg())
-    bpy.ops.render.render(write_still=True)
-    diff_col = read_multilayer(tmp_path / "r.exr")["Diffuse Color"][:, :, :3]
+    s, layers = _plane_head_on(tmp_path, {"Base Color": base, "Specular IOR Level": level, "Metallic": metallic},
+                               spp=1, pass_name="Diffuse Color")
+    diff_col = layers["Diffuse Color"][:, :, :3]
     assert diff_col.shape == (16, 16, 3)
     np.testing.assert_allclose(diff_col, np.broadcast_to(s.albedo[0], diff_col.shape), atol=2e-3)
     expected_factor = {0.0: 1.0, 0.5: 0.9626, 1.0: 0.9254}[level]  # measured head-on (module docstring)
@@ -401,33 +409,16 @@ def test_glossy_lobe_matches_cycles_glossy_color(fresh_blend, tmp_path, metallic
     n.v = 1 (addon/engine/brdf.py), against Cycles' Glossy Color pass of a plane seen head-on (16 spp,
     noise < 1e-4). Measured ratios 0.998-1.001 for metals and smooth dielectrics, 0.976 at roughness 0.8
     for a dielectric (Cycles uses the exact dielectric Fresnel, we Schlick's): bound 3 %."""
-    from addon.bridge.images import read_multilayer
     from addon.engine import brdf
 
     base = np.array([0.6, 0.3, 0.1])
-    plane = _obj("Plane", [(-50, -50, 0), (50, -50, 0), (50, 50, 0), (-50, 50, 0)], [(0, 1, 2, 3)])
-    plane.data.materials.append(_principled("M", **{"Base Color": (*base, 1), "Specular IOR Level": level,
-                                                    "Metallic": metallic, "Roughness": roughness}))
-    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
-    cam.data.lens = 200
-    cam.location = (0, 0, 10)
-    sc = bpy.context.scene
-    sc.collection.objects.link(cam)
-    sc.camera = cam
-    r = sc.render
-    r.engine, r.resolution_x, r.resolution_y, r.resolution_percentage = "CYCLES", 16, 16, 100
-    sc.cycles.samples, sc.cycles.use_denoising, sc.cycles.use_adaptive_sampling = 16, False, False
-    bpy.context.view_layer.use_pass_glossy_color = True
-    r.image_settings.media_type = "MULTI_LAYER_IMAGE"  # 5.0: before the file format
-    r.image_settings.file_format = "OPEN_EXR_MULTILAYER"
-    r.image_settings.color_depth = "32"
-    r.filepath, r.use_file_extension = str(tmp_path / "r.exr"), False
-    s = cap.capture(_dg())
+    s, layers = _plane_head_on(tmp_path, {"Base Color": (*base, 1), "Specular IOR Level": level,
+                                          "Metallic": metallic, "Roughness": roughness},
+                               spp=16, pass_name="Glossy Color")
     f0 = metallic * base + (1 - metallic) * 0.04 * 2 * level
     np.testing.assert_allclose(s.specular[0], f0, atol=1e-6)
     assert s.roughness[0] == pytest.approx(roughness, abs=1e-6)
-    bpy.ops.render.render(write_still=True)
-    cycles = read_multilayer(tmp_path / "r.exr")["Glossy Color"][:, :, :3].mean(axis=(0, 1))
+    cycles = layers["Glossy Color"][:, :, :3].mean(axis=(0, 1))
     a, b = brdf.split_albedo(1.0, roughness)
     ours = (f0 * a + b) * brdf.multiscatter_factor(a, b, f0)
     print("ours / Cycles' Glossy Color:", ours / cycles)

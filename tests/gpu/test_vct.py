@@ -60,16 +60,22 @@ class Volumes:
         return pyr
 
 
-def gather(gl, pyr, grid, points_cells, normals, config=None):
-    """E / pi and ao at points given in cell units (VctConfig's defaults unless `config`)."""
-    config = config or VctConfig()
+def point_gbuffer(gl, grid, points_cells, normals) -> dict:
+    """A one-row G-buffer (position, normal) of points given in cell units."""
     n = len(points_cells)
     pos = np.zeros((1, n, 4), np.float32)
     pos[0, :, :3] = grid.origin_m + np.asarray(points_cells) * grid.cell_size_m
     pos[0, :, 3] = 1.0
     nrm = np.zeros((1, n, 4), np.float32)
     nrm[0, :, :3] = normals
-    gbuf = {"position": gl.texture((n, 1), data=pos), "normal": gl.texture((n, 1), data=nrm)}
+    return {"position": gl.texture((n, 1), data=pos), "normal": gl.texture((n, 1), data=nrm)}
+
+
+def gather(gl, pyr, grid, points_cells, normals, config=None):
+    """E / pi and ao at points given in cell units (VctConfig's defaults unless `config`)."""
+    config = config or VctConfig()
+    n = len(points_cells)
+    gbuf = point_gbuffer(gl, grid, points_cells, normals)
     indirect, ao = gl.texture((n, 1)), gl.texture((n, 1))
     vct_gather.pixels(gl, pyr, gbuf, indirect, ao, grid, config)
     return gl.read(indirect)[0, :, :3], gl.read(ao)[0, :, 0]
@@ -289,16 +295,10 @@ def glossy_at(gl, pyr, grid, points_cells, normals, eyes_cells, f0, roughness, c
     """The glossy product at points (cell units) seen from eyes (cell units), lobes (F0 rgb, roughness)."""
     config = config or VctConfig()
     n = len(points_cells)
-    pos = np.zeros((1, n, 4), np.float32)
-    pos[0, :, :3] = grid.origin_m + np.asarray(points_cells) * grid.cell_size_m
-    pos[0, :, 3] = 1.0
-    nrm = np.zeros((1, n, 4), np.float32)
-    nrm[0, :, :3] = normals
     spec = np.zeros((1, n, 4), np.float32)
     spec[0, :, :3] = np.asarray(f0, np.float32).reshape(-1, 3)
     spec[0, :, 3] = roughness
-    gbuf = {"position": gl.texture((n, 1), data=pos), "normal": gl.texture((n, 1), data=nrm),
-            "specular": gl.texture((n, 1), data=spec)}
+    gbuf = {**point_gbuffer(gl, grid, points_cells, normals), "specular": gl.texture((n, 1), data=spec)}
     out = gl.texture((n, 1))
     eyes_m = grid.origin_m + np.asarray(eyes_cells, float) * grid.cell_size_m
     results = []
