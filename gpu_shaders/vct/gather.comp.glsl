@@ -3,13 +3,14 @@
 // With scale > 1 the images are 1/scale of the G-buffer's size and each texel gathers at the centre
 // pixel of its scale x scale block (upsample.comp.glsl brings them back to full size).
 #include "vct/diffuse.glsl"
+#include "vct/source_pixel.glsl"
 
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(px, imageSize(indirect)))) {
         return;
     }
-    ivec2 src = min(px * scale + scale / 2, textureSize(gbuf_position, 0) - 1);
+    ivec2 src = source_pixel(px);
     vec4 pos = texelFetch(gbuf_position, src, 0);
     if (pos.w == 0.0) {
         imageStore(indirect, px, vec4(0.0));

@@ -3,9 +3,7 @@
 // pixel it was gathered at matches this pixel: normal agreement max(0, n.n_q)^8 and distance from this
 // pixel's tangent plane, exp(-|n.(p_q - p)| / cell_size). Light does not bleed across depth or normal
 // edges; where no neighbour matches (a thin feature), the nearest texel is used.
-ivec2 source_pixel(ivec2 q) {
-    return min(q * scale + scale / 2, textureSize(gbuf_position, 0) - 1);
-}
+#include "vct/source_pixel.glsl"
 
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
