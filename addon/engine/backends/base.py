@@ -14,7 +14,7 @@ from __future__ import annotations
 import abc
 import contextlib
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
@@ -101,6 +101,15 @@ class ShaderSpec:
             if img.format not in FORMATS:
                 raise ConfigError(
                     f"ShaderSpec {self.name}: image {img.name} format {img.format} not in {list(FORMATS)}")
+
+    def __hash__(self) -> int:
+        # Specs key the backends' program caches, looked up at every dispatch (an LPV update makes
+        # hundreds): hash the nested field tuples once, not per lookup.
+        cached = self.__dict__.get("_hash")
+        if cached is None:
+            cached = hash(tuple(getattr(self, f.name) for f in fields(self)))
+            object.__setattr__(self, "_hash", cached)
+        return cached
 
     @property
     def is_compute(self) -> bool:

@@ -94,6 +94,11 @@ def _in_own_context(method):
     return wrapper
 
 
+@dataclass
+class _Program(Program):
+    members: frozenset = frozenset()  # the names moderngl found (uniforms the compiler kept, ...)
+
+
 class ModernGLBackend(Backend):
     name = "moderngl"
 
@@ -194,14 +199,17 @@ class ModernGLBackend(Backend):
                 )
             except Exception as exc:
                 raise ShaderCompileError(f"{spec.name}: {fs.map_error(str(exc))}") from None
-        prog = Program(spec, gl)
+        prog = _Program(spec, gl, frozenset(gl))
         self._programs[spec] = prog
         return prog
 
-    def _set_uniforms(self, prog: Program, uniforms: dict[str, Any] | None) -> None:
+    def _set_uniforms(self, prog: _Program, uniforms: dict[str, Any] | None) -> None:
         for name, value in (uniforms or {}).items():
-            if name not in prog.gl:
+            if name not in prog.members:
                 continue  # declared but optimised out by the compiler
+            if isinstance(value, (int, float)):  # the common case, without numpy's conversions
+                prog.gl[name].value = value
+                continue
             arr = np.asarray(value)
             if arr.shape == (4, 4):  # numpy row-major maths -> GLSL column-major
                 prog.gl[name].write(np.ascontiguousarray(arr.T, dtype=np.float32).tobytes())
