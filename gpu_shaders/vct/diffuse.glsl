@@ -8,8 +8,9 @@
 // each cone a narrow probe of its band: with fixed elevations the probes never looked along the normal
 // (a small source straight ahead read 0.16 at 24 cells); with the per-receiver jitter and rotation
 // (uniform in [0, 1) and [0, 2 pi)) every direction is probed on average, and neighbouring pixels
-// average the noise. Returns (E / pi, the cosine-weighted opacity).
-vec4 gather_diffuse(vec3 p, vec3 n, float rotation, float jitter) {
+// average the noise. `dither` (uniform in [0, 1)) rounds cone i's levels with dither + i x the golden
+// ratio (trace_cone). Returns (E / pi, the cosine-weighted opacity).
+vec4 gather_diffuse(vec3 p, vec3 n, float rotation, float jitter, float dither) {
     vec3 tx, ty;
     tangent_frame(n, tx, ty);
     vec3 g0 = (p - grid_origin) / cell_size + offset_cells * n;
@@ -22,7 +23,7 @@ vec4 gather_diffuse(vec3 p, vec3 n, float rotation, float jitter) {
         float r = sqrt(max(1.0 - z * z, 0.0));
         float phi = 2.39996323 * float(i) + rotation;
         vec3 d = normalize(tx * (r * cos(phi)) + ty * (r * sin(phi)) + n * z);
-        sum += z * trace_cone(g0, d, tan_half, dot(d, n), SIDE_CAP);
+        sum += z * trace_cone(g0, d, tan_half, dot(d, n), SIDE_CAP, fract(dither + 0.61803399 * float(i)));
         weights += z;
     }
     return sum / weights;

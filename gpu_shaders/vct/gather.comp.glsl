@@ -20,7 +20,8 @@ void main() {
     vec3 n = normalize(texelFetch(gbuf_normal, src, 0).xyz);
     uint s = uint(seed) * 2u;
     vec4 e = gather_diffuse(pos.xyz, n, 6.28318531 * random01(uint(px.x), uint(px.y), s),
-                            random01(uint(px.x), uint(px.y), s + 1u));
+                            random01(uint(px.x), uint(px.y), s + 1u),
+                            random01(uint(px.x), uint(px.y), hash_u32(s ^ DITHER_STREAM)));
     imageStore(indirect, px, vec4(e.rgb, 1.0));
     imageStore(ao, px, vec4(vec3(1.0 - e.a), 1.0));
 }

@@ -41,6 +41,7 @@ void main() {
     uint s = uint(seed) * 2u + 1u;
     float rotation = 6.28318531 * random01(uint(px.x), uint(px.y), s);
     float jitter = random01(uint(px.x), uint(px.y), s + 1u);
+    float dither = random01(uint(px.x), uint(px.y), hash_u32(s ^ DITHER_STREAM));
     float lambda_v = smith_lambda(n_dot_v, alpha);
     vec3 radiance = vec3(0.0);
     float weights = 0.0;
@@ -65,7 +66,8 @@ void main() {
         float cos_half = max(1.0 - solid_angle / 6.28318531, 0.5);
         float tan_half = sqrt(max(1.0 - cos_half * cos_half, 0.0)) / cos_half;
         float weight = v_dot_h / (cos_h * (1.0 + lambda_v + smith_lambda(n_dot_l, alpha)));
-        radiance += weight * trace_cone(g0, l, tan_half, n_dot_l, side_cap).rgb;
+        float u = fract(dither + 0.61803399 * float(i));
+        radiance += weight * trace_cone(g0, l, tan_half, n_dot_l, side_cap, u).rgb;
         weights += weight;
     }
     vec3 mean_radiance = weights > 0.0 ? radiance / weights : vec3(0.0);

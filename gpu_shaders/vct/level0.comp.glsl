@@ -5,7 +5,9 @@
 // A Lambertian surfel of flux phi has radiance phi / (pi A); seen along t it covers A |n.t| of the
 // cell's h^2 cross-section, so its premultiplied radiance is phi |n.t| / (pi h^2): what the atlas
 // summed (phi max(0, n.t)) over pi h^2. ISOTROPIC replaces the six colours by their mean (opacity
-// stays directional).
+// stays directional). Stored x radiance_scale (vct_pyramid.radiance_scale: the first bounce's colours
+// stay below HALF_BOUND), clamped to half_clamp so that later bounces' light, whose bound is not
+// proven, cannot overflow the half floats.
 #include "common/atlas.glsl"
 #include "vct/pyramid.glsl"
 
@@ -37,6 +39,9 @@ void main() {
         col[i] = mean;
     }
 #endif
+    for (int i = 0; i < 6; i++) {
+        col[i] = min(col[i] * radiance_scale, vec3(half_clamp));
+    }
     vec3 opacity = min(texelFetch(vox_projected, c, 0).xyz, vec3(1.0));
     imageStore(pyr_px, c, vec4(col[0], opacity.x));
     imageStore(pyr_nx, c, vec4(col[1], opacity.x));

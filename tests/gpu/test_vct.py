@@ -19,6 +19,10 @@ from addon.engine.passes.vct_inject import DIRECTIONS
 pytestmark = pytest.mark.gpu
 
 H_M = 0.1  # cell size of the synthetic grids
+# The pyramid holds radiance x a scale (vct_pyramid.radiance_scale, for half floats' range) that every
+# gather divides out: the synthetic pyramids use one that is not a power of two, so a pass that forgot
+# it fails the closed forms below.
+RADIANCE_SCALE = 0.37
 
 
 def to_atlas(volume: np.ndarray, atlas: Atlas) -> np.ndarray:
@@ -50,12 +54,12 @@ class Volumes:
         d = ("px", "py", "pz")[axis] if facing > 0 else ("nx", "ny", "nz")[axis]
         self.flux[d][idx + (slice(0, 3),)] += radiance * np.pi * H_M**2
 
-    def pyramid(self, gl, isotropic=False):
+    def pyramid(self, gl, isotropic=False, scale=RADIANCE_SCALE):
         atlas = Atlas.for_grid(self.grid)
         flux = {d: gl.texture(atlas.size, data=to_atlas(self.flux[d], atlas)) for d in DIRECTIONS}
         projected = gl.texture(self.grid.dims, data=self.projected)
         pyr = vct_pyramid.pyramid_textures(gl, self.grid)
-        vct_pyramid.level0(gl, flux, projected, pyr, self.grid, atlas, isotropic=isotropic)
+        vct_pyramid.level0(gl, flux, projected, pyr, self.grid, atlas, scale, isotropic=isotropic)
         vct_pyramid.downsample(gl, pyr, self.grid)
         return pyr
 
@@ -71,13 +75,14 @@ def point_gbuffer(gl, grid, points_cells, normals) -> dict:
     return {"position": gl.texture((n, 1), data=pos), "normal": gl.texture((n, 1), data=nrm)}
 
 
-def gather(gl, pyr, grid, points_cells, normals, config=None):
-    """E / pi and ao at points given in cell units (VctConfig's defaults unless `config`)."""
+def gather(gl, pyr, grid, points_cells, normals, config=None, scale=RADIANCE_SCALE):
+    """E / pi and ao at points given in cell units (VctConfig's defaults unless `config`) from a pyramid
+    built with radiance scale `scale`."""
     config = config or VctConfig()
     n = len(points_cells)
     gbuf = point_gbuffer(gl, grid, points_cells, normals)
     indirect, ao = gl.texture((n, 1)), gl.texture((n, 1))
-    vct_gather.pixels(gl, pyr, gbuf, indirect, ao, grid, config)
+    vct_gather.pixels(gl, pyr, scale, gbuf, indirect, ao, grid, config)
     return gl.read(indirect)[0, :, :3], gl.read(ao)[0, :, 0]
 
 
@@ -165,8 +170,10 @@ def test_add_light_caps_flux_where_footprints_overhang_the_geometry(gl):
 
 
 def test_level0_and_downsample_match_numpy(gl):
-    """Level 0 = flux / (pi h^2) with opacity min(1, projected area); level 1 = pairs composited along
-    t (near child first), four pairs averaged. Exact in fp32 up to rounding (rtol 1e-5)."""
+    """Level 0 = flux / (pi h^2) x the radiance scale with opacity min(1, projected area); level 1 =
+    pairs composited along t (near child first), four pairs averaged. Exact up to half floats' rounding:
+    11 significant bits (2^-11 = 4.9e-4 relative), rounded once at level 0 and again at level 1, so
+    rtol 1.5e-3 (fp32 textures met 1e-5)."""
     rng = np.random.default_rng(7)
     vols = Volumes((6, 4, 5))
     for d in DIRECTIONS:
@@ -176,11 +183,11 @@ def test_level0_and_downsample_match_numpy(gl):
     dims = vols.grid.dims
     level0 = {}
     for i, d in enumerate(DIRECTIONS):
-        c = vols.flux[d][..., :3] / (np.pi * H_M**2)
+        c = vols.flux[d][..., :3] / (np.pi * H_M**2) * RADIANCE_SCALE
         a = np.minimum(vols.projected[..., i // 2], 1.0)[..., None]
         level0[d] = np.concatenate([c, a], axis=-1)
         got = gl.read(pyr[d])[:, :, :dims[0]]
-        np.testing.assert_allclose(got, level0[d], rtol=1e-5, atol=1e-6, err_msg=d)
+        np.testing.assert_allclose(got, level0[d], rtol=1.5e-3, atol=1e-6, err_msg=d)
     # Level 1 by numpy, cell by cell; children outside level 0 are empty.
     d1 = vct_pyramid.level_dims(dims, 1)
     off = vct_pyramid.level_offset(dims, 1)
@@ -204,7 +211,7 @@ def test_level0_and_downsample_match_numpy(gl):
                 want[z, y, x, :3] += 0.25 * (near[:3] + (1 - near[3]) * far[:3])
                 want[z, y, x, 3] += 0.25 * (near[3] + (1 - near[3]) * far[3])
         got = gl.read(pyr[d])[:d1[2], :d1[1], off:off + d1[0]]
-        np.testing.assert_allclose(got, want, rtol=1e-5, atol=1e-6, err_msg=d)
+        np.testing.assert_allclose(got, want, rtol=1.5e-3, atol=1e-6, err_msg=d)
 
 
 # -- cone gathers against closed forms -----------------------------------------------------------------
@@ -303,7 +310,8 @@ def glossy_at(gl, pyr, grid, points_cells, normals, eyes_cells, f0, roughness, c
     eyes_m = grid.origin_m + np.asarray(eyes_cells, float) * grid.cell_size_m
     results = []
     for i in range(n):  # one camera position per point: the pass takes one
-        vct_gather.glossy(gl, pyr, gbuf, vct_gather.split_albedo_texture(gl), out, grid, config, eyes_m[i])
+        vct_gather.glossy(gl, pyr, RADIANCE_SCALE, gbuf, vct_gather.split_albedo_texture(gl), out, grid, config,
+                          eyes_m[i])
         results.append(gl.read(out)[0, i, :3])
     return np.array(results)
 

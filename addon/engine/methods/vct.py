@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from ..config import VctConfig
 from ..grid import Grid
-from ..passes import atlas, vct_gather, vct_inject, vct_pyramid
+from ..passes import atlas, vct_gather, vct_inject, vct_pyramid, zero
 from ..passes.atlas import Atlas
 from ..passes.light_views import LightView
 from ..passes.vct_inject import DIRECTIONS
@@ -53,7 +53,6 @@ class VctMethod(OneBounceMethod):
         self.voxels = self.voxelizer.run()
         self.atlas = Atlas.for_grid(self.grid)
         self.flux = vct_pyramid.direction_textures(be, self.atlas.size)
-        self._flux_target = be.target([self.flux[d] for d in DIRECTIONS])
         # One light's VPLs (all its RSM faces) before vct_inject.add_light adds them to `flux`.
         self.light_flux = vct_pyramid.direction_textures(be, self.atlas.size)
         self._light_target = be.target([self.light_flux[d] for d in DIRECTIONS])
@@ -78,8 +77,8 @@ class VctMethod(OneBounceMethod):
 
     def clear_products(self) -> None:
         super().clear_products()
-        self.backend.clear(self._flux_target)
-        self.backend.clear(self._light_target)
+        zero.images(self.backend, [self.flux[d] for d in DIRECTIONS])
+        zero.images(self.backend, [self.light_flux[d] for d in DIRECTIONS])
         self._pending_light = None
 
     def per_light_view(self, view: LightView, timings: dict[str, float]) -> None:
@@ -94,27 +93,31 @@ class VctMethod(OneBounceMethod):
         """The pending light's scratch atlas, capped by the voxelized geometry, added to `flux`."""
         vct_inject.add_light(self.backend, self.light_flux, self.flux, self.voxels["vox_projected"], self.grid,
                              self.atlas)
-        self.backend.clear(self._light_target)
+        zero.images(self.backend, [self.light_flux[d] for d in DIRECTIONS])
         self._pending_light = None
 
     def _build(self, atlas_weight: float, add: dict | None) -> None:
         be, iso = self.backend, self.vct_config.radiance == "isotropic"
         vct_pyramid.level0(be, self.flux, self.voxels["vox_projected"], self.pyramid, self.grid, self.atlas,
-                           atlas_weight, add, iso)
+                           self.radiance_scale, atlas_weight, add, iso)
         vct_pyramid.downsample(be, self.pyramid, self.grid)
 
     def bounce_light(self, timings: dict[str, float]) -> None:
         """The pyramid of every bounce's light: the first from the injected flux; each later one gathered
         at the voxels from a pyramid of the bounce before it alone (so none is counted twice)."""
         be, cfg = self.backend, self.vct_config
+        lights = [*self.source.lights, *self.emissive]
+        albedo_max = float(self.scene.albedo.max()) if len(self.scene.albedo) else 0.0
+        self.radiance_scale = vct_pyramid.radiance_scale(lights, self.bounds_m, self.grid.cell_size_m,
+                                                         self.gi.bounces, albedo_max)
         with self.timed(timings, "vct_pyramid"):
             self._build(1.0, None)
         if self.gi.bounces == 1:
             return
         for bounce in range(2, self.gi.bounces + 1):
             with self.timed(timings, "vct_bounce"):
-                vct_gather.bounce(be, self.pyramid, self.voxels, self.next_bounce, self.grid, cfg,
-                                  self.gi.seed + bounce)
+                vct_gather.bounce(be, self.pyramid, self.radiance_scale, self.voxels, self.next_bounce, self.grid,
+                                  cfg, self.gi.seed + bounce)
                 vct_pyramid.accumulate(be, self.later_bounces, self.next_bounce, self.grid, first=bounce == 2)
             with self.timed(timings, "vct_pyramid"):
                 if bounce < self.gi.bounces:
@@ -133,9 +136,9 @@ class VctMethod(OneBounceMethod):
                     self._flush_light()
             self.bounce_light(timings)
             with self.timed(timings, "vct_gather"):
-                vct_gather.pixels(self.backend, self.pyramid, self.gbuf, self.indirect, self.ao, self.grid,
-                                  self.vct_config, self.gi.seed, self._low)
+                vct_gather.pixels(self.backend, self.pyramid, self.radiance_scale, self.gbuf, self.indirect,
+                                  self.ao, self.grid, self.vct_config, self.gi.seed, self._low)
             with self.timed(timings, "vct_glossy"):
-                vct_gather.glossy(self.backend, self.pyramid, self.gbuf, self._lobe_albedo, self.glossy, self.grid,
-                                  self.vct_config, self.camera().position_m, self.gi.seed)
+                vct_gather.glossy(self.backend, self.pyramid, self.radiance_scale, self.gbuf, self._lobe_albedo,
+                                  self.glossy, self.grid, self.vct_config, self.camera().position_m, self.gi.seed)
         return timings

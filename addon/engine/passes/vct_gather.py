@@ -27,7 +27,7 @@ from .vct_pyramid import level_count, named, texture_size
 _PYRAMID = tuple(Sampler(f"pyr_{d}", "3D") for d in DIRECTIONS)
 _CONE_UNIFORMS = (Var("grid_origin", "vec3"), Var("cell_size", "float"), Var("dims", "ivec3"), Var("levels", "int"),
                   Var("tex_width", "int"), Var("step_ratio", "float"), Var("offset_cells", "float"),
-                  Var("seed", "int"))
+                  Var("seed", "int"), Var("radiance_scale", "float"))
 _DIFFUSE_UNIFORMS = (*_CONE_UNIFORMS, Var("diffuse_cones", "int"))
 
 PIXELS = ShaderSpec(
@@ -70,9 +70,10 @@ BOUNCE = ShaderSpec(
 )
 
 
-def cone_uniforms(grid: Grid, config: VctConfig, seed: int) -> dict:
-    """`seed` turns every receiver's cone spiral by its own random angle (GIConfig.seed)."""
-    return {"seed": seed, "grid_origin": grid.origin_m, "cell_size": grid.cell_size_m,
+def cone_uniforms(grid: Grid, config: VctConfig, seed: int, radiance_scale: float) -> dict:
+    """`seed` turns every receiver's cone spiral by its own random angle (GIConfig.seed); radiance_scale
+    is what the pyramid's radiance was multiplied by (vct_pyramid.radiance_scale)."""
+    return {"seed": seed, "radiance_scale": radiance_scale, "grid_origin": grid.origin_m, "cell_size": grid.cell_size_m,
             "dims": grid.dims,
             "levels": level_count(grid.dims), "tex_width": texture_size(grid.dims)[0],
             "step_ratio": config.step_ratio,
@@ -84,15 +85,15 @@ def low_size(size: tuple[int, int], scale: int) -> tuple[int, int]:
     return (-(-size[0] // scale), -(-size[1] // scale))
 
 
-def pixels(backend: Backend, pyramid: dict, gbuf: dict, indirect, ao, grid: Grid, config: VctConfig,
-           seed: int = 0, low: tuple | None = None) -> None:
+def pixels(backend: Backend, pyramid: dict, radiance_scale: float, gbuf: dict, indirect, ao, grid: Grid,
+           config: VctConfig, seed: int = 0, low: tuple | None = None) -> None:
     """Gather into `indirect` and `ao`; with config.gather_scale > 1, into `low` (two textures of
     low_size) first, then upsample."""
     scale = config.gather_scale
     out = (indirect, ao) if scale == 1 else low
     backend.dispatch(backend.program(PIXELS), group_count(out[0].size, PIXELS.local_size),
-                     uniforms={**cone_uniforms(grid, config, seed), "diffuse_cones": config.diffuse_cones,
-                               "scale": scale},
+                     uniforms={**cone_uniforms(grid, config, seed, radiance_scale),
+                               "diffuse_cones": config.diffuse_cones, "scale": scale},
                      samplers={**named(pyramid, "pyr"), "gbuf_position": gbuf["position"],
                                "gbuf_normal": gbuf["normal"]},
                      images={"indirect": out[0], "ao": out[1]})
@@ -115,12 +116,12 @@ def split_albedo_texture(backend: Backend):
     return backend.texture((table.shape[1], table.shape[0]), data=table)
 
 
-def glossy(backend: Backend, pyramid: dict, gbuf: dict, lobe_albedo, out, grid: Grid, config: VctConfig,
-           camera_pos_m, seed: int = 0) -> None:
+def glossy(backend: Backend, pyramid: dict, radiance_scale: float, gbuf: dict, lobe_albedo, out, grid: Grid,
+           config: VctConfig, camera_pos_m, seed: int = 0) -> None:
     """The specular cones at every pixel into `out` (G-buffer sized); `lobe_albedo` from
     split_albedo_texture; camera_pos_m in the G-buffer's frame."""
     backend.dispatch(backend.program(GLOSSY), group_count(out.size, GLOSSY.local_size),
-                     uniforms={**cone_uniforms(grid, config, seed), "camera_pos_ws": camera_pos_m,
+                     uniforms={**cone_uniforms(grid, config, seed, radiance_scale), "camera_pos_ws": camera_pos_m,
                                "specular_cones": config.specular_cones, "aperture_scale": config.specular_aperture,
                                "side_cap": config.specular_side_cap},
                      samplers={**named(pyramid, "pyr"), "gbuf_position": gbuf["position"],
@@ -129,10 +130,11 @@ def glossy(backend: Backend, pyramid: dict, gbuf: dict, lobe_albedo, out, grid: 
                      images={"glossy": out})
 
 
-def bounce(backend: Backend, pyramid: dict, voxels: dict, next_bounce: dict, grid: Grid, config: VctConfig,
-           seed: int = 0) -> None:
+def bounce(backend: Backend, pyramid: dict, radiance_scale: float, voxels: dict, next_bounce: dict, grid: Grid,
+           config: VctConfig, seed: int = 0) -> None:
     backend.dispatch(backend.program(BOUNCE), group_count(grid.dims, BOUNCE.local_size),
-                     uniforms={**cone_uniforms(grid, config, seed), "diffuse_cones": config.bounce_cones},
+                     uniforms={**cone_uniforms(grid, config, seed, radiance_scale),
+                               "diffuse_cones": config.bounce_cones},
                      samplers={**named(pyramid, "pyr"), "vox_albedo": voxels["vox_albedo"],
                                "vox_normal": voxels["vox_normal"], "vox_projected": voxels["vox_projected"]},
                      images=named(next_bounce, "next"))
