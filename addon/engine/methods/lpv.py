@@ -27,7 +27,7 @@ import numpy as np
 from ..config import LpvConfig
 from ..errors import ConfigError
 from ..grid import Grid
-from ..passes import atlas, lpv_cascade, lpv_inject, lpv_lookup, lpv_propagate, lpv_reinject, rsm_reduce
+from ..passes import atlas, lpv_cascade, lpv_inject, lpv_lookup, lpv_propagate, lpv_reinject, rsm_reduce, zero
 from ..passes.light_views import LightView
 from ..passes.voxelize import Voxelizer
 from .direct import OneBounceMethod
@@ -134,7 +134,7 @@ class LpvMethod(OneBounceMethod):
     def clear_products(self) -> None:
         super().clear_products()
         for level in self.levels:
-            self.backend.clear(level.inject_target)
+            zero.images(self.backend, list(level.inject_atlas.values()))
 
     def per_light_view(self, view: LightView, timings: dict[str, float]) -> None:
         with self.timed(timings, "lpv_inject"):

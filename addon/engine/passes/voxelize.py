@@ -28,6 +28,7 @@ import numpy as np
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
 from ..scene import Scene
+from . import zero
 
 _UNIFORMS = (Var("grid_origin", "vec3"), Var("cell_size", "float"), Var("dims", "ivec3"), Var("axis", "int"),
              Var("layer", "int"))
@@ -92,6 +93,12 @@ def slab_buckets(first_layer: np.ndarray, last_layer: np.ndarray) -> dict[int, n
     tri, layer = tri[order], layer[order]
     bounds = np.flatnonzero(np.diff(layer, prepend=-1, append=-1))  # each run's start, and the end (layers >= 0)
     return {int(layer[b]): tri[b:e] for b, e in zip(bounds[:-1], bounds[1:], strict=True)}
+
+
+def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
+    """(first, count) of each run of True in a bool array."""
+    edges = np.flatnonzero(np.diff(np.r_[0, flags.astype(np.int8), 0]))
+    return [(int(a), int(b - a)) for a, b in zip(edges[::2], edges[1::2], strict=True)]
 
 
 class Voxelizer:
@@ -161,6 +168,12 @@ class Voxelizer:
             dirty |= rebuilt
         return int(changed.size)
 
+    def invalidate(self) -> None:
+        """Make the next run clear and redraw every layer: what a change reaching everywhere costs (the
+        GPU timings measure a full voxelization this way)."""
+        for dirty in self._dirty:
+            dirty[:] = True
+
     def _classify(self, tris: np.ndarray) -> None:
         """Normals, dominant axes and reached layers of triangles `tris` from the stored positions."""
         pos = self._positions_m[tris]
@@ -218,12 +231,14 @@ class Voxelizer:
         uniforms = {"grid_origin": grid.origin_m, "cell_size": grid.cell_size_m, "dims": grid.dims}
         self.layers_drawn = 0
         for axis in range(3):
+            volumes = [self._axis_volumes[axis][q] for q in _QUANTITIES]
+            for first, count in _runs(self._dirty[axis]):
+                zero.layers(be, volumes, first, count)
             for k in map(int, np.flatnonzero(self._dirty[axis])):
-                target = self._layer_targets[axis][k]
-                be.clear(target)
                 mesh = self._meshes[axis].get(k)
                 if mesh is not None:
-                    be.draw(prog, target, mesh, uniforms={**uniforms, "axis": axis, "layer": k}, blend="add")
+                    be.draw(prog, self._layer_targets[axis][k], mesh, uniforms={**uniforms, "axis": axis, "layer": k},
+                            blend="add")
             self.layers_drawn += int(self._dirty[axis].sum())
             self._dirty[axis][:] = False
         samplers = {f"{q}_{'xyz'[a]}": self._axis_volumes[a][q] for q in _QUANTITIES for a in range(3)}
