@@ -124,3 +124,22 @@ def test_empty_scene_and_no_lights_give_zero(gl):
         method.set_scene(scene)
         img = method.run().images["direct"]
         assert np.all(img[..., :3] == 0.0)
+
+
+def test_every_update_starts_from_a_cleared_gbuffer(gl):
+    """The G-buffer's colours are zeroed by a compute pass and its depth alone by a clear. If depth were
+    not cleared, the second update's fragments (same depth, depth test LESS) would all fail and the
+    image go black; if the colours were not, what a moved camera no longer sees would stay. Exact: the
+    second and third updates equal the first bit for bit, and a camera looking away sees nothing (w = 0)."""
+    method = DirectMethod(gl, GIConfig(), RsmConfig(resolution=64))
+    scene = make_scene(Light("SUN", [0, 0, 0], [0, 0, -1], [1, 1, 1], sun_strength=2.0))
+    method.set_scene(scene)
+    first = method.run().images["direct"]
+    assert first[..., 0].max() > 0
+    for _ in range(2):
+        np.testing.assert_array_equal(method.run().images["direct"], first)
+    # The camera turned to look up (same size: the G-buffer is kept): no pixel sees geometry now.
+    up = Camera(look_along([0, 0, 5], [0, 0, 1], [0, 1, 0]), scene.camera.projection, SIZE, SIZE)
+    method.set_camera(up)
+    method.run()
+    assert np.all(method.backend.read(method.gbuf["position"])[..., 3] == 0.0)

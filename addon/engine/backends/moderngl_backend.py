@@ -22,6 +22,7 @@ from .base import FORMATS, Backend, Mesh, Program, ShaderSpec, Target, Texture
 _DTYPE = {"RGBA32F": "f4", "RGBA16F": "f2", "R32F": "f4", "RG32F": "f4"}
 _GL_FRAMEBUFFER = 0x8D40
 _GL_COLOR_ATTACHMENT0 = 0x8CE0
+_GL_DEPTH_BUFFER_BIT = 0x100
 
 
 @dataclass
@@ -40,7 +41,8 @@ class _Target(Target):
 
 
 def _gl_library():
-    """libGL entry points for the one call moderngl lacks: attaching a 3D-texture layer to an FBO."""
+    """libGL entry points for the calls moderngl lacks: attaching a 3D-texture layer to an FBO, clearing
+    depth alone."""
     for name in ("GL", "OpenGL"):
         path = ctypes.util.find_library(name)
         if path:
@@ -126,6 +128,8 @@ class ModernGLBackend(Backend):
         self._programs: dict[ShaderSpec, Program] = {}
         self._gl = _gl_library()
         self._gl.glFramebufferTextureLayer.argtypes = [ctypes.c_uint] * 3 + [ctypes.c_int] * 2
+        self._gl.glClearDepth.argtypes = [ctypes.c_double]
+        self._gl.glClear.argtypes = [ctypes.c_uint]
 
     @property
     def renderer(self) -> str:
@@ -273,8 +277,9 @@ class ModernGLBackend(Backend):
         self.ctx.viewport = (0, 0, *target.size)
         if color is not None:
             target.fbo.clear(*color, depth=1.0 if depth is None else depth)
-        elif depth is not None:
-            self.ctx.clear(depth=depth)
+        elif depth is not None:  # depth alone: moderngl's clears always clear the colour attachments too
+            self._gl.glClearDepth(depth)
+            self._gl.glClear(_GL_DEPTH_BUFFER_BIT)
 
     @_in_own_context
     def draw(self, program, target, mesh, uniforms=None, samplers=None, blend="none", depth_test=False) -> None:

@@ -133,7 +133,7 @@ class DirectMethod:
         with self.timed(timings, "total"):
             if run_gbuffer:
                 with self.timed(timings, "gbuffer"):
-                    gbuffer.run(be, self.gbuf_target, self._meshes[gbuffer.SPEC.name], self.camera())
+                    gbuffer.run(be, self.gbuf_target, self.gbuf, self._meshes[gbuffer.SPEC.name], self.camera())
             self.clear_products()
             for view in self.light_views():
                 with self.timed(timings, "rsm"):

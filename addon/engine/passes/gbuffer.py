@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from ..backends.base import Backend, ShaderSpec, Var
 from ..scene import Camera
+from . import zero
 
 SPEC = ShaderSpec(
     name="gbuffer",
@@ -26,8 +27,12 @@ SPEC = ShaderSpec(
 CHANNELS = ("position", "normal", "albedo", "specular")  # the outputs' textures, in order
 
 
-def run(backend: Backend, target, mesh, camera: Camera) -> None:
-    backend.clear(target, color=(0, 0, 0, 0), depth=1.0)
+def run(backend: Backend, target, textures: dict, mesh, camera: Camera) -> None:
+    """Draw into `target` (the CHANNELS textures of `textures` + depth). The colours are zeroed by a
+    compute pass and only depth by a clear: a framebuffer clear of four 1080p RGBA32F targets is raster
+    work, slow on compute GPUs (passes/zero.py)."""
+    zero.images(backend, [textures[c] for c in CHANNELS])
+    backend.clear(target, color=None, depth=1.0)
     if mesh is not None:
         backend.draw(backend.program(SPEC), target, mesh,
                      uniforms={"view_projection": camera.view_projection, "camera_pos_ws": camera.position_m},
