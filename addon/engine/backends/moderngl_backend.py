@@ -9,7 +9,7 @@ from __future__ import annotations
 import ctypes
 import ctypes.util
 import functools
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -99,6 +99,14 @@ def _in_own_context(method):
 @dataclass
 class _Program(Program):
     members: frozenset = frozenset()  # the names moderngl found (uniforms the compiler kept, ...)
+    last_values: dict = field(default_factory=dict)  # plain uniform values last written (_set_uniforms)
+
+
+def _plain(value) -> bool:
+    """An int or float, or a tuple of them: written as is and compared cheaply."""
+    if isinstance(value, (int, float)):
+        return True
+    return isinstance(value, tuple) and all(isinstance(v, (int, float)) for v in value)
 
 
 class ModernGLBackend(Backend):
@@ -208,12 +216,17 @@ class ModernGLBackend(Backend):
         return prog
 
     def _set_uniforms(self, prog: _Program, uniforms: dict[str, Any] | None) -> None:
+        last = prog.last_values
         for name, value in (uniforms or {}).items():
             if name not in prog.members:
                 continue  # declared but optimised out by the compiler
-            if isinstance(value, (int, float)):  # the common case, without numpy's conversions
+            if _plain(value):  # the common case, without numpy's conversions
+                if name in last and type(last[name]) is type(value) and last[name] == value:
+                    continue  # a program keeps its uniforms: an LPV propagation sets the same 7 each step
                 prog.gl[name].value = value
+                last[name] = value
                 continue
+            last.pop(name, None)
             arr = np.asarray(value)
             if arr.shape == (4, 4):  # numpy row-major maths -> GLSL column-major
                 prog.gl[name].write(np.ascontiguousarray(arr.T, dtype=np.float32).tobytes())
