@@ -16,13 +16,14 @@ const float SIDE_CAP = 0.15;
 // The level-dithering random numbers' own stream: random01(x, y, hash_u32(stream ^ DITHER_STREAM)).
 const uint DITHER_STREAM = 0x68e31da4u;
 
-// Trilinear sample of one direction's texture at level `level`, clamped to that level's cells
-// (the march stops at the grid's border, so clamping only reaches half a cell outside it).
-vec4 sample_level(sampler3D pyr, vec3 g, int level) {
+// Where a position g (level-0 cell units) is sampled at level `level` in every direction's texture
+// (they share one layout): clamped to that level's cells (the march stops at the grid's border, so
+// clamping only reaches half a cell outside it), then shifted to the level's place along x.
+vec3 level_uvw(vec3 g, int level) {
     ivec3 ld = level_dims(dims, level);
     vec3 q = clamp(g / float(1 << level), vec3(0.5), vec3(ld) - 0.5);
     q.x += float(level_offset(dims, level));
-    return texture(pyr, q / vec3(float(tex_width), float(dims.y), float(dims.z)));
+    return q / vec3(float(tex_width), float(dims.y), float(dims.z));
 }
 
 // What a ray travelling along d meets: the light travelling along -d, from the three axis textures.
@@ -30,16 +31,18 @@ vec4 sample_level(sampler3D pyr, vec3 g, int level) {
 // 1 / |d_i| cells by a ray along d, so it passes (1 - a) of the light at every angle, as a wall with
 // holes does; the d^2-weighted mean of the a_i (Crassin et al.) lets an opaque wall seen at 60 degrees
 // pass 37 % and cones leave closed rooms (a closed box of radiance 1 read 0.36 with 6 cones).
+// The product is exp2(sum |d_i| log2(1 - a_i)), each log floored at -1e30 so that an opaque layer
+// (log -inf) gives 0 and an axis the ray does not cross (|d_i| = 0) gives a factor 1, not NaN.
 // Radiance: the d^2-weighted colours over the d^2-weighted opacities (exact for one surface
 // orientation: each axis texture holds that surface's radiance times its coverage).
 vec4 sample_directional(vec3 g, int level, vec3 d) {
-    vec3 w = d * d;
-    vec4 sx = d.x > 0.0 ? sample_level(pyr_nx, g, level) : sample_level(pyr_px, g, level);
-    vec4 sy = d.y > 0.0 ? sample_level(pyr_ny, g, level) : sample_level(pyr_py, g, level);
-    vec4 sz = d.z > 0.0 ? sample_level(pyr_nz, g, level) : sample_level(pyr_pz, g, level);
+    vec3 uvw = level_uvw(g, level);
+    vec4 sx = d.x > 0.0 ? texture(pyr_nx, uvw) : texture(pyr_px, uvw);
+    vec4 sy = d.y > 0.0 ? texture(pyr_ny, uvw) : texture(pyr_py, uvw);
+    vec4 sz = d.z > 0.0 ? texture(pyr_nz, uvw) : texture(pyr_pz, uvw);
     vec3 a = clamp(vec3(sx.a, sy.a, sz.a), 0.0, 1.0);
-    vec3 ad = abs(d);
-    float transmit = pow(1.0 - a.x, ad.x) * pow(1.0 - a.y, ad.y) * pow(1.0 - a.z, ad.z);
+    float transmit = exp2(dot(abs(d), max(log2(1.0 - a), vec3(-1e30))));
+    vec3 w = d * d;
     float weight = dot(w, a);
     vec3 colour = w.x * sx.rgb + w.y * sy.rgb + w.z * sz.rgb;
     vec3 radiance = weight > 1e-6 ? colour / weight : vec3(0.0);
