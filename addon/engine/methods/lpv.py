@@ -9,7 +9,8 @@ voxels' surface area x |n.d| blocks each transfer. GIConfig.bounces = k > 1 adds
 the first bounce's lookup, each: lpv_reinject (the voxelized surfaces reflect the previous bounce's
 light into a fresh snapshot), N x lpv_propagate into a per-bounce accumulation, lpv_lookup added to
 `indirect`, lpv_reinject.add into the total; these need the voxelizer's albedo and normals, so it runs
-whenever bounces > 1 (it blocks propagation only with geometry_volume). docs/LPV.md derives the
+whenever bounces > 1 (it blocks propagation only with geometry_volume). Over cascades every grid
+re-injects and propagates each bounce, coarsest first, with its parent's inflow of that bounce. docs/LPV.md derives the
 normalisation and measures both variants against Cycles.
 
 The grid is fitted to the uploaded (re-centred) geometry: Grid.fit(bounds, max_cells=grid_cells),
@@ -25,7 +26,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..config import LpvConfig
-from ..errors import ConfigError
 from ..grid import Grid
 from ..passes import atlas, lpv_cascade, lpv_inject, lpv_lookup, lpv_propagate, lpv_reinject, rsm_reduce, zero
 from ..passes.light_views import LightView
@@ -87,11 +87,6 @@ class LpvMethod(OneBounceMethod):
     def __init__(self, backend, gi, rsm_config, lpv_config: LpvConfig | None = None):
         super().__init__(backend, gi, rsm_config)
         self.lpv_config = lpv_config if lpv_config is not None else LpvConfig()
-        if self.lpv_config.cascades > 1 and gi.bounces > 1:
-            raise ConfigError(f"LpvConfig.cascades = {self.lpv_config.cascades} with GIConfig.bounces = "
-                              f"{gi.bounces}: later bounces are computed on a single grid only (cascades = 1); "
-                              "re-injecting per cascade needs each cascade's bounce fed from its parent's, "
-                              "which is not implemented")
         self.levels: list[LpvVolume] = []
 
     # The finest grid's textures (the only grid when cascades = 1).
@@ -119,6 +114,12 @@ class LpvMethod(OneBounceMethod):
         self._reduce = rsm_reduce.factor_for(res, self.lpv_config.grid_cells)
         self._vpls = rsm_reduce.textures(self.backend, res, self._reduce) if self._reduce > 1 else None
         self._points = atlas.texel_points(self.backend, res // self._reduce, lpv_inject.SPEC)
+
+    def allocate_products(self, size: tuple[int, int]) -> None:
+        super().allocate_products(size)
+        # A later bounce's lookup over cascades, before it is added to `indirect` (add_bounces).
+        several = self.lpv_config.cascades > 1 and self.gi.bounces > 1
+        self._bounce_image = self.backend.texture(size) if several else None
 
     def follow_camera(self) -> None:
         """Re-place the finer cascades where the camera has moved to another parent cell."""
@@ -164,23 +165,46 @@ class LpvMethod(OneBounceMethod):
                          self.snapshots[0], self.grid)
 
     def add_bounces(self, timings: dict[str, float]) -> None:
-        """Bounces 2..gi.bounces on top of the first bounce (in `accumulated` and `indirect`): each is
-        looked up on its own and added to `indirect` (clamped per bounce, so none takes light away),
-        and added to `accumulated`, the total a volume bake reads. Afterwards `bounce_accumulated`
-        holds the last bounce alone. One grid only (cascades > 1 refuses bounces > 1)."""
-        be, grid = self.backend, self.grid
-        previous = self.accumulated  # holds bounce 1 alone until the first add
+        """Bounces 2..gi.bounces on top of the first bounce (in each grid's `accumulated` and in
+        `indirect`). Each: every grid, coarsest first, re-injects what its surfaces reflect of the
+        previous bounce and propagates it into its `bounce_accumulated` (a finer cascade after its
+        parent's inflow of the same bounce, as for the first); the bounce is looked up on its own (clamped
+        at 0 by itself, so none takes light away) and added to `indirect`, and each grid's bounce to its
+        `accumulated`, the total a volume bake reads. Afterwards `bounce_accumulated` holds the last
+        bounce alone."""
+        be, levels = self.backend, self.levels
+        previous = [level.accumulated for level in levels]  # each holds bounce 1 alone until the first add
         for _ in range(self.gi.bounces - 1):
-            with self.timed(timings, "lpv_reinject"):
-                self.reinject(previous)
-            with self.timed(timings, "lpv_propagate"):
-                self.propagate(accumulated=self.bounce_accumulated)
+            for i in reversed(range(len(levels))):
+                level = levels[i]
+                with self.timed(timings, "lpv_reinject"):
+                    lpv_reinject.run(be, previous[i], level.voxels["vox_normal"], level.voxels["vox_albedo"],
+                                     level.snapshots[0], level.grid)
+                    if i + 1 < len(levels):
+                        parent = levels[i + 1]
+                        lpv_cascade.inflow(be, level.cascade, level.snapshots[0], parent.grid,
+                                           parent.bounce_accumulated, parent.snapshots[0], self.lpv_config.variant)
+                with self.timed(timings, "lpv_propagate"):
+                    self.propagate(accumulated=level.bounce_accumulated, level=level)
             with self.timed(timings, "lpv_lookup"):
-                lpv_lookup.run(be, self.gbuf, self.bounce_accumulated, self.indirect, grid, accumulate=True,
-                               vox_normal=self.lookup_vox(self.levels[0]))
+                if len(levels) == 1:
+                    lpv_lookup.run(be, self.gbuf, levels[0].bounce_accumulated, self.indirect, levels[0].grid,
+                                   accumulate=True, vox_normal=self.lookup_vox(levels[0]))
+                else:
+                    self.look_up(lambda level: level.bounce_accumulated, self._bounce_image)
+                    lpv_lookup.add_image(be, self._bounce_image, self.indirect)
             with self.timed(timings, "lpv_reinject"):
-                lpv_reinject.add(be, self.bounce_accumulated, self.accumulated, grid)
-            previous = self.bounce_accumulated
+                for level in levels:
+                    lpv_reinject.add(be, level.bounce_accumulated, level.accumulated, level.grid)
+            previous = [level.bounce_accumulated for level in levels]
+
+    def look_up(self, volume_of, out) -> None:
+        """`out` from every grid's volume_of(level), coarsest first, each finer cascade blended in."""
+        for i in reversed(range(len(self.levels))):
+            level = self.levels[i]
+            lpv_lookup.run(self.backend, self.gbuf, volume_of(level), out, level.grid,
+                           vox_normal=self.lookup_vox(level),
+                           cascade=level.cascade if i + 1 < len(self.levels) else None)
 
     def compute(self, run_gbuffer: bool = True) -> dict[str, float]:
         be = self.backend
@@ -208,10 +232,6 @@ class LpvMethod(OneBounceMethod):
                     else:
                         self.propagate(level=level)
             with self.timed(timings, "lpv_lookup"):
-                for i in reversed(range(len(self.levels))):
-                    level = self.levels[i]
-                    lpv_lookup.run(be, self.gbuf, level.accumulated, self.indirect, level.grid,
-                                   vox_normal=self.lookup_vox(level),
-                                   cascade=level.cascade if i + 1 < len(self.levels) else None)
+                self.look_up(lambda level: level.accumulated, self.indirect)
             self.add_bounces(timings)
         return timings

@@ -10,7 +10,8 @@ trilinear corners are weighted by their transmittance along n, 1 - min(1, w |n_c
 renormalised: the cells a surface blocks hold light its own geometry attenuated, not the light arriving
 at it (docs/LPV.md, "Geometry-aware lookup"). With `cascade` (a finer LPV cascade, lpv_cascade.Cascade)
 `indirect` holds the parent cascades' answer and is blended towards this grid's across the transition
-band inside its interior faces (lpv_cascade.blend_weight); run coarsest first.
+band inside its interior faces (lpv_cascade.blend_weight); run coarsest first. A later bounce over
+cascades is looked up that way into an image of its own, then `add_image` adds it to `indirect`.
 """
 
 from __future__ import annotations
@@ -49,6 +50,16 @@ def _spec(accumulate: bool, geometry_volume: bool, cascade: bool) -> ShaderSpec:
 SPECS = {(acc, gv, cas): _spec(acc, gv, cas) for acc in (False, True) for gv in (False, True)
          for cas in (False, True) if not (acc and cas)}
 
+# A later bounce over cascades: `accumulate` cannot blend (the parent's share of this bounce would stay
+# in full under the finer cascade's), so the bounce is looked up into its own image and added.
+ADD_IMAGE = ShaderSpec(
+    name="lpv_add_image",
+    compute="lpv/add_image.comp.glsl",
+    local_size=(8, 8, 1),
+    samplers=(Sampler("bounce_image", "2D"),),
+    images=(Image("indirect", "2D", "RGBA32F", "read_write"),),
+)
+
 
 def run(backend: Backend, gbuf: dict, acc: dict, indirect, grid: Grid, offset_cells: float = 0.5,
         accumulate: bool = False, vox_normal=None, cascade: Cascade | None = None) -> None:
@@ -66,3 +77,9 @@ def run(backend: Backend, gbuf: dict, acc: dict, indirect, grid: Grid, offset_ce
                         band_start=lpv_cascade.BAND_START_CELLS, band_cells=lpv_cascade.BAND_CELLS)
     backend.dispatch(backend.program(spec), group_count(indirect.size, spec.local_size), uniforms=uniforms,
                      samplers=samplers, images={"indirect": indirect})
+
+
+def add_image(backend: Backend, bounce_image, indirect) -> None:
+    """indirect += bounce_image (one later bounce, looked up over the cascades on its own)."""
+    backend.dispatch(backend.program(ADD_IMAGE), group_count(indirect.size, ADD_IMAGE.local_size),
+                     samplers={"bounce_image": bounce_image}, images={"indirect": indirect})
