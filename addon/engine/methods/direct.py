@@ -15,7 +15,7 @@ import numpy as np
 from ..backends.base import Backend
 from ..config import GIConfig, RsmConfig
 from ..errors import ConfigError
-from ..passes import direct_light, gbuffer, rsm
+from ..passes import direct_light, gbuffer, rsm, zero
 from ..passes.light_views import LightView, emissive_lights, views_for
 from ..scene import Camera, Scene
 
@@ -109,7 +109,6 @@ class DirectMethod:
 
     def allocate_products(self, size: tuple[int, int]) -> None:
         self.direct = self.backend.texture(size)
-        self._direct_target = self.backend.target([self.direct])
 
     def camera(self) -> Camera:
         """The current camera in the uploaded geometry's (re-centred) frame."""
@@ -163,7 +162,7 @@ class DirectMethod:
         return Result(images, timings)
 
     def clear_products(self) -> None:
-        self.backend.clear(self._direct_target)
+        zero.images(self.backend, [self.direct])  # a compute pass: framebuffer clears are slow raster work
 
     def per_light_view(self, view: LightView, timings: dict[str, float]) -> None:
         """Hook for methods that add work per RSM face while it is bound (the indirect gathers)."""
@@ -189,11 +188,10 @@ class OneBounceMethod(DirectMethod):
     def allocate_products(self, size: tuple[int, int]) -> None:
         super().allocate_products(size)
         self.indirect = self.backend.texture(size)
-        self._indirect_target = self.backend.target([self.indirect])
 
     def clear_products(self) -> None:
         super().clear_products()
-        self.backend.clear(self._indirect_target)
+        zero.images(self.backend, [self.indirect])
 
     def product_textures(self) -> dict:
         return {**super().product_textures(), "indirect": self.indirect}
