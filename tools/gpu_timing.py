@@ -13,6 +13,8 @@ Two steps, because the GPU machine has no Blender:
   gpu_*        GL timestamp queries (glQueryCounter) around every pass, no waits between passes
   wall_pass_*  method.profile on: glFinish before and after every pass (stalls; per-pass upper bound)
   voxelize     a full re-voxelization (every layer redrawn: Voxelizer.invalidate, then run), GPU and wall
+  *_fed        the voxelization and LPV's propagation with an update's GPU work queued ahead (fed_gpu_ms):
+               their GPU work alone, where Python submits their many dispatches slower than the GPU runs them
 It writes timings.json and timings.md into DIR.
 
 On the lent GPU machine (no moderngl there): carry .whl (cp312 wheels of moderngl 5.13.0 and glcontext
@@ -351,8 +353,40 @@ def time_method(be, method, scene, warmup: int, repeat: int, stamps: GpuTimestam
                 if stamps.available:
                     gpu.append(stamps.end_update()["voxelize"])
         res["voxelize"] = {"wall": summary(wall), **({"gpu": summary(gpu)} if gpu else {})}
+        if stamps.available:
+            res["voxelize_fed"] = fed_gpu_ms(be, stamps, method, lambda: (voxelizer.invalidate(), voxelizer.run()),
+                                             warmup, repeat)
+
+    # 5. LPV's propagation (finest grid) alone, fed: its ~100-190 dispatches are Python-bound on a slow host
+    if stamps.available and hasattr(method, "propagate"):
+        res["lpv_propagate_fed"] = fed_gpu_ms(be, stamps, method, method.propagate, warmup, repeat)
     res["gl_error"] = be.gl_error()
     return res
+
+
+def fed_gpu_ms(be, stamps: GpuTimestamps, method, fn, warmup: int, repeat: int) -> dict:
+    """GPU time of fn() with a whole update's GPU work queued ahead of it (method.compute(), not waited
+    for), so that fn's commands are all submitted before the GPU reaches them: the timestamps then measure
+    fn's GPU work, not how fast this host's Python submits many small dispatches or draws. Also returned:
+    `submit_ms`, fn's submission (wall, no finish), and `ahead_gpu_ms`, the queued update's GPU time: the
+    figure is fn's GPU work alone only while ahead_gpu_ms > submit_ms."""
+    method.profile = False
+    gpu, submit, ahead = [], [], []
+    for i in range(warmup + repeat):
+        stamps.begin_update()
+        with stamps.timed({}, "ahead"):
+            method.compute()
+        t0 = time.perf_counter()
+        with stamps.timed({}, "fn"):
+            fn()
+        t1 = time.perf_counter()
+        be.finish()
+        r = stamps.end_update()
+        if i >= warmup:
+            gpu.append(r["fn"])
+            ahead.append(r["ahead"])
+            submit.append((t1 - t0) * 1e3)
+    return {"gpu": summary(gpu), "submit_ms": summary(submit), "ahead_gpu_ms": summary(ahead)}
 
 
 def _patch_gl_library() -> None:
@@ -478,6 +512,15 @@ def markdown(report: dict) -> str:
                 target = (f"voxelize+inject+pyramid {both:.3f}; gather {_fmt(gpu.get('vct_gather'))}")
             lines.append(f"| {scene} | {label} | {grid} | {r['set_scene_ms']:.1f} | {_fmt(r['wall_total'])} | "
                          f"{_fmt(gpu.get('total'))} | {target} | {_fmt(vox)} |")
+    lines += ["", "## Passes of many dispatches, fed (fed_gpu_ms): GPU work | Python submission | GPU work queued "
+              "ahead (ms, medians; the first is the pass's GPU work alone where the third exceeds the second)", ""]
+    for scene, entry in report["scenes"].items():
+        for label, r in entry["configs"].items():
+            for key in ("voxelize_fed", "lpv_propagate_fed"):
+                if key in r:
+                    f = r[key]
+                    lines.append(f"- {scene} / {label} / {key.removesuffix('_fed')}: {f['gpu']['median']:.3f} | "
+                                 f"{f['submit_ms']['median']:.3f} | {f['ahead_gpu_ms']['median']:.3f}")
     lines += ["", "## Per pass (median / p90 ms): GPU timestamps | wall with glFinish around each pass", ""]
     for scene, entry in report["scenes"].items():
         for label, r in entry["configs"].items():
