@@ -42,6 +42,7 @@ class VctMethod(OneBounceMethod):
         volumes, tests/gpu/test_voxelize.py) and the grid's other textures are kept."""
         super().set_scene(scene)
         be, cfg = self.backend, self.vct_config
+        self._albedo_max = float(self.scene.albedo.max()) if len(self.scene.albedo) else 0.0
         grid = Grid.fit(*self.bounds_m, max_cells=cfg.voxel_cells)
         if grid.same_cells(self.grid):
             self.voxelizer.update(self.scene)
@@ -78,7 +79,8 @@ class VctMethod(OneBounceMethod):
     def clear_products(self) -> None:
         super().clear_products()
         zero.images(self.backend, [self.flux[d] for d in DIRECTIONS])
-        zero.images(self.backend, [self.light_flux[d] for d in DIRECTIONS])
+        if self._pending_light is not None:  # an update left unfinished; _flush_light zeroes it otherwise
+            zero.images(self.backend, [self.light_flux[d] for d in DIRECTIONS])
         self._pending_light = None
 
     def per_light_view(self, view: LightView, timings: dict[str, float]) -> None:
@@ -106,10 +108,9 @@ class VctMethod(OneBounceMethod):
         """The pyramid of every bounce's light: the first from the injected flux; each later one gathered
         at the voxels from a pyramid of the bounce before it alone (so none is counted twice)."""
         be, cfg = self.backend, self.vct_config
-        lights = [*self.source.lights, *self.emissive]
-        albedo_max = float(self.scene.albedo.max()) if len(self.scene.albedo) else 0.0
-        self.radiance_scale = vct_pyramid.radiance_scale(lights, self.bounds_m, self.grid.cell_size_m,
-                                                         self.gi.bounces, albedo_max)
+        # Lights may change between updates (set_lights); the geometry's largest albedo only with set_scene.
+        self.radiance_scale = vct_pyramid.radiance_scale([*self.source.lights, *self.emissive], self.bounds_m,
+                                                         self.grid.cell_size_m, self.gi.bounces, self._albedo_max)
         with self.timed(timings, "vct_pyramid"):
             self._build(1.0, None)
         if self.gi.bounces == 1:
