@@ -27,6 +27,8 @@ def add_arguments(p) -> None:
     p.add_argument("--variant", default="improved", help="LPV transport: improved or classic (the published one)")
     p.add_argument("--geometry-volume", action=argparse.BooleanOptionalAction, default=True,
                    help="LPV: occlude by the voxelized surfaces (default on)")
+    p.add_argument("--surface-offsets", action=argparse.BooleanOptionalAction, default=True,
+                   help="LPV geometry volume: a surface blocks the transfers on its side of its cell (default on)")
     p.add_argument("--cascades", type=int, default=1, help="LPV: nested grids, the finest around the camera")
     p.add_argument("--cell-size", type=float, default=0.0,
                    help="LPV: finest cascade's cell in metres (0: the coarsest grid fits the scene)")
@@ -45,7 +47,8 @@ def run(args) -> int:
     rsm = RsmConfig(resolution=args.rsm_res, vpl_samples=args.vpl_samples, visibility=args.visibility,
                     voxel_cells=args.voxel_cells)
     lpv = LpvConfig(grid_cells=args.grid, iterations=args.iterations, variant=args.variant,
-                    geometry_volume=args.geometry_volume, cascades=args.cascades, cell_size_m=args.cell_size)
+                    geometry_volume=args.geometry_volume, surface_offsets=args.surface_offsets,
+                    cascades=args.cascades, cell_size_m=args.cell_size)
     vct = VctConfig(voxel_cells=args.voxel_cells, diffuse_cones=args.cones, step_ratio=args.step_ratio,
                     offset_cells=args.cone_offset, radiance=args.radiance, gather_scale=args.gather_scale)
     blend = existing_blend(args.blend)

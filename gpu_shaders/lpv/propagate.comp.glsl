@@ -11,37 +11,47 @@
 // light moves on average along its own direction, w / |w|_1 cells per step; re-emission keeps the
 // direction it had instead of turning it to the side faces' normals. By symmetry M_+x has only
 // M00 = 1/6, M0x = Mx0 = m_cross, Mxx = m_along, Myy = Mzz = m_side (uniforms, computed in Python).
-// GEOMETRY_VOLUME: each transfer A -> B is scaled by 1 - blocking, blocking = mean over A and B of
-// min(1, surface area in the cell (cells^2) * |n . d|) from the voxelizer's vox_normal.
+// GEOMETRY_VOLUME: each transfer A -> B along d is scaled by 1 - b_A s_A - b_B (1 - s_B): b = a cell's
+// blocking along d's axis, min(1, the area its surfaces project along it, cells^2; the voxelizer's
+// vox_projected: both faces of a closed wall thinner than a cell count once, where a mean normal
+// cancels), s = the share of it on the transfer leaving the cell along d. SURFACE_OFFSETS: s = 0.5 +
+// (the surfaces' mean offset from the cell's centre along d, cells; vox_offset), clamped to 0..1: a
+// surface blocks the half-cell transfers on its own side of the centre (fully at a face, half each at
+// the centre), so a VPL in front of its own surface, in the same cell, leaves unblocked, and the
+// light no longer depends on how walls align with cells (docs/LPV.md). Without it s = 0.5.
 #include "lpv/transfer.glsl"
 
-// Blocking of cell c for travel along the axis with unit vector e: nv = the cell's vox_normal.
-float blocking(vec4 nv, vec3 e) {
+// Blocking of cell c along `axis`, and the share of it on the transfer leaving c along sgn * axis.
+float blocking(ivec3 c, int axis) {
 #ifdef GEOMETRY_VOLUME
-    return min(1.0, nv.w * abs(dot(nv.xyz, e)));
+    return min(1.0, texelFetch(vox_projected, c, 0)[axis]);
 #else
     return 0.0;
 #endif
 }
 
-vec4 vox_at(ivec3 c) {
-#ifdef GEOMETRY_VOLUME
-    return texelFetch(vox_normal, c, 0);
+float leaving_share(ivec3 c, int axis, float sgn) {
+#ifdef SURFACE_OFFSETS
+    return clamp(0.5 + sgn * texelFetch(vox_offset, c, 0)[axis], 0.0, 1.0);
 #else
-    return vec4(0.0);
+    return 0.5;
 #endif
 }
 
 // Light of neighbour A = B - sgn * e_axis entering B, scaled by the geometry volume's pass-through.
-void gather(ivec3 b, vec4 vox_b, int axis, float sgn, inout vec4 out_r, inout vec4 out_g, inout vec4 out_b) {
+void gather(ivec3 b, int axis, float sgn, inout vec4 out_r, inout vec4 out_g, inout vec4 out_b) {
     ivec3 di = ivec3(0);
     di[axis] = int(sgn);
     ivec3 a = b - di;
     if (any(lessThan(a, ivec3(0))) || any(greaterThanEqual(a, dims))) {
         return;
     }
-    vec3 e = vec3(di);
-    float pass_through = 1.0 - 0.5 * (blocking(vox_at(a), e) + blocking(vox_b, e));
+    float pass_through = 1.0;
+#ifdef GEOMETRY_VOLUME
+    // Each share is <= 1 and each blocking <= 1, but both cells may block fully: clamp at 0.
+    pass_through = max(0.0, 1.0 - blocking(a, axis) * leaving_share(a, axis, sgn)
+                                - blocking(b, axis) * (1.0 - leaving_share(b, axis, sgn)));
+#endif
     vec4 r = vec4(0.0);
     vec4 g = vec4(0.0);
     vec4 bl = vec4(0.0);
@@ -61,13 +71,12 @@ void main() {
     vec4 out_r = vec4(0.0);
     vec4 out_g = vec4(0.0);
     vec4 out_b = vec4(0.0);
-    vec4 vox_b = vox_at(b);
-    gather(b, vox_b, 0, 1.0, out_r, out_g, out_b);
-    gather(b, vox_b, 0, -1.0, out_r, out_g, out_b);
-    gather(b, vox_b, 1, 1.0, out_r, out_g, out_b);
-    gather(b, vox_b, 1, -1.0, out_r, out_g, out_b);
-    gather(b, vox_b, 2, 1.0, out_r, out_g, out_b);
-    gather(b, vox_b, 2, -1.0, out_r, out_g, out_b);
+    gather(b, 0, 1.0, out_r, out_g, out_b);
+    gather(b, 0, -1.0, out_r, out_g, out_b);
+    gather(b, 1, 1.0, out_r, out_g, out_b);
+    gather(b, 1, -1.0, out_r, out_g, out_b);
+    gather(b, 2, 1.0, out_r, out_g, out_b);
+    gather(b, 2, -1.0, out_r, out_g, out_b);
     imageStore(dst_r, b, out_r);
     imageStore(dst_g, b, out_g);
     imageStore(dst_b, b, out_b);

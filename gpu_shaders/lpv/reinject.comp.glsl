@@ -3,8 +3,9 @@
 // Cell B writes what its 6 neighbours A = B - d send it; one invocation per cell, 6 iterations.
 //
 // A's surface (voxelizer: mean normal n, area w in cells^2, albedo rho) receives on its side facing m
-// (m = n or -n) E_m = max(0, c(p) . cosine_lobe(-m)) / h^2 with c trilinear at p = centre + 0.5 h m:
-// what lookup.comp.glsl reads on a surface at the cell's centre. Voxel normals of one-sided meshes do
+// (m = n or -n) E_m = max(0, c(p) . cosine_lobe(-m)) / h^2 with c trilinear at p = centre + 0.5 h m
+// over the corners that do not block along m (see arriving(); lookup.comp.glsl weighs its corners the
+// same way): a cell's own light is mostly what its surface sent away, not light arriving at it. Voxel normals of one-sided meshes do
 // not say which side is lit, so A reflects from the side that receives more (the inside of a closed
 // solid and the outside of a room stay dark; L1 reads ~0 behind a one-sided field). It reflects
 // phi = rho * E_m * w h^2 = rho * w * max(0, c . cosine_lobe(-m)) watts (h^2 cancels), emitted as
@@ -14,11 +15,30 @@
 #include "common/sh.glsl"
 
 // E_m * h^2 per colour: the previous bounce's light arriving at cell c's surface on the side facing m.
+// Trilinear at c's centre + m / 2 over the corners that do not block along m (1 - min(1, projected
+// area along m)), renormalised: c's own surface blocks, so c's own light -- mostly what its surface
+// emitted the other way -- is not read as arriving; 0 where every corner blocks (inside a solid).
 vec3 arriving(ivec3 c, vec3 m) {
-    vec3 uvw = (vec3(c) + 0.5 + 0.5 * m) / vec3(dims);  // texel centres at (i + 0.5) / dims
+    vec3 t = vec3(c) + 0.5 * m;  // cell-index space: centres at integers
+    ivec3 i0 = ivec3(floor(t));
+    vec3 f = t - vec3(i0);
     vec4 lobe = sh_cosine_lobe(-m);
-    return vec3(max(dot(texture(acc_r, uvw), lobe), 0.0), max(dot(texture(acc_g, uvw), lobe), 0.0),
-                max(dot(texture(acc_b, uvw), lobe), 0.0));
+    vec3 sum = vec3(0.0);
+    float weight = 0.0;
+    for (int k = 0; k < 8; ++k) {
+        ivec3 corner = ivec3(k & 1, (k >> 1) & 1, k >> 2);
+        vec3 wv = mix(1.0 - f, f, vec3(corner));
+        float w = wv.x * wv.y * wv.z;
+        if (w == 0.0) {
+            continue;
+        }
+        ivec3 q = clamp(i0 + corner, ivec3(0), dims - 1);
+        float through = 1.0 - min(1.0, dot(texelFetch(vox_projected, q, 0).xyz, abs(m)));
+        sum += (w * through) * vec3(dot(texelFetch(acc_r, q, 0), lobe), dot(texelFetch(acc_g, q, 0), lobe),
+                                    dot(texelFetch(acc_b, q, 0), lobe));
+        weight += w * through;
+    }
+    return weight > 1e-4 ? max(sum / weight, vec3(0.0)) : vec3(0.0);
 }
 
 // The flux (W, rgb) cell a reflects and the side m it reflects to; zero without a surface: empty cells

@@ -72,6 +72,9 @@ void main() {
     float weight = max(covered / nw * share, 1e-6);
     out_albedo = vec4(v_albedo * weight, weight);
     out_normal = vec4(v_normal * weight, weight);
-    out_emission = vec4(v_emission * weight, weight);
+    // Alpha: the depth of the surface's part in this slab, from the slab's centre (cells, -0.5..0.5),
+    // x weight; the merge turns it into vox_offset (where in its cell a surface lies along each axis).
+    float depth = 0.5 * (max(w0, float(layer)) + min(w1, float(layer + 1)));
+    out_emission = vec4(v_emission * weight, (depth - float(layer) - 0.5) * weight);
     out_projected = vec4(abs(v_normal) * weight, weight);
 }

@@ -135,6 +135,29 @@ def test_projected_area_counts_a_closed_object_once(gl):
     np.testing.assert_allclose(vols["vox_projected"][1, 1, 1, :3], [0.36, 0.0, 0.0], atol=1e-5)
 
 
+def quad_x(x, lo=1.2, hi=1.8):
+    """Two triangles of a square facing +x at depth x over y, z in [lo, hi]."""
+    return [[[x, lo, lo], [x, hi, lo], [x, hi, hi]], [[x, lo, lo], [x, hi, hi], [x, lo, hi]]]
+
+
+def test_surface_offset_is_where_the_surface_lies_in_its_cell(gl):
+    """vox_offset: per axis the area-weighted mean offset, from the cell's centre in cells, of the
+    surfaces voxelized along that axis. A square facing +x at x = 1.8 in cell (1, 1, 1): 0.3 along x, 0
+    along y and z (no surface is voxelized along them). Two squares, at 1.2 (area 0.36) and 1.7 (area
+    0.16, a smaller square): (0.36 * -0.3 + 0.16 * 0.2) / 0.52 = -0.14615. A square on the cell's face
+    x = 2 lies in one of the two cells only; no other offset may leave -0.5..0.5. Exact up to fp32 sums
+    of a few fragments (atol 1e-5)."""
+    grid = Grid(np.zeros(3), 1.0, (3, 3, 3))
+    vols = voxelize(gl, scene(quad_x(1.8), [[0.5] * 3] * 2), grid)
+    np.testing.assert_allclose(vols["vox_offset"][1, 1, 1, :3], [0.3, 0.0, 0.0], atol=1e-5)
+    two = quad_x(1.2) + quad_x(1.7, 1.3, 1.7)
+    vols = voxelize(gl, scene(two, [[0.5] * 3] * 4), grid)
+    np.testing.assert_allclose(vols["vox_offset"][1, 1, 1, 0], (0.36 * -0.3 + 0.16 * 0.2) / 0.52, atol=1e-5)
+    np.testing.assert_allclose(vols["vox_normal"][1, 1, 1, 3], 0.52, atol=1e-5)  # the weights divided by
+    assert np.all(vols["vox_offset"][vols["vox_albedo"][..., 3] == 0] == 0.0)
+    assert np.all(np.abs(vols["vox_offset"]) <= 0.5)
+
+
 def test_surface_area_is_exact_for_finely_tessellated_and_partial_surfaces(gl):
     """The weight of a fragment is the triangle's area clipped to its cell, so a surface's area per cell
     does not depend on how it is tessellated, and a surface covering part of a cell counts that part.

@@ -5,7 +5,8 @@ bound: lpv_inject (VPLs splatted into a 2D atlas of the grid's layers); once per
 face: lpv_inject.unpack (atlas -> 3D snapshot), N x lpv_propagate (ping-pong, accumulated), lpv_lookup
 -> `indirect` (Cycles' Diffuse Indirect units; improved + geometry volume: geometry-aware corners).
 With LpvConfig.geometry_volume the scene is voxelized once per geometry change on the LPV grid and the
-voxels' surface area x |n.d| blocks each transfer. GIConfig.bounces = k > 1 adds k - 1 bounces after
+area its surfaces project along each axis blocks the transfers (with surface_offsets, those on the
+surfaces' side of the cell's centre). GIConfig.bounces = k > 1 adds k - 1 bounces after
 the first bounce's lookup, each: lpv_reinject (the voxelized surfaces reflect the previous bounce's
 light into a fresh snapshot), N x lpv_propagate into a per-bounce accumulation, lpv_lookup added to
 `indirect`, lpv_reinject.add into the total; these need the voxelizer's albedo and normals, so it runs
@@ -72,6 +73,11 @@ class LpvVolume:
         """The same dims at another place (the camera moved): re-voxelized; the atlas layout is unchanged."""
         self.cascade, self.grid = cascade, cascade.grid
         self.voxelize(method)
+
+    @property
+    def geometry(self) -> dict | None:
+        """The voxels that block propagation (only with LpvConfig.geometry_volume)."""
+        return self.voxels if self.voxels is not None and self.geometry_volume else None
 
     @property
     def vox_normal(self):
@@ -157,12 +163,12 @@ class LpvMethod(OneBounceMethod):
         for i in range(n):
             src = sets[0] if i == 0 else sets[2 - i % 2]
             lpv_propagate.run(self.backend, src, sets[1 + i % 2], acc, level.grid, self.lpv_config.variant,
-                              first_step=i == 0, vox_normal=level.vox_normal)
+                              first_step=i == 0, geometry=level.geometry,
+                              surface_offsets=self.lpv_config.surface_offsets)
 
     def reinject(self, previous: dict) -> None:
         """The light the surfaces reflect of one bounce's accumulation -> snapshot set 0 (overwritten)."""
-        lpv_reinject.run(self.backend, previous, self.voxels["vox_normal"], self.voxels["vox_albedo"],
-                         self.snapshots[0], self.grid)
+        lpv_reinject.run(self.backend, previous, self.voxels, self.snapshots[0], self.grid)
 
     def add_bounces(self, timings: dict[str, float]) -> None:
         """Bounces 2..gi.bounces on top of the first bounce (in each grid's `accumulated` and in
@@ -178,8 +184,7 @@ class LpvMethod(OneBounceMethod):
             for i in reversed(range(len(levels))):
                 level = levels[i]
                 with self.timed(timings, "lpv_reinject"):
-                    lpv_reinject.run(be, previous[i], level.voxels["vox_normal"], level.voxels["vox_albedo"],
-                                     level.snapshots[0], level.grid)
+                    lpv_reinject.run(be, previous[i], level.voxels, level.snapshots[0], level.grid)
                     if i + 1 < len(levels):
                         parent = levels[i + 1]
                         lpv_cascade.inflow(be, level.cascade, level.snapshots[0], parent.grid,

@@ -1,8 +1,9 @@
 """LPV propagation pass: one gather step per dispatch, ping-pong volumes, snapshots accumulated.
 
 Inputs: the source snapshot `src_r/g/b` (RGBA32F 3D, L1 SH of radiant intensity in W/sr by direction
-of travel, per colour), optionally the voxelizer's `vox_normal` (xyz mean normal, w = surface area in
-the cell in cells^2) as geometry volume. Outputs: the next snapshot `dst_r/g/b` and the accumulation
+of travel, per colour), optionally the voxelizer's output as geometry volume: `vox_projected` (per axis
+the area its surfaces project along it, cells^2: the blocking) and, with surface offsets, `vox_offset`
+(per axis the surfaces' mean offset from the cell's centre, cells: which transfers the blocking falls on). Outputs: the next snapshot `dst_r/g/b` and the accumulation
 `acc_r/g/b` (read-write). On the first step acc = source_weight * src + step_weight * dst; afterwards
 acc += step_weight * dst.
 
@@ -35,18 +36,23 @@ _IMAGES = tuple(Image(f"dst_{c}", "3D", "RGBA32F", "write") for c in "rgb") + tu
 _SRC = tuple(Sampler(f"src_{c}", "3D") for c in "rgb")
 
 
-def _spec(variant: str, geometry_volume: bool) -> ShaderSpec:
+def _spec(variant: str, geometry_volume: bool, surface_offsets: bool) -> ShaderSpec:
     defines = (("IMPROVED", "1"),) if variant == "improved" else ()
     samplers = _SRC
     if geometry_volume:
         defines += (("GEOMETRY_VOLUME", "1"),)
-        samplers += (Sampler("vox_normal", "3D"),)
-    return ShaderSpec(name=f"lpv_propagate_{variant}{'_gv' if geometry_volume else ''}",
+        samplers += (Sampler("vox_projected", "3D"),)
+        if surface_offsets:
+            defines += (("SURFACE_OFFSETS", "1"),)
+            samplers += (Sampler("vox_offset", "3D"),)
+    suffix = ("_gv" if geometry_volume else "") + ("_offsets" if geometry_volume and surface_offsets else "")
+    return ShaderSpec(name=f"lpv_propagate_{variant}{suffix}",
                       compute="lpv/propagate.comp.glsl", local_size=(4, 4, 4), samplers=samplers,
                       images=_IMAGES, uniforms=_UNIFORMS, defines=defines)
 
 
-SPECS = {(v, gv): _spec(v, gv) for v in ("classic", "improved") for gv in (False, True)}
+SPECS = {(v, gv, so): _spec(v, gv, so) for v in ("classic", "improved") for gv in (False, True)
+         for so in (False, True)}
 
 
 @functools.cache
@@ -73,14 +79,18 @@ def weights(variant: str) -> tuple[float, float]:
 
 
 def run(backend: Backend, src: dict, dst: dict, acc: dict, grid: Grid, variant: str, first_step: bool,
-        vox_normal=None) -> None:
-    """One step: src (sh_r/g/b textures) -> dst, accumulated into acc (keys acc_r/g/b)."""
-    spec = SPECS[(variant, vox_normal is not None)]
+        geometry: dict | None = None, surface_offsets: bool = True) -> None:
+    """One step: src (sh_r/g/b textures) -> dst, accumulated into acc (keys acc_r/g/b); `geometry`: the
+    voxelizer's volumes (vox_projected, vox_offset) when a geometry volume blocks the transfers."""
+    offsets = geometry is not None and surface_offsets
+    spec = SPECS[(variant, geometry is not None, offsets)]
     c = improved_constants() if variant == "improved" else {"m_cross": 0.0, "m_along": 0.0, "m_side": 0.0}
     source_weight, step_weight = weights(variant)
     samplers = {f"src_{ch}": src[f"sh_{ch}"] for ch in "rgb"}
-    if vox_normal is not None:
-        samplers["vox_normal"] = vox_normal
+    if geometry is not None:
+        samplers["vox_projected"] = geometry["vox_projected"]
+        if offsets:
+            samplers["vox_offset"] = geometry["vox_offset"]
     images = {**{f"dst_{ch}": dst[f"sh_{ch}"] for ch in "rgb"}, **{f"acc_{ch}": acc[f"acc_{ch}"] for ch in "rgb"}}
     uniforms = {"dims": grid.dims, "first_step": int(first_step), "source_weight": source_weight,
                 "step_weight": step_weight, "m_cross": c["m_cross"], "m_along": c["m_along"], "m_side": c["m_side"]}

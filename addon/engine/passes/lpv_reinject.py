@@ -2,10 +2,13 @@
 
 Inputs: the previous bounce's accumulation `acc_r/g/b` (RGBA32F 3D, L1 SH, W/sr per cell by direction
 of travel, as lpv_lookup reads it), the voxelizer's `vox_normal` (xyz mean normal, w = surface area in
-the cell in cells^2) and `vox_albedo` (rgb diffuse albedo) on the LPV grid. Output: a fresh snapshot
+the cell in cells^2), `vox_albedo` (rgb diffuse albedo) and `vox_projected` (per axis projected area,
+cells^2) on the LPV grid. Output: a fresh snapshot
 `sh_r/g/b` (RGBA32F 3D, written in every cell, not accumulated). A cell A with geometry reflects
-phi = albedo * E * area (W): E the irradiance lpv_lookup would read on a surface at A's centre, on the
-better lit side m of +-n; area = w h^2. Its Lambertian lobe phi / pi * cosine_lobe(m) goes to the
+phi = albedo * E * area (W): E the irradiance on a surface at A's centre, on the better lit side m of
++-n, read at A's centre + h m / 2 from the trilinear corners that do not block along m (renormalised;
+A's own surface blocks, so A's own light, mostly what its surface emitted the other way, is not read
+as arriving: the sun-lit roof of window-room re-emitted its own light into the room); area = w h^2. Its Lambertian lobe phi / pi * cosine_lobe(m) goes to the
 neighbours A + d in the shares max(0, m.d) / |m|_1 (sum 1). Gather form: one compute invocation per
 cell reads its 6 neighbours; no atomics. `add` sums one bounce's accumulation into the total.
 """
@@ -20,7 +23,7 @@ SPEC = ShaderSpec(
     compute="lpv/reinject.comp.glsl",
     local_size=(4, 4, 4),
     samplers=tuple(Sampler(f"acc_{c}", "3D") for c in "rgb") + (Sampler("vox_normal", "3D"),
-                                                               Sampler("vox_albedo", "3D")),
+                                                               Sampler("vox_albedo", "3D"), Sampler("vox_projected", "3D")),
     images=tuple(Image(f"sh_{c}", "3D", "RGBA32F", "write") for c in "rgb"),
     uniforms=(Var("dims", "ivec3"),),
 )
@@ -35,10 +38,12 @@ ADD = ShaderSpec(
 )
 
 
-def run(backend: Backend, acc: dict, vox_normal, vox_albedo, snapshot: dict, grid: Grid) -> None:
-    """acc (keys acc_r/g/b) -> snapshot (keys sh_r/g/b), overwritten in every cell."""
+def run(backend: Backend, acc: dict, voxels: dict, snapshot: dict, grid: Grid) -> None:
+    """acc (keys acc_r/g/b) -> snapshot (keys sh_r/g/b), overwritten in every cell; `voxels`: the
+    voxelizer's vox_normal, vox_albedo and vox_projected."""
+    samplers = {**acc, **{k: voxels[k] for k in ("vox_normal", "vox_albedo", "vox_projected")}}
     backend.dispatch(backend.program(SPEC), group_count(grid.dims, SPEC.local_size), uniforms={"dims": grid.dims},
-                     samplers={**acc, "vox_normal": vox_normal, "vox_albedo": vox_albedo}, images=snapshot)
+                     samplers=samplers, images=snapshot)
 
 
 def add(backend: Backend, bounce: dict, total: dict, grid: Grid) -> None:

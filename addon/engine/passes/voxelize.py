@@ -5,8 +5,10 @@ Inputs: scene triangles; a Grid. Outputs (RGBA32F 3D textures of grid.dims, cano
 area in the cell in cell units^2), `vox_emission` (emitted radiance W/m^2/sr, a = occupancy),
 `vox_projected` (xyz = per axis the larger of the areas the surfaces facing + and - project along it,
 in cell units^2: a one-sided wall its area, both faces of a thin wall one of them, a closed column its
-silhouette; unlike the mean normal it does not cancel in thin walls: VCT's directional opacity;
-w = surface area).
+silhouette; unlike the mean normal it does not cancel in thin walls: VCT's directional opacity and
+LPV's blocking; w = surface area), `vox_offset` (xyz = per axis the area-weighted mean offset from the
+cell's centre, in cells (-0.5..0.5), of the surfaces voxelized along that axis, 0 where there are
+none: where in its cell a wall lies; the raster pass sums depth x weight in emission's alpha).
 
 Portable scatter (ARCHITECTURE.md section 3): each triangle is drawn along its dominant axis into the
 layers of that axis's volumes with additive blending (conservative coverage, see voxelize.vert.glsl),
@@ -48,13 +50,15 @@ RASTER = ShaderSpec(
 )
 
 _QUANTITIES = ("albedo", "normal", "emission", "projected")
+# The merge also writes vox_offset, from the depths the raster pass sums in emission's alpha.
+_MERGED = (*_QUANTITIES, "offset")
 
 MERGE = ShaderSpec(
     name="voxelize_merge",
     compute="voxelize/merge.comp.glsl",
     local_size=(4, 4, 4),
     samplers=tuple(Sampler(f"{q}_{a}", "3D") for q in _QUANTITIES for a in "xyz"),
-    images=tuple(Image(f"vox_{q}", "3D") for q in _QUANTITIES),
+    images=tuple(Image(f"vox_{q}", "3D") for q in _MERGED),
     uniforms=(Var("dims", "ivec3"),),
 )
 
@@ -108,7 +112,7 @@ class Voxelizer:
     def __init__(self, backend: Backend, grid: Grid):
         self.backend, self.grid = backend, grid
         be = backend
-        self.volumes = {f"vox_{q}": be.texture(grid.dims) for q in _QUANTITIES}
+        self.volumes = {f"vox_{q}": be.texture(grid.dims) for q in _MERGED}
         self._axis_volumes = []
         self._layer_targets = []
         for axis in range(3):
