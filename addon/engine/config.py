@@ -84,6 +84,7 @@ class LpvConfig(_Validated):
     # On: a surface blocks the transfers on its side of the cell's centre (by where it lies in the cell),
     # so light does not depend on how walls align with cells (thin-wall 0.68 -> 0.22); off: each cell's
     # blocking is split half and half between entering and leaving (docs/LPV.md, "geometry volume").
+    # The improved variant's; classic, the published baseline, always splits half and half.
     surface_offsets: bool = field(default=True, metadata={
         "doc": "geometry volume: a surface blocks the transfers on its side of the cell's centre"})
     cascades: int = _num(1, 1, 4, "nested grids, each finer one half the cell size, the finest around the camera")

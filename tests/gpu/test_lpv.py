@@ -101,7 +101,8 @@ def reference_step(channels, variant, geometry=None, surface_offsets=True):
         if geometry is None:
             through = 1.0
         else:
-            through = pass_through(geometry, d, surface_offsets)[..., None]
+            # Classic (the published baseline) splits every cell's blocking half and half.
+            through = pass_through(geometry, d, surface_offsets and variant == "improved")[..., None]
         for o, c in zip(out, channels, strict=True):
             o += through * (shifted(c.astype(np.float64), d) @ m.T)
     return out

@@ -52,7 +52,7 @@ def _spec(variant: str, geometry_volume: bool, surface_offsets: bool) -> ShaderS
 
 
 SPECS = {(v, gv, so): _spec(v, gv, so) for v in ("classic", "improved") for gv in (False, True)
-         for so in (False, True)}
+         for so in (False, True) if not (so and (v == "classic" or not gv))}
 
 
 @functools.cache
@@ -82,7 +82,8 @@ def run(backend: Backend, src: dict, dst: dict, acc: dict, grid: Grid, variant: 
         geometry: dict | None = None, surface_offsets: bool = True) -> None:
     """One step: src (sh_r/g/b textures) -> dst, accumulated into acc (keys acc_r/g/b); `geometry`: the
     voxelizer's volumes (vox_projected, vox_offset) when a geometry volume blocks the transfers."""
-    offsets = geometry is not None and surface_offsets
+    # Classic is the published scheme's baseline: its cells block half and half whatever the config.
+    offsets = geometry is not None and surface_offsets and variant == "improved"
     spec = SPECS[(variant, geometry is not None, offsets)]
     c = improved_constants() if variant == "improved" else {"m_cross": 0.0, "m_along": 0.0, "m_side": 0.0}
     source_weight, step_weight = weights(variant)
