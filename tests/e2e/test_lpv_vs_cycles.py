@@ -2,9 +2,10 @@
 
 BASELINE.md measured classic LPV (as published) at rel_rmse_8 ~0.96 at best on this scene at 128 px,
 no better than a constant. The issue's target for the improved variant is rel_rmse_8 <= 0.45 with
-bias 0.8..1.25 (met without surface offsets: 0.441 / 1.141; the default with them reads 0.474 / 1.202,
-and 0.22 instead of 0.68 on thin-wall, whose walls do not align with cells). The bounds below are the figures measured here (in comments)
-with a margin; the reference (256 spp) has rel_rmse_8 ~0.02 on its own, far below every bound.
+bias 0.8..1.25 (met without surface offsets: 0.441 / 1.141; the default with them reads 0.474 /
+1.202, and 0.18 instead of 0.62 on thin-wall, whose walls do not align with cells). The bounds below
+are the figures measured here (in comments) with a margin; the reference (256 spp) has rel_rmse_8
+~0.02 on its own, far below every bound.
 """
 
 import pytest
@@ -35,17 +36,24 @@ def render_lpv(blend, lpv_config, res=RES, bounces=1):
     return result.images["indirect"], result.timings_ms
 
 
-def test_lpv_variants_on_cornell(tmp_path):
+def scene_and_reference(tmp_path, name, bounces=1):
+    """Procedural scene `name` saved under tmp_path and Cycles' Diffuse Indirect of it (256 spp, RES):
+    (blend path, reference RGBA, mask of the pixels with geometry)."""
     from addon.bridge import images, scenes
     from addon.bridge.reference import render_reference
+
+    blend = tmp_path / f"{name}.blend"
+    scenes.save(name, blend)
+    render_reference(blend, tmp_path / "ref", spp=256, bounces=bounces, res=RES, seed=0)
+    ref = images.read_exr(tmp_path / "ref" / "indirect.exr")
+    return blend, ref, ref[..., 3] > 0.5
+
+
+def test_lpv_variants_on_cornell(tmp_path):
     from addon.engine import metrics
     from addon.engine.config import LpvConfig
 
-    blend = tmp_path / "cornell.blend"
-    scenes.save("cornell", blend)
-    render_reference(blend, tmp_path / "ref", spp=256, bounces=1, res=RES, seed=0)
-    ref = images.read_exr(tmp_path / "ref" / "indirect.exr")
-    mask = ref[..., 3] > 0.5
+    blend, ref, mask = scene_and_reference(tmp_path, "cornell", bounces=1)
     errors = {}
     for name, cfg in {
         "classic": LpvConfig(variant="classic", geometry_volume=True),
@@ -92,16 +100,10 @@ def test_lpv_second_bounce_on_cornell(tmp_path):
     outside the 2-bounce figures and exclude the 1-bounce ones, so a missing or halved second bounce
     fails (bias, ratio), as does one that adds error (rel_rmse_8).
     """
-    from addon.bridge import images, scenes
-    from addon.bridge.reference import render_reference
     from addon.engine import metrics
     from addon.engine.config import LpvConfig
 
-    blend = tmp_path / "cornell.blend"
-    scenes.save("cornell", blend)
-    render_reference(blend, tmp_path / "ref", spp=256, bounces=2, res=RES, seed=0)
-    ref = images.read_exr(tmp_path / "ref" / "indirect.exr")
-    mask = ref[..., 3] > 0.5
+    blend, ref, mask = scene_and_reference(tmp_path, "cornell", bounces=2)
     cfg = LpvConfig(variant="improved", geometry_volume=True)
     errors, means = {}, {}
     for bounces in (1, 2):
@@ -128,16 +130,10 @@ def test_surface_offsets_on_thin_wall(tmp_path):
     0.30 / 0.30 / 0.22 / 0.31 / 0.28 (docs/LPV.md). Measured here at 64 px: see the printed figures;
     without offsets rel_rmse_8 0.617 / bias 0.569, with offsets 0.178 / 0.929. Bounds between the two
     (the reference alone reads ~0.03), so either transport's regression fails."""
-    from addon.bridge import images, scenes
-    from addon.bridge.reference import render_reference
     from addon.engine import metrics
     from addon.engine.config import LpvConfig
 
-    blend = tmp_path / "thin-wall.blend"
-    scenes.save("thin-wall", blend)
-    render_reference(blend, tmp_path / "ref", spp=256, bounces=1, res=RES, seed=0)
-    ref = images.read_exr(tmp_path / "ref" / "indirect.exr")
-    mask = ref[..., 3] > 0.5
+    blend, ref, mask = scene_and_reference(tmp_path, "thin-wall", bounces=1)
     errors = {}
     for offsets in (False, True):
         ours, _ = render_lpv(blend, LpvConfig(variant="improved", geometry_volume=True, surface_offsets=offsets))
