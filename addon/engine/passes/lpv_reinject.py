@@ -8,8 +8,9 @@ cells^2) on the LPV grid. Output: a fresh snapshot
 phi = albedo * E * area (W): E the irradiance on a surface at A's centre, on the better lit side m of
 +-n, read at A's centre + h m / 2 from the trilinear corners that do not block along m (renormalised;
 A's own surface blocks, so A's own light, mostly what its surface emitted the other way, is not read
-as arriving: the sun-lit roof of window-room re-emitted its own light into the room); area = w h^2. Its Lambertian lobe phi / pi * cosine_lobe(m) goes to the
-neighbours A + d in the shares max(0, m.d) / |m|_1 (sum 1). Gather form: one compute invocation per
+as arriving: the sun-lit roof of window-room re-emitted its own light into the room); area = w h^2.
+Its Lambertian lobe phi / pi * cosine_lobe(m) goes to the neighbours A + d in the shares
+max(0, m.d) / |m|_1 (sum 1). Gather form: one compute invocation per
 cell reads its 6 neighbours; no atomics. `add` sums one bounce's accumulation into the total.
 """
 
@@ -22,8 +23,8 @@ SPEC = ShaderSpec(
     name="lpv_reinject",
     compute="lpv/reinject.comp.glsl",
     local_size=(4, 4, 4),
-    samplers=tuple(Sampler(f"acc_{c}", "3D") for c in "rgb") + (Sampler("vox_normal", "3D"),
-                                                               Sampler("vox_albedo", "3D"), Sampler("vox_projected", "3D")),
+    samplers=tuple(Sampler(f"acc_{c}", "3D") for c in "rgb")
+    + tuple(Sampler(f"vox_{q}", "3D") for q in ("normal", "albedo", "projected")),
     images=tuple(Image(f"sh_{c}", "3D", "RGBA32F", "write") for c in "rgb"),
     uniforms=(Var("dims", "ivec3"),),
 )
