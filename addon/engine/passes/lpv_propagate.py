@@ -4,8 +4,8 @@ Inputs: the source snapshot `src_r/g/b` (RGBA32F 3D, L1 SH of radiant intensity 
 of travel, per colour), optionally the voxelizer's output as geometry volume: `vox_projected` (per axis
 the area its surfaces project along it, cells^2: the blocking) and, with surface offsets, `vox_offset`
 (per axis the surfaces' mean offset from the cell's centre, cells: which transfers the blocking falls
-on). Outputs: the next snapshot `dst_r/g/b` and the accumulation `acc_r/g/b` (read-write). On the first step acc = source_weight * src + step_weight * dst; afterwards
-acc += step_weight * dst.
+on). Outputs: the next snapshot `dst_r/g/b` and the accumulation `acc_r/g/b` (read-write). On the
+first step acc = source_weight * src + step_weight * dst; afterwards acc += step_weight * dst.
 
 Variants (gpu_shaders/lpv/propagate.comp.glsl has the equations; docs/LPV.md the derivations):
 - classic: CLPV 5-face transfer, face solid angles 0.4006696846 / 0.4234313544 sr, re-emission as a
