@@ -11,35 +11,17 @@
 // light moves on average along its own direction, w / |w|_1 cells per step; re-emission keeps the
 // direction it had instead of turning it to the side faces' normals. By symmetry M_+x has only
 // M00 = 1/6, M0x = Mx0 = m_cross, Mxx = m_along, Myy = Mzz = m_side (uniforms, computed in Python).
-// GEOMETRY_VOLUME: each transfer A -> B along d is scaled by 1 - b_A s_A - b_B (1 - s_B): b = a cell's
-// blocking along d's axis, min(1, the area its surfaces project along it, cells^2; the voxelizer's
-// vox_projected: both faces of a closed wall thinner than a cell count once, where a mean normal
-// cancels), s = the share of it on the transfer leaving the cell along d. SURFACE_OFFSETS: s = 0.5 +
-// (the surfaces' mean offset from the cell's centre along d, cells; vox_offset), clamped to 0..1: a
-// surface blocks the half-cell transfers on its own side of the centre (fully at a face, half each at
-// the centre), so a VPL in front of its own surface, in the same cell, leaves unblocked, and the
-// light no longer depends on how walls align with cells (docs/LPV.md). Without it s = 0.5.
+// GEOMETRY_VOLUME: each transfer A -> B along d is scaled by 1 - b_A s_A - b_B (1 - s_B), clamped at 0:
+// b = a cell's blocking along d's axis, min(1, the area its surfaces project along it), s = the share
+// of it on the transfer leaving the cell along d (0.5, or with surface offsets by where its surfaces
+// lie: docs/LPV.md). blocking.comp.glsl stores b s per direction: block_plus (+x, +y, +z) and
+// block_minus (-x, -y, -z); light entering B along d meets b_B (1 - s_B(d)) = b_B s_B(-d).
 #include "lpv/transfer.glsl"
 
-// Blocking of cell c along `axis`, and the share of it on the transfer leaving c along sgn * axis.
-float blocking(ivec3 c, int axis) {
-#ifdef GEOMETRY_VOLUME
-    return min(1.0, texelFetch(vox_projected, c, 0)[axis]);
-#else
-    return 0.0;
-#endif
-}
-
-float leaving_share(ivec3 c, int axis, float sgn) {
-#ifdef SURFACE_OFFSETS
-    return clamp(0.5 + sgn * texelFetch(vox_offset, c, 0)[axis], 0.0, 1.0);
-#else
-    return 0.5;
-#endif
-}
-
 // Light of neighbour A = B - sgn * e_axis entering B, scaled by the geometry volume's pass-through.
-void gather(ivec3 b, int axis, float sgn, inout vec4 out_r, inout vec4 out_g, inout vec4 out_b) {
+// plus_b / minus_b: B's own block_plus and block_minus (fetched once per cell by main).
+void gather(ivec3 b, int axis, float sgn, vec3 plus_b, vec3 minus_b, inout vec4 out_r, inout vec4 out_g,
+            inout vec4 out_b) {
     ivec3 di = ivec3(0);
     di[axis] = int(sgn);
     ivec3 a = b - di;
@@ -48,9 +30,11 @@ void gather(ivec3 b, int axis, float sgn, inout vec4 out_r, inout vec4 out_g, in
     }
     float pass_through = 1.0;
 #ifdef GEOMETRY_VOLUME
-    // Each share is <= 1 and each blocking <= 1, but both cells may block fully: clamp at 0.
-    pass_through = max(0.0, 1.0 - blocking(a, axis) * leaving_share(a, axis, sgn)
-                                - blocking(b, axis) * (1.0 - leaving_share(b, axis, sgn)));
+    // A's share on light leaving it along d, B's on light entering along d (= leaving along -d). Each
+    // is <= 1, but both cells may block fully: clamp at 0.
+    float leave_a = (sgn > 0.0 ? texelFetch(block_plus, a, 0) : texelFetch(block_minus, a, 0))[axis];
+    float enter_b = (sgn > 0.0 ? minus_b : plus_b)[axis];
+    pass_through = max(0.0, 1.0 - leave_a - enter_b);
 #endif
     vec4 r = vec4(0.0);
     vec4 g = vec4(0.0);
@@ -71,12 +55,18 @@ void main() {
     vec4 out_r = vec4(0.0);
     vec4 out_g = vec4(0.0);
     vec4 out_b = vec4(0.0);
-    gather(b, 0, 1.0, out_r, out_g, out_b);
-    gather(b, 0, -1.0, out_r, out_g, out_b);
-    gather(b, 1, 1.0, out_r, out_g, out_b);
-    gather(b, 1, -1.0, out_r, out_g, out_b);
-    gather(b, 2, 1.0, out_r, out_g, out_b);
-    gather(b, 2, -1.0, out_r, out_g, out_b);
+    vec3 plus_b = vec3(0.0);
+    vec3 minus_b = vec3(0.0);
+#ifdef GEOMETRY_VOLUME
+    plus_b = texelFetch(block_plus, b, 0).xyz;
+    minus_b = texelFetch(block_minus, b, 0).xyz;
+#endif
+    gather(b, 0, 1.0, plus_b, minus_b, out_r, out_g, out_b);
+    gather(b, 0, -1.0, plus_b, minus_b, out_r, out_g, out_b);
+    gather(b, 1, 1.0, plus_b, minus_b, out_r, out_g, out_b);
+    gather(b, 1, -1.0, plus_b, minus_b, out_r, out_g, out_b);
+    gather(b, 2, 1.0, plus_b, minus_b, out_r, out_g, out_b);
+    gather(b, 2, -1.0, plus_b, minus_b, out_r, out_g, out_b);
     imageStore(dst_r, b, out_r);
     imageStore(dst_g, b, out_g);
     imageStore(dst_b, b, out_b);

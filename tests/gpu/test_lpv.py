@@ -119,11 +119,14 @@ def gpu_steps(gl, grid, channels, variant, steps, geometry=None, surface_offsets
     `geometry`: {"vox_projected", "vox_offset"} arrays (z, y, x, 4) of a geometry volume."""
     sets = [volumes(gl, grid.dims, channels), volumes(gl, grid.dims)]
     acc = {f"acc_{c}": gl.texture(grid.dims) for c in "rgb"}
-    gv = ({k: gl.texture(grid.dims, "RGBA32F", v) for k, v in geometry.items()} if geometry is not None else None)
+    gv = None
+    if geometry is not None:
+        voxels = {k: gl.texture(grid.dims, "RGBA32F", v) for k, v in geometry.items()}
+        # As LpvVolume does: classic always splits its blocking half and half.
+        gv = lpv_propagate.blocking(gl, voxels, grid, surface_offsets and variant == "improved")
     snaps = []
     for i in range(steps):
-        lpv_propagate.run(gl, sets[i % 2], sets[(i + 1) % 2], acc, grid, variant, first_step=i == 0, geometry=gv,
-                          surface_offsets=surface_offsets)
+        lpv_propagate.run(gl, sets[i % 2], sets[(i + 1) % 2], acc, grid, variant, first_step=i == 0, geometry=gv)
         snaps.append([gl.read(sets[(i + 1) % 2][f"sh_{c}"]) for c in "rgb"])
     return snaps, [gl.read(acc[f"acc_{c}"]) for c in "rgb"]
 

@@ -59,6 +59,7 @@ class LpvVolume:
                                    else None)
         self.geometry_volume = method.lpv_config.geometry_volume
         self.voxels = None
+        self.blocking = None  # lpv_propagate.blocking's volumes, with the geometry volume
         self.voxelize(method)
 
     def voxelize(self, method: LpvMethod) -> None:
@@ -68,16 +69,15 @@ class LpvVolume:
         self._voxelizer = Voxelizer(method.backend, self.grid)  # keeps its textures alive
         self._voxelizer.set_scene(method.scene)
         self.voxels = self._voxelizer.run()
+        if cfg.geometry_volume:
+            # Classic is the published scheme's baseline: its cells block half and half whatever the config.
+            offsets = cfg.surface_offsets and cfg.variant == "improved"
+            self.blocking = lpv_propagate.blocking(method.backend, self.voxels, self.grid, offsets, self.blocking)
 
     def move(self, method: LpvMethod, cascade: lpv_cascade.Cascade) -> None:
         """The same dims at another place (the camera moved): re-voxelized; the atlas layout is unchanged."""
         self.cascade, self.grid = cascade, cascade.grid
         self.voxelize(method)
-
-    @property
-    def geometry(self) -> dict | None:
-        """The voxels that block propagation (only with LpvConfig.geometry_volume)."""
-        return self.voxels if self.voxels is not None and self.geometry_volume else None
 
     @property
     def vox_normal(self):
@@ -163,8 +163,7 @@ class LpvMethod(OneBounceMethod):
         for i in range(n):
             src = sets[0] if i == 0 else sets[2 - i % 2]
             lpv_propagate.run(self.backend, src, sets[1 + i % 2], acc, level.grid, self.lpv_config.variant,
-                              first_step=i == 0, geometry=level.geometry,
-                              surface_offsets=self.lpv_config.surface_offsets)
+                              first_step=i == 0, geometry=level.blocking)
 
     def reinject(self, previous: dict) -> None:
         """The light the surfaces reflect of one bounce's accumulation -> snapshot set 0 (overwritten)."""

@@ -1,11 +1,13 @@
 """LPV propagation pass: one gather step per dispatch, ping-pong volumes, snapshots accumulated.
 
 Inputs: the source snapshot `src_r/g/b` (RGBA32F 3D, L1 SH of radiant intensity in W/sr by direction
-of travel, per colour), optionally the voxelizer's output as geometry volume: `vox_projected` (per axis
-the area its surfaces project along it, cells^2: the blocking) and, with surface offsets, `vox_offset`
-(per axis the surfaces' mean offset from the cell's centre, cells: which transfers the blocking falls
-on). Outputs: the next snapshot `dst_r/g/b` and the accumulation `acc_r/g/b` (read-write). On the
-first step acc = source_weight * src + step_weight * dst; afterwards acc += step_weight * dst.
+of travel, per colour), optionally a geometry volume: `block_plus` / `block_minus` (per axis, the share
+of a cell's blocking on light leaving it along +axis / -axis), which `blocking` computes once per
+voxelization from the voxelizer's `vox_projected` (per axis the area the surfaces project along it,
+cells^2) and, with surface offsets, `vox_offset` (per axis the surfaces' mean offset from the cell's
+centre, cells: which side's transfers the blocking falls on). Outputs: the next snapshot `dst_r/g/b`
+and the accumulation `acc_r/g/b` (read-write). On the first step acc = source_weight * src +
+step_weight * dst; afterwards acc += step_weight * dst.
 
 Variants (gpu_shaders/lpv/propagate.comp.glsl has the equations; docs/LPV.md the derivations):
 - classic: CLPV 5-face transfer, face solid angles 0.4006696846 / 0.4234313544 sr, re-emission as a
@@ -36,23 +38,43 @@ _IMAGES = tuple(Image(f"dst_{c}", "3D", "RGBA32F", "write") for c in "rgb") + tu
 _SRC = tuple(Sampler(f"src_{c}", "3D") for c in "rgb")
 
 
-def _spec(variant: str, geometry_volume: bool, surface_offsets: bool) -> ShaderSpec:
+def _spec(variant: str, geometry_volume: bool) -> ShaderSpec:
     defines = (("IMPROVED", "1"),) if variant == "improved" else ()
     samplers = _SRC
     if geometry_volume:
         defines += (("GEOMETRY_VOLUME", "1"),)
-        samplers += (Sampler("vox_projected", "3D"),)
-        if surface_offsets:
-            defines += (("SURFACE_OFFSETS", "1"),)
-            samplers += (Sampler("vox_offset", "3D"),)
-    suffix = ("_gv" if geometry_volume else "") + ("_offsets" if geometry_volume and surface_offsets else "")
-    return ShaderSpec(name=f"lpv_propagate_{variant}{suffix}",
+        samplers += (Sampler("block_plus", "3D"), Sampler("block_minus", "3D"))
+    return ShaderSpec(name=f"lpv_propagate_{variant}{'_gv' if geometry_volume else ''}",
                       compute="lpv/propagate.comp.glsl", local_size=(4, 4, 4), samplers=samplers,
                       images=_IMAGES, uniforms=_UNIFORMS, defines=defines)
 
 
-SPECS = {(v, gv, so): _spec(v, gv, so) for v in ("classic", "improved") for gv in (False, True)
-         for so in (False, True) if not (so and (v == "classic" or not gv))}
+SPECS = {(v, gv): _spec(v, gv) for v in ("classic", "improved") for gv in (False, True)}
+
+
+def _blocking_spec(surface_offsets: bool) -> ShaderSpec:
+    return ShaderSpec(
+        name="lpv_blocking" + ("_offsets" if surface_offsets else ""), compute="lpv/blocking.comp.glsl",
+        local_size=(4, 4, 4),
+        samplers=(Sampler("vox_projected", "3D"),) + ((Sampler("vox_offset", "3D"),) if surface_offsets else ()),
+        images=(Image("block_plus", "3D", "RGBA32F", "write"), Image("block_minus", "3D", "RGBA32F", "write")),
+        uniforms=(Var("dims", "ivec3"),), defines=(("SURFACE_OFFSETS", "1"),) if surface_offsets else ())
+
+
+BLOCKING = {so: _blocking_spec(so) for so in (False, True)}
+
+
+def blocking(backend: Backend, voxels: dict, grid: Grid, surface_offsets: bool, out: dict | None = None) -> dict:
+    """The geometry volume a propagation reads (block_plus, block_minus; `out`'s textures, or new ones)
+    from the voxels (vox_projected, and vox_offset with surface_offsets)."""
+    out = out or {k: backend.texture(grid.dims) for k in ("block_plus", "block_minus")}
+    spec = BLOCKING[surface_offsets]
+    samplers = {"vox_projected": voxels["vox_projected"]}
+    if surface_offsets:
+        samplers["vox_offset"] = voxels["vox_offset"]
+    backend.dispatch(backend.program(spec), group_count(grid.dims, spec.local_size), uniforms={"dims": grid.dims},
+                     samplers=samplers, images=out)
+    return out
 
 
 @functools.cache
@@ -79,19 +101,15 @@ def weights(variant: str) -> tuple[float, float]:
 
 
 def run(backend: Backend, src: dict, dst: dict, acc: dict, grid: Grid, variant: str, first_step: bool,
-        geometry: dict | None = None, surface_offsets: bool = True) -> None:
-    """One step: src (sh_r/g/b textures) -> dst, accumulated into acc (keys acc_r/g/b); `geometry`: the
-    voxelizer's volumes (vox_projected, vox_offset) when a geometry volume blocks the transfers."""
-    # Classic is the published scheme's baseline: its cells block half and half whatever the config.
-    offsets = geometry is not None and surface_offsets and variant == "improved"
-    spec = SPECS[(variant, geometry is not None, offsets)]
+        geometry: dict | None = None) -> None:
+    """One step: src (sh_r/g/b textures) -> dst, accumulated into acc (keys acc_r/g/b); `geometry`:
+    `blocking`'s output when a geometry volume blocks the transfers."""
+    spec = SPECS[(variant, geometry is not None)]
     c = improved_constants() if variant == "improved" else {"m_cross": 0.0, "m_along": 0.0, "m_side": 0.0}
     source_weight, step_weight = weights(variant)
     samplers = {f"src_{ch}": src[f"sh_{ch}"] for ch in "rgb"}
     if geometry is not None:
-        samplers["vox_projected"] = geometry["vox_projected"]
-        if offsets:
-            samplers["vox_offset"] = geometry["vox_offset"]
+        samplers.update(geometry)
     images = {**{f"dst_{ch}": dst[f"sh_{ch}"] for ch in "rgb"}, **{f"acc_{ch}": acc[f"acc_{ch}"] for ch in "rgb"}}
     uniforms = {"dims": grid.dims, "first_step": int(first_step), "source_weight": source_weight,
                 "step_weight": step_weight, "m_cross": c["m_cross"], "m_along": c["m_along"], "m_side": c["m_side"]}
