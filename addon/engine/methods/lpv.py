@@ -81,8 +81,9 @@ class LpvVolume:
 
     @property
     def vox_normal(self):
-        """The geometry volume that blocks propagation (only with LpvConfig.geometry_volume; later bounces
-        use the voxels as emitters either way)."""
+        """The voxels' mean normals the geometry-aware lookup weighs its corners by (only with
+        LpvConfig.geometry_volume; `blocking` is what blocks propagation; later bounces use the voxels
+        as emitters either way)."""
         return self.voxels["vox_normal"] if self.voxels is not None and self.geometry_volume else None
 
 
