@@ -5,9 +5,10 @@
 // A's surface (voxelizer: mean normal n, area w in cells^2, albedo rho) receives on its side facing m
 // (m = n or -n) E_m = max(0, c(p) . cosine_lobe(-m)) / h^2 with c trilinear at p = centre + 0.5 h m
 // over the corners that do not block along m (see arriving(); lookup.comp.glsl weighs its corners the
-// same way): a cell's own light is mostly what its surface sent away, not light arriving at it. Voxel normals of one-sided meshes do
-// not say which side is lit, so A reflects from the side that receives more (the inside of a closed
-// solid and the outside of a room stay dark; L1 reads ~0 behind a one-sided field). It reflects
+// same way): a cell's own light is mostly what its surface sent away, not light arriving at it.
+// Voxel normals of one-sided meshes do not say which side is lit, so A reflects from the side that
+// receives more (the inside of a closed solid and the outside of a room stay dark; L1 reads ~0 behind
+// a one-sided field). It reflects
 // phi = rho * E_m * w h^2 = rho * w * max(0, c . cosine_lobe(-m)) watts (h^2 cancels), emitted as
 // phi / pi * cosine_lobe(m) (flux 2 sqrt(pi) c0 = phi, as inject.vert.glsl does for a VPL), split over
 // the neighbours B = A + d by max(0, m.d) / |m|_1 (a partition of unity over the 6 axes: phi is kept).
