@@ -87,13 +87,19 @@ class LpvConfig(_Validated):
     # The improved variant's; classic, the published baseline, always splits half and half.
     surface_offsets: bool = field(default=True, metadata={
         "doc": "geometry volume: a surface blocks the transfers on its side of the cell's centre"})
+    # On: the grid runs only its near steps and a grid of twice the cell carries the light further
+    # (docs/LPV.md, "Far field": Cornell 0.54 -> 0.38 at 32 cells, 4x fewer fine steps). Improved
+    # variant, grid_cells >= 32, on the coarsest grid (the only one without cascades).
+    far_field: bool = field(default=True, metadata={
+        "doc": "carry light beyond the near steps on a grid of twice the cell size (faster, less on-axis excess)"})
+    near_steps: int = _num(0, 0, 256, "far field: steps the fine grid runs (0: half of grid_cells)")
     cascades: int = _num(1, 1, 4, "nested grids, each finer one half the cell size, the finest around the camera")
     cell_size_m: float = _num(0.0, 0.0, 1.0e6, "finest cascade's cell in metres when the cascades can cover "
                               "the scene with it; 0: the coarsest fits the scene")
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        for name in ("geometry_volume", "surface_offsets"):
+        for name in ("geometry_volume", "surface_offsets", "far_field"):
             if not isinstance(getattr(self, name), bool):
                 raise ConfigError(f"LpvConfig.{name} = {getattr(self, name)!r}: must be True or False")
 

@@ -2,10 +2,9 @@
 
 BASELINE.md measured classic LPV (as published) at rel_rmse_8 ~0.96 at best on this scene at 128 px,
 no better than a constant. The issue's target for the improved variant is rel_rmse_8 <= 0.45 with
-bias 0.8..1.25 (met without surface offsets: 0.441 / 1.141; the default with them reads 0.474 /
-1.202, and 0.18 instead of 0.62 on thin-wall, whose walls do not align with cells). The bounds below
-are the figures measured here (in comments) with a margin; the reference (256 spp) has rel_rmse_8
-~0.02 on its own, far below every bound.
+bias 0.8..1.25: the default (surface offsets, far field) reads 0.326 / 0.928 (0.474 / 1.202 on one
+grid without the far field). The bounds below are the figures measured here (in comments) with a
+margin; the reference (256 spp) has rel_rmse_8 ~0.02 on its own, far below every bound.
 """
 
 import pytest
@@ -59,45 +58,46 @@ def test_lpv_variants_on_cornell(tmp_path):
         "classic": LpvConfig(variant="classic", geometry_volume=True),
         "improved": LpvConfig(variant="improved", geometry_volume=True),
         "improved, no surface offsets": LpvConfig(variant="improved", geometry_volume=True, surface_offsets=False),
+        "improved, one grid": LpvConfig(variant="improved", geometry_volume=True, far_field=False),
     }.items():
         ours, timings = render_lpv(blend, cfg)
         errors[name] = metrics.compare(ours, ref, mask)
         print(f"lpv {name} vs Cycles: {errors[name]}, total {timings['total']:.0f} ms, "
               f"propagate {timings['lpv_propagate']:.0f} ms")
     classic, improved = errors["classic"], errors["improved"]
-    aligned = errors["improved, no surface offsets"]
+    aligned, one_grid = errors["improved, no surface offsets"], errors["improved, one grid"]
     # Measured at 64 px, 32-cell grid, geometry volume on (llvmpipe):
     # classic (16 iterations): rel_rmse 1.37, rel_rmse_8 1.17, bias 0.46 (without GV: 1.37, 0.69;
     # BASELINE at 128 px: 1.50, 0.46 for 32^3 + GV). Band: as bad as BASELINE says, not worse.
     assert 0.9 <= classic["rel_rmse_8"] <= 1.5
     assert 0.2 <= classic["bias"] <= 0.7
-    # improved (93 iterations = the grid's Manhattan span), geometry-aware lookup, blocking by projected
-    # area, without surface offsets (each cell's blocking split half and half between entering and
-    # leaving): rel_rmse 0.587, rel_rmse_8 0.441, bias 1.141 (0.439 / 1.134 with the mean normal's
-    # blocking; 0.412 / 1.080 before the voxelizer weighed tilted surfaces by their share of each
-    # slab; plain trilinear lookup: 0.456 / 0.797). The bounds are the issue's target.
+    # improved on one grid (far_field=False; 93 iterations = the grid's Manhattan span), geometry-aware
+    # lookup, blocking by projected area, surface offsets: rel_rmse 0.613, rel_rmse_8 0.474, bias 1.202
+    # (without offsets 0.441 / 1.141; 0.412 / 1.080 before the voxelizer weighed tilted surfaces by their
+    # share of each slab; plain trilinear lookup: 0.456 / 0.797). Over the target: the L1 transfer
+    # over-reads along the axes, more the more steps light takes (docs/LPV.md, "Measured").
+    # The default adds the far field (16 steps on this grid, the rest on a 16-cell grid: half the steps
+    # for the same distance): rel_rmse 0.457, rel_rmse_8 0.326, bias 0.928; without surface offsets
+    # 0.333 / 0.932. Both meet the issue's target; the default's bound is its figure plus llvmpipe's
+    # run-to-run spread (below 0.005) and a margin, so a regression fails; the far field must earn
+    # its place (at least a fifth less error than one grid).
+    assert improved["rel_rmse_8"] <= 0.34
+    assert 0.8 <= improved["bias"] <= 1.25
     assert aligned["rel_rmse_8"] <= 0.45
     assert 0.8 <= aligned["bias"] <= 1.25
-    # The default, with surface offsets: rel_rmse 0.613, rel_rmse_8 0.474, bias 1.202 -- over the
-    # target: the VPLs of the boxes' faces that share a cell with their surface are no longer half
-    # blocked, and the on-axis over-reading of the L1 transfer (docs/LPV.md) is no longer offset by
-    # that loss. The offsets earn their place on walls that do not align with cells (thin-wall 0.68 ->
-    # 0.22, tests/e2e/test_lpv_vs_cycles.py::test_surface_offsets_on_thin_wall). Bound: the measured
-    # figure plus the run-to-run spread of llvmpipe's fp32 sums (below 0.005), so a regression fails.
-    assert improved["rel_rmse_8"] <= 0.48
-    assert 0.8 <= improved["bias"] <= 1.25
+    assert improved["rel_rmse_8"] < 0.8 * one_grid["rel_rmse_8"]
     assert improved["rel_rmse_8"] < 0.5 * classic["rel_rmse_8"]
 
 
 def test_lpv_second_bounce_on_cornell(tmp_path):
     """Improved variant, 32 cells, geometry volume, bounces=2 vs Cycles' Diffuse Indirect at
     diffuse_bounces=2 (256 spp, 64 px). Measured (llvmpipe, 2 cores; geometry-aware lookup, surface
-    offsets, re-injection from the corners that do not block along the side):
-    - bounces=2: rel_rmse 0.490, rel_rmse_8 0.378, bias 1.153; update ~1-2.5 s (0.5-1.2 s at one bounce).
-    - bounces=1 against the same reference: rel_rmse 0.447, rel_rmse_8 0.331, bias 0.859.
-    - the second bounce raises our mean by 1.34x; Cycles' by 1.40x (2-bounce / 1-bounce reference).
-    (Session 4, plain trilinear re-injection, no offsets: 0.318 / 1.022 and 0.348 / 0.811; the
-    geometry-aware re-injection costs Cornell this and cuts window-room's leak, 2.53 -> 0.55 at 128 px.)
+    offsets, re-injection from the corners that do not block along the side, far field):
+    - bounces=2: rel_rmse 0.384, rel_rmse_8 0.280, bias 0.857; update ~0.3 s.
+    - bounces=1 against the same reference: rel_rmse 0.481, rel_rmse_8 0.405, bias 0.664.
+    - the second bounce raises our mean by 1.29x; Cycles' by 1.40x (2-bounce / 1-bounce reference).
+    (On one grid, far_field=False: 0.378 / 1.153 and 0.331 / 0.859, the L1 transfer's on-axis excess
+    lifting both; session 4, plain trilinear re-injection, no offsets: 0.318 / 1.022 and 0.348 / 0.811.)
     The reference's own noise (seed 0 vs seed 1): rel_rmse_8 0.024, bias 0.995. The bounds sit a little
     outside the 2-bounce figures and exclude the 1-bounce ones, so a missing or halved second bounce
     fails (bias, ratio), as does one that adds error (rel_rmse_8).
@@ -115,31 +115,39 @@ def test_lpv_second_bounce_on_cornell(tmp_path):
         print(f"lpv improved, bounces={bounces} vs Cycles diffuse_bounces=2: {errors[bounces]}, "
               f"total {timings['total']:.0f} ms")
     two = errors[2]
-    assert two["rel_rmse_8"] <= 0.39
-    assert 0.9 <= two["bias"] <= 1.2
+    assert two["rel_rmse_8"] <= 0.30
+    assert 0.8 <= two["bias"] <= 1.2
     assert means[2] / means[1] >= 1.2
     # The bounds can fail: one bounce scores outside the bias band (its rel_rmse_8 is as low: the
     # pattern is right, the level is not).
-    assert errors[1]["bias"] < 0.9
+    assert errors[1]["bias"] < 0.8
 
 
 def test_surface_offsets_on_thin_wall(tmp_path):
     """thin-wall (a lit 2 m room of walls 0.1 m thick, thinner than a 0.13 m cell, at positions that do
-    not align with cells) vs Cycles, 64 px, 256 spp, improved, 32 cells. Without surface offsets a VPL
+    not align with cells) vs Cycles, 64 px, 256 spp, improved, 32 cells, on one grid (far_field=False,
+    which isolates the offsets). Without surface offsets a VPL
     that lands in the cell of its own wall (the wall in the cell's near 40 %) loses half its light on
     its first step out, so the room's light depends on how its walls fall in cells: at 128 px rel_rmse_8
     0.28 / 0.64 / 0.68 / 0.29 / 0.53 at 16 / 24 / 32 / 48 / 64 cells (bias 0.56 at 32), with offsets
     0.30 / 0.30 / 0.22 / 0.31 / 0.28 (docs/LPV.md). Measured here at 64 px: see the printed figures;
     without offsets rel_rmse_8 0.617 / bias 0.569, with offsets 0.178 / 0.929. Bounds between the two
-    (the reference alone reads ~0.03), so either transport's regression fails."""
+    (the reference alone reads ~0.03), so either transport's regression fails. The default (offsets and
+    the far field, whose 16-cell grid holds these walls less well) reads 0.242 / 0.849: bounded too."""
     from addon.engine import metrics
     from addon.engine.config import LpvConfig
 
     blend, ref, mask = scene_and_reference(tmp_path, "thin-wall", bounces=1)
     errors = {}
-    for offsets in (False, True):
-        ours, _ = render_lpv(blend, LpvConfig(variant="improved", geometry_volume=True, surface_offsets=offsets))
-        errors[offsets] = metrics.compare(ours, ref, mask)
-        print(f"lpv thin-wall, surface_offsets={offsets}: {errors[offsets]}")
-    assert errors[True]["rel_rmse_8"] <= 0.3 and 0.85 <= errors[True]["bias"] <= 1.15
-    assert errors[False]["rel_rmse_8"] > 0.5 and errors[False]["bias"] < 0.7
+    for name, cfg in {
+        "no offsets, one grid": LpvConfig(surface_offsets=False, far_field=False),
+        "offsets, one grid": LpvConfig(far_field=False),
+        "default": LpvConfig(),
+    }.items():
+        ours, _ = render_lpv(blend, cfg)
+        errors[name] = metrics.compare(ours, ref, mask)
+        print(f"lpv thin-wall, {name}: {errors[name]}")
+    offsets, no_offsets, default = errors["offsets, one grid"], errors["no offsets, one grid"], errors["default"]
+    assert offsets["rel_rmse_8"] <= 0.3 and 0.85 <= offsets["bias"] <= 1.15
+    assert no_offsets["rel_rmse_8"] > 0.5 and no_offsets["bias"] < 0.7
+    assert default["rel_rmse_8"] <= 0.3 and 0.8 <= default["bias"] <= 1.15

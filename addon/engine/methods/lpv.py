@@ -19,7 +19,10 @@ non-cubic for flat scenes. With LpvConfig.cascades = C > 1 (lpv_cascade.place) t
 coarsest of C nested ones, each finer one half the cell size around the camera (re-placed when the
 camera leaves a parent cell, re-voxelized then). Every cascade gets the same VPLs; coarsest first, each
 propagates on its own after lpv_cascade.inflow has added the light entering it from its parent; the
-lookups run coarsest first, each finer one blended in across its band. Products: direct, indirect, albedo.
+lookups run coarsest first, each finer one blended in across its band. With LpvConfig.far_field (improved,
+>= 32 cells) the coarsest grid runs only its near steps and a far-field grid of twice its cell
+(lpv_far_field: its own voxels and injection; later bounces' sources summed from the fine grid's) carries
+the light further; its accumulation is added to the fine one. Products: direct, indirect, albedo.
 """
 
 from __future__ import annotations
@@ -28,7 +31,17 @@ import numpy as np
 
 from ..config import LpvConfig
 from ..grid import Grid
-from ..passes import atlas, lpv_cascade, lpv_inject, lpv_lookup, lpv_propagate, lpv_reinject, rsm_reduce, zero
+from ..passes import (
+    atlas,
+    lpv_cascade,
+    lpv_far_field,
+    lpv_inject,
+    lpv_lookup,
+    lpv_propagate,
+    lpv_reinject,
+    rsm_reduce,
+    zero,
+)
 from ..passes.light_views import LightView
 from ..passes.voxelize import Voxelizer
 from .direct import OneBounceMethod
@@ -43,28 +56,43 @@ def iterations_for(config: LpvConfig, grid: Grid) -> int:
     return config.iterations
 
 
+def near_steps_for(config: LpvConfig, grid: Grid) -> int:
+    """The steps `grid` runs itself when a far field carries the rest (lpv_far_field), 0 when it has none:
+    the improved variant with LpvConfig.far_field, on a grid of >= MIN_GRID_CELLS along its longest side;
+    near_steps, or 0 for half that side's cells (measured: docs/LPV.md, "Far field"); none when the
+    grid's own steps are no more than that."""
+    if not (config.far_field and config.variant == "improved" and max(grid.dims) >= lpv_far_field.MIN_GRID_CELLS):
+        return 0
+    near = config.near_steps or max(grid.dims) // 2
+    return near if near < iterations_for(config, grid) else 0
+
+
 class LpvVolume:
     """One grid's textures: snapshot sets (0 = the injection, kept for a finer cascade's inflow; 1 and 2
-    ping-pong), the accumulation, the injection atlas and, when asked for, the voxels."""
+    ping-pong), the accumulation, the injection atlas, when asked for the voxels, and its far-field grid
+    (`far`, an LpvVolume made with is_far_field, or None). A far-field grid's accumulation holds only
+    the far light of one propagation; it has no bounce accumulation and voxels only to block light."""
 
-    def __init__(self, method: LpvMethod, cascade: lpv_cascade.Cascade):
+    def __init__(self, method: LpvMethod, cascade: lpv_cascade.Cascade, is_far_field: bool = False):
         be = method.backend
         self.cascade, self.grid = cascade, cascade.grid
+        self.is_far_field = is_far_field
         dims = self.grid.dims
         self.snapshots = [{f"sh_{c}": be.texture(dims) for c in "rgb"} for _ in range(3)]
         self.accumulated = {f"acc_{c}": be.texture(dims) for c in "rgb"}
         self.atlas, self.inject_atlas, self.inject_target = lpv_inject.atlas_target(be, self.grid)
         # One bounce's accumulation (the total is `accumulated`): what the next bounce re-injects.
-        self.bounce_accumulated = ({f"acc_{c}": be.texture(dims) for c in "rgb"} if method.gi.bounces > 1
-                                   else None)
+        self.bounce_accumulated = ({f"acc_{c}": be.texture(dims) for c in "rgb"}
+                                   if method.gi.bounces > 1 and not is_far_field else None)
         self.geometry_volume = method.lpv_config.geometry_volume
         self.voxels = None
         self.blocking = None  # lpv_propagate.blocking's volumes, with the geometry volume
+        self.far: LpvVolume | None = None
         self.voxelize(method)
 
     def voxelize(self, method: LpvMethod) -> None:
         cfg = method.lpv_config
-        if not (cfg.geometry_volume or method.gi.bounces > 1):
+        if not (cfg.geometry_volume or (method.gi.bounces > 1 and not self.is_far_field)):
             return
         self._voxelizer = Voxelizer(method.backend, self.grid)  # keeps its textures alive
         self._voxelizer.set_scene(method.scene)
@@ -117,6 +145,9 @@ class LpvMethod(OneBounceMethod):
     def set_scene(self, scene) -> None:
         super().set_scene(scene)
         self.levels = [LpvVolume(self, c) for c in self.place_cascades()]
+        top = self.levels[-1]
+        if near_steps_for(self.lpv_config, top.grid):
+            top.far = LpvVolume(self, lpv_cascade.Cascade(lpv_far_field.grid_for(top.grid)), is_far_field=True)
         res = self.rsm_config.resolution
         self._reduce = rsm_reduce.factor_for(res, self.lpv_config.grid_cells)
         self._vpls = rsm_reduce.textures(self.backend, res, self._reduce) if self._reduce > 1 else None
@@ -139,9 +170,14 @@ class LpvMethod(OneBounceMethod):
         classic keeps the published plain trilinear lookup (docs/LPV.md, "Lookup")."""
         return level.vox_normal if self.lpv_config.variant == "improved" else None
 
+    def grids(self) -> list[LpvVolume]:
+        """Every grid that receives the VPLs: the cascades, finest first, then the far field if any."""
+        far = self.levels[-1].far
+        return self.levels + ([far] if far is not None else [])
+
     def clear_products(self) -> None:
         super().clear_products()
-        for level in self.levels:
+        for level in self.grids():
             zero.images(self.backend, list(level.inject_atlas.values()))
 
     def per_light_view(self, view: LightView, timings: dict[str, float]) -> None:
@@ -150,21 +186,38 @@ class LpvMethod(OneBounceMethod):
             if self._vpls is not None:
                 rsm_reduce.run(self.backend, self.rsm, self._vpls, self._reduce)
                 vpls = self._vpls
-            for level in self.levels:
+            for level in self.grids():
                 lpv_inject.run(self.backend, level.inject_target, self._points, vpls, level.grid, level.atlas)
 
     def propagate(self, iterations: int | None = None, accumulated: dict | None = None,
                   level: LpvVolume | None = None) -> None:
         """Propagate a grid's (default: the finest's) snapshot set 0 into `accumulated` (default: its
-        total), overwriting it; set 0 is kept. `iterations` overrides the config."""
+        total), overwriting it; set 0 is kept. With a far field (whose snapshot set 0 the caller has
+        filled too) the grid runs its near steps, the far field its own span, and its far light is added.
+        `iterations` overrides the config: that many steps on this grid alone."""
         level = self.levels[0] if level is None else level
-        n = iterations_for(self.lpv_config, level.grid) if iterations is None else iterations
         acc = level.accumulated if accumulated is None else accumulated
+        near = near_steps_for(self.lpv_config, level.grid) if level.far is not None and iterations is None else 0
+        if not near:
+            self._steps(level, iterations_for(self.lpv_config, level.grid) if iterations is None else iterations,
+                        acc)
+            return
+        far = level.far
+        # The fine grid's last step with a share is near - 1; at least one step initialises `acc`.
+        self._steps(level, max(1, near - 1), acc, lambda step: lpv_far_field.fine_weight(step, near))
+        self._steps(far, iterations_for(self.lpv_config, far.grid), far.accumulated,
+                    lambda step: lpv_far_field.coarse_weight(step, near))
+        lpv_far_field.add(self.backend, far.accumulated, far.grid, acc, level.grid)
+
+    def _steps(self, level: LpvVolume, n: int, acc: dict, share=None) -> None:
+        """n propagation steps of `level` from its snapshot set 0, accumulated into acc (overwritten),
+        step s (1-based) weighted by share(s) when given."""
         sets = level.snapshots
         for i in range(n):
             src = sets[0] if i == 0 else sets[2 - i % 2]
             lpv_propagate.run(self.backend, src, sets[1 + i % 2], acc, level.grid, self.lpv_config.variant,
-                              first_step=i == 0, geometry=level.blocking)
+                              first_step=i == 0, geometry=level.blocking,
+                              step_scale=1.0 if share is None else share(i + 1))
 
     def reinject(self, previous: dict) -> None:
         """The light the surfaces reflect of one bounce's accumulation -> snapshot set 0 (overwritten)."""
@@ -189,6 +242,9 @@ class LpvMethod(OneBounceMethod):
                         parent = levels[i + 1]
                         lpv_cascade.inflow(be, level.cascade, level.snapshots[0], parent.grid,
                                            parent.bounce_accumulated, parent.snapshots[0], self.lpv_config.variant)
+                    if level.far is not None:
+                        lpv_far_field.source(be, level.snapshots[0], level.grid, level.far.snapshots[0],
+                                             level.far.grid)
                 with self.timed(timings, "lpv_propagate"):
                     self.propagate(accumulated=level.bounce_accumulated, level=level)
             with self.timed(timings, "lpv_lookup"):
@@ -226,6 +282,9 @@ class LpvMethod(OneBounceMethod):
                 level = self.levels[i]
                 with self.timed(timings, "lpv_inject"):
                     lpv_inject.unpack(be, level.inject_atlas, level.snapshots[0], level.grid, level.atlas)
+                    if level.far is not None:
+                        far = level.far
+                        lpv_inject.unpack(be, far.inject_atlas, far.snapshots[0], far.grid, far.atlas)
                     if i + 1 < len(self.levels):
                         parent = self.levels[i + 1]
                         lpv_cascade.inflow(be, level.cascade, level.snapshots[0], parent.grid, parent.accumulated,

@@ -101,8 +101,9 @@ def weights(variant: str) -> tuple[float, float]:
 
 
 def run(backend: Backend, src: dict, dst: dict, acc: dict, grid: Grid, variant: str, first_step: bool,
-        geometry: dict | None = None) -> None:
-    """One step: src (sh_r/g/b textures) -> dst, accumulated into acc (keys acc_r/g/b); `geometry`:
+        geometry: dict | None = None, step_scale: float = 1.0) -> None:
+    """One step: src (sh_r/g/b textures) -> dst, accumulated into acc (keys acc_r/g/b) with `weights`'
+    step weight times `step_scale` (the far field's share of the step, lpv_far_field); `geometry`:
     `blocking`'s output when a geometry volume blocks the transfers."""
     spec = SPECS[(variant, geometry is not None)]
     c = improved_constants() if variant == "improved" else {"m_cross": 0.0, "m_along": 0.0, "m_side": 0.0}
@@ -112,6 +113,7 @@ def run(backend: Backend, src: dict, dst: dict, acc: dict, grid: Grid, variant: 
         samplers.update(geometry)
     images = {**{f"dst_{ch}": dst[f"sh_{ch}"] for ch in "rgb"}, **{f"acc_{ch}": acc[f"acc_{ch}"] for ch in "rgb"}}
     uniforms = {"dims": grid.dims, "first_step": int(first_step), "source_weight": source_weight,
-                "step_weight": step_weight, "m_cross": c["m_cross"], "m_along": c["m_along"], "m_side": c["m_side"]}
+                "step_weight": step_weight * step_scale, "m_cross": c["m_cross"], "m_along": c["m_along"],
+                "m_side": c["m_side"]}
     backend.dispatch(backend.program(spec), group_count(grid.dims, spec.local_size), uniforms=uniforms,
                      samplers=samplers, images=images)
