@@ -29,6 +29,9 @@ def add_arguments(p) -> None:
                    help="LPV: occlude by the voxelized surfaces (default on)")
     p.add_argument("--surface-offsets", action=argparse.BooleanOptionalAction, default=True,
                    help="LPV geometry volume: a surface blocks the transfers on its side of its cell (default on)")
+    p.add_argument("--far-field", action=argparse.BooleanOptionalAction, default=True,
+                   help="LPV: run the near steps on the grid, the rest on a grid of twice the cell (default on)")
+    p.add_argument("--near-steps", type=int, default=0, help="LPV far field: the grid's own steps (0: half its cells)")
     p.add_argument("--cascades", type=int, default=1, help="LPV: nested grids, the finest around the camera")
     p.add_argument("--cell-size", type=float, default=0.0,
                    help="LPV: finest cascade's cell in metres (0: the coarsest grid fits the scene)")
@@ -48,6 +51,7 @@ def run(args) -> int:
                     voxel_cells=args.voxel_cells)
     lpv = LpvConfig(grid_cells=args.grid, iterations=args.iterations, variant=args.variant,
                     geometry_volume=args.geometry_volume, surface_offsets=args.surface_offsets,
+                    far_field=args.far_field, near_steps=args.near_steps,
                     cascades=args.cascades, cell_size_m=args.cell_size)
     vct = VctConfig(voxel_cells=args.voxel_cells, diffuse_cones=args.cones, step_ratio=args.step_ratio,
                     offset_cells=args.cone_offset, radiance=args.radiance, gather_scale=args.gather_scale)

@@ -15,9 +15,9 @@ import pytest
 from addon.engine import sh
 from addon.engine.config import GIConfig, LpvConfig, RsmConfig
 from addon.engine.grid import Grid
-from addon.engine.methods.lpv import LpvMethod
+from addon.engine.methods.lpv import LpvMethod, iterations_for, near_steps_for
 from addon.engine.passes import atlas as atlas_pass
-from addon.engine.passes import lpv_cascade, lpv_inject, lpv_lookup, lpv_propagate, lpv_reinject
+from addon.engine.passes import lpv_cascade, lpv_far_field, lpv_inject, lpv_lookup, lpv_propagate, lpv_reinject
 from addon.engine.scene import Camera, Light, Scene
 from addon.engine.transforms import look_along, perspective
 
@@ -301,6 +301,110 @@ def test_point_source_irradiance_along_an_axis(gl):
     # and the border absorbs them along with the positive light. Bound: [0.6, 1.9] on 2..32 cells.
     for r in range(2, 33):
         assert 0.6 <= improved[r] <= 1.9, (r, improved[r])
+
+
+# -- far field ----------------------------------------------------------------------------------------
+def test_far_field_shares_count_every_distance_once():
+    # A packet at fine step s (distance ~s fine cells) is counted by the fine grid with fine_weight(s)
+    # and by the coarse grid at step s / 2 with coarse_weight(s / 2) = 1 - fine_weight(s): the shares
+    # sum to exactly 1 at every even distance; the fine grid counts everything up to K/2 and nothing
+    # from K on, so its last step with a share is K - 1.
+    for near in (8, 16, 17, 32):
+        for s in range(1, 3 * near):
+            w = lpv_far_field.fine_weight(s, near)
+            assert 0.0 <= w <= 1.0
+            assert w == (1.0 if s <= near / 2 else 0.0 if s >= near else w)
+            if s % 2 == 0:
+                assert w + lpv_far_field.coarse_weight(s // 2, near) == 1.0
+
+
+def test_far_field_applies_where_it_is_measured_to_help():
+    grid32, grid16 = Grid(np.zeros(3), 0.1, (32, 12, 20)), Grid(np.zeros(3), 0.1, (16, 16, 16))
+    assert near_steps_for(LpvConfig(), grid32) == 16  # half the longest side
+    assert near_steps_for(LpvConfig(near_steps=10), grid32) == 10
+    assert near_steps_for(LpvConfig(far_field=False), grid32) == 0
+    assert near_steps_for(LpvConfig(variant="classic"), grid32) == 0  # the published baseline stays as it is
+    assert near_steps_for(LpvConfig(), grid16) == 0  # an 8-cell far field resolves too little
+    span = iterations_for(LpvConfig(), grid32)
+    assert near_steps_for(LpvConfig(near_steps=span), grid32) == 0  # the grid's own steps reach everywhere
+    coarse = lpv_far_field.grid_for(Grid(np.array([1.0, 2.0, 3.0]), 0.1, (33, 12, 7)))
+    assert coarse.dims == (17, 6, 4) and coarse.cell_size_m == 0.2 and np.array_equal(coarse.origin_m, [1, 2, 3])
+
+
+def test_far_field_passes_equal_numpy(gl):
+    # add: fine += 1/4 x trilinear(coarse) at fine centres (coarse coordinate (i + 0.5) / 2 - 0.5,
+    # clamped to the edge); source: coarse = sum of its 2 x 2 x 2 fine cells, those beyond odd fine dims
+    # absent. Exact arithmetic up to fp32 rounding: rtol 1e-5 of the largest value.
+    rng = np.random.default_rng(7)
+    fine = Grid(np.zeros(3), 1.0, (7, 4, 5))
+    coarse = lpv_far_field.grid_for(fine)
+    fz, fy, fx = reversed(fine.dims)
+    cz, cy, cx = reversed(coarse.dims)
+    coarse_acc = [rng.normal(size=(cz, cy, cx, 4)).astype(np.float32) for _ in range(3)]
+    fine_acc = [rng.normal(size=(fz, fy, fx, 4)).astype(np.float32) for _ in range(3)]
+    acc = {f"acc_{c}": gl.texture(fine.dims, "RGBA32F", a) for c, a in zip("rgb", fine_acc, strict=True)}
+    far = {f"acc_{c}": gl.texture(coarse.dims, "RGBA32F", a) for c, a in zip("rgb", coarse_acc, strict=True)}
+    lpv_far_field.add(gl, far, coarse, acc, fine)
+
+    def corners(n_fine, n_coarse):  # per fine index: (lower corner, upper corner, upper weight)
+        t = (np.arange(n_fine) + 0.5) / 2 - 0.5
+        i0 = np.floor(t).astype(int)
+        return np.clip(i0, 0, n_coarse - 1), np.clip(i0 + 1, 0, n_coarse - 1), t - i0
+
+    (z0, z1, wz), (y0, y1, wy), (x0, x1, wx) = corners(fz, cz), corners(fy, cy), corners(fx, cx)
+    for got, before, far_c in zip((gl.read(acc[f"acc_{c}"]) for c in "rgb"), fine_acc, coarse_acc, strict=True):
+        want = before.astype(np.float64)
+        for kz, az in ((z0, 1 - wz), (z1, wz)):
+            for ky, ay in ((y0, 1 - wy), (y1, wy)):
+                for kx, ax in ((x0, 1 - wx), (x1, wx)):
+                    w = az[:, None, None] * ay[None, :, None] * ax[None, None, :]
+                    want += 0.25 * w[..., None] * far_c[np.ix_(kz, ky, kx)]
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-5 * np.abs(want).max())
+    snapshot = {f"sh_{c}": gl.texture(fine.dims, "RGBA32F", a) for c, a in zip("rgb", fine_acc, strict=True)}
+    out = volumes(gl, coarse.dims)
+    lpv_far_field.source(gl, snapshot, fine, out, coarse)
+    for c, f in zip("rgb", fine_acc, strict=True):
+        padded = np.zeros((2 * cz, 2 * cy, 2 * cx, 4))
+        padded[:fz, :fy, :fx] = f
+        want = padded.reshape(cz, 2, cy, 2, cx, 2, 4).sum(axis=(1, 3, 5))
+        np.testing.assert_allclose(gl.read(out[f"sh_{c}"]), want, rtol=0, atol=1e-5 * np.abs(want).max())
+
+
+def far_field_point_source_profile(gl, near, length=36, side=31):
+    """point_source_profile's source and read-out through the far field: the fine grid's near steps
+    plus a coarse grid (its source summed from the fine one, as for later bounces) over its span."""
+    grid = Grid(np.zeros(3), 1.0, (length + 6, side, side))
+    coarse = lpv_far_field.grid_for(grid)
+    src = (4, side // 2, side // 2)
+    field = [np.zeros((side, side, length + 6, 4), np.float32) for _ in range(3)]
+    field[0][src[2], src[1], src[0], 0] = 1.0 / FLUX_PER_C0
+    fine_sets = [volumes(gl, grid.dims, field), volumes(gl, grid.dims)]
+    coarse_sets = [volumes(gl, coarse.dims), volumes(gl, coarse.dims)]
+    lpv_far_field.source(gl, fine_sets[0], grid, coarse_sets[0], coarse)
+    acc = {f"acc_{c}": gl.texture(grid.dims) for c in "rgb"}
+    far = {f"acc_{c}": gl.texture(coarse.dims) for c in "rgb"}
+    for g, sets, out, n, share in ((grid, fine_sets, acc, near - 1, lpv_far_field.fine_weight),
+                                   (coarse, coarse_sets, far, sum(coarse.dims) - 3, lpv_far_field.coarse_weight)):
+        for i in range(n):
+            lpv_propagate.run(gl, sets[i % 2], sets[(i + 1) % 2], out, g, "improved", first_step=i == 0,
+                              step_scale=share(i + 1, near))
+    lpv_far_field.add(gl, far, coarse, acc, grid)
+    acc_r = gl.read(acc["acc_r"])
+    return {r: max(acc_r[src[2], src[1], src[0] + r] @ sh.cosine_lobe_l1(np.array([1.0, 0, 0])), 0.0)
+            / (1.0 / (4 * np.pi) / r**2) for r in range(1, length + 1)}
+
+
+def test_far_field_point_source_irradiance_along_an_axis(gl):
+    # In open space the far field reads like the single grid: the coarse grid's L1 transfer has the same
+    # on-axis excess (it is not a property of the number of steps there). Measured, near = 16, LPV /
+    # exact at 1, 2, 4, 8, 12, 16, 24, 32 cells: 0.69, 1.29, 1.66, 0.97, 1.47, 1.80, 1.76, 1.86 (one
+    # grid: 0.69, 1.27, 1.48, 1.42, 1.55, 1.70, 1.51, 1.57); the dip at 8 cells is the hand-over
+    # (K/2 .. K), where the coarse source sits half a fine cell further out. Bound: the single grid's
+    # band [0.6, 1.9] over 2..32 cells, so lost or doubled far light fails.
+    far = far_field_point_source_profile(gl, near=16)
+    print("far field, near 16: " + ", ".join(f"{r}: {far[r]:.2f}" for r in (1, 2, 4, 8, 12, 16, 24, 32)))
+    for r in range(2, 33):
+        assert 0.6 <= far[r] <= 1.9, (r, far[r])
 
 
 # -- lookup -------------------------------------------------------------------------------------------
@@ -600,17 +704,18 @@ def test_surface_offsets_make_light_less_dependent_on_wall_alignment(gl):
     assert spreads[False] >= 2.0
 
 
-def first_and_second_bounce_flux(gl, geometry_volume):
-    """(flux the VPLs inject, flux the surfaces reflect of it) per colour, W, in the box scene."""
+def first_and_second_bounce_flux(gl, geometry_volume, grid_cells=16, far_field=True):
+    """(flux the VPLs inject, flux the surfaces reflect of the first bounce) per colour, W, in the box
+    scene: a bounces=2 update, whose snapshot set 0 holds the second bounce's source at the end."""
     method = LpvMethod(gl, GIConfig(method="lpv", bounces=2), RsmConfig(resolution=64),
-                       LpvConfig(grid_cells=16, variant="improved", geometry_volume=geometry_volume))
+                       LpvConfig(grid_cells=grid_cells, variant="improved", geometry_volume=geometry_volume,
+                                 far_field=far_field))
     method.set_scene(box_scene())
-    super(LpvMethod, method).compute()  # the direct method's passes: RSMs and the injection
-    lpv_inject.unpack(gl, method.inject_atlas, method.snapshots[0], method.grid, method.atlas)
-    injected = flux([gl.read(method.snapshots[0][f"sh_{c}"]) for c in "rgb"])
-    method.propagate()
-    method.reinject(method.accumulated)
-    return injected, flux([gl.read(method.snapshots[0][f"sh_{c}"]) for c in "rgb"])
+    method.compute()
+    injected = volumes(gl, method.grid.dims)
+    lpv_inject.unpack(gl, method.inject_atlas, injected, method.grid, method.atlas)
+    return (flux([gl.read(injected[f"sh_{c}"]) for c in "rgb"]),
+            flux([gl.read(method.snapshots[0][f"sh_{c}"]) for c in "rgb"]))
 
 
 def test_second_bounce_gains_no_energy(gl):
@@ -631,6 +736,14 @@ def test_second_bounce_gains_no_energy(gl):
     assert np.all(reflected <= albedo_max * injected)
     assert np.all(reflected > 0.3 * injected)  # and the bounce is there
     assert np.any(leaky > albedo_max * injected)
+    # At 32 cells the far field applies (16 near steps, a 16-cell far field): 0.59, 0.58, 0.45. One
+    # 32-cell grid reflects 0.76, 0.75, 0.58 -- over the bound in green and blue: every step at a wall
+    # adds a little (the L1 transfer's negative backward lobes are absorbed there with the positive
+    # light), and the far field takes half as many steps beyond its near field.
+    injected, reflected = first_and_second_bounce_flux(gl, geometry_volume=True, grid_cells=32)
+    print(f"32 cells, far field: reflected / injected = {reflected / injected}")
+    assert np.all(reflected <= albedo_max * injected)
+    assert np.all(reflected > 0.3 * injected)
 
 
 def test_more_bounces_only_add_light(gl):

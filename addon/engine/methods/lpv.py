@@ -70,13 +70,15 @@ def near_steps_for(config: LpvConfig, grid: Grid) -> int:
 class LpvVolume:
     """One grid's textures: snapshot sets (0 = the injection, kept for a finer cascade's inflow; 1 and 2
     ping-pong), the accumulation, the injection atlas, when asked for the voxels, and its far-field grid
-    (`far`, an LpvVolume made with is_far_field, or None). A far-field grid's accumulation holds only
-    the far light of one propagation; it has no bounce accumulation and voxels only to block light."""
+    (`far`, an LpvVolume made with far_field_of, or None). A far-field grid's accumulation holds only
+    the far light of one propagation; it has no bounce accumulation, and with the geometry volume its
+    voxels (projected areas and offsets only) are summed from its fine grid's, not voxelized."""
 
-    def __init__(self, method: LpvMethod, cascade: lpv_cascade.Cascade, is_far_field: bool = False):
+    def __init__(self, method: LpvMethod, cascade: lpv_cascade.Cascade, far_field_of: LpvVolume | None = None):
         be = method.backend
         self.cascade, self.grid = cascade, cascade.grid
-        self.is_far_field = is_far_field
+        self.far_field_of = far_field_of
+        is_far_field = far_field_of is not None
         dims = self.grid.dims
         self.snapshots = [{f"sh_{c}": be.texture(dims) for c in "rgb"} for _ in range(3)]
         self.accumulated = {f"acc_{c}": be.texture(dims) for c in "rgb"}
@@ -92,11 +94,15 @@ class LpvVolume:
 
     def voxelize(self, method: LpvMethod) -> None:
         cfg = method.lpv_config
-        if not (cfg.geometry_volume or (method.gi.bounces > 1 and not self.is_far_field)):
+        fine = self.far_field_of
+        if not (cfg.geometry_volume or (method.gi.bounces > 1 and fine is None)):
             return
-        self._voxelizer = Voxelizer(method.backend, self.grid)  # keeps its textures alive
-        self._voxelizer.set_scene(method.scene)
-        self.voxels = self._voxelizer.run()
+        if fine is not None:
+            self.voxels = lpv_far_field.voxels(method.backend, fine.voxels, fine.grid, self.grid, self.voxels)
+        else:
+            self._voxelizer = Voxelizer(method.backend, self.grid)  # keeps its textures alive
+            self._voxelizer.set_scene(method.scene)
+            self.voxels = self._voxelizer.run()
         if cfg.geometry_volume:
             # Classic is the published scheme's baseline: its cells block half and half whatever the config.
             offsets = cfg.surface_offsets and cfg.variant == "improved"
@@ -147,7 +153,7 @@ class LpvMethod(OneBounceMethod):
         self.levels = [LpvVolume(self, c) for c in self.place_cascades()]
         top = self.levels[-1]
         if near_steps_for(self.lpv_config, top.grid):
-            top.far = LpvVolume(self, lpv_cascade.Cascade(lpv_far_field.grid_for(top.grid)), is_far_field=True)
+            top.far = LpvVolume(self, lpv_cascade.Cascade(lpv_far_field.grid_for(top.grid)), far_field_of=top)
         res = self.rsm_config.resolution
         self._reduce = rsm_reduce.factor_for(res, self.lpv_config.grid_cells)
         self._vpls = rsm_reduce.textures(self.backend, res, self._reduce) if self._reduce > 1 else None
