@@ -165,8 +165,9 @@ def test_navigating_gives_preview_then_full_quality(cornell):
     np.testing.assert_array_equal(full.view, preview.view)
 
 
-@pytest.mark.parametrize("name", ["direct", "rsm", "lpv", "vct"])
+@pytest.mark.parametrize("name", ["direct", "rsm", "lpv", "lpv-far-field", "vct"])
 def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, name):
+    # lpv at 16 cells runs one grid; "lpv-far-field" at 32 cells adds the far field's passes.
     from addon.bridge import scenes
     from addon.bridge.capture import SceneCache
     from addon.engine import methods
@@ -174,15 +175,16 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
 
     scenes.build("cornell-glossy" if name == "vct" else "cornell")  # vct: its glossy product too
     scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 64, 48)
-    gi, rsm = GIConfig(method=name, resolution=64), RsmConfig(resolution=128, vpl_samples=64)
+    method_name, grid_cells = ("lpv", 32) if name == "lpv-far-field" else (name, 16)
+    gi, rsm = GIConfig(method=method_name, resolution=64), RsmConfig(resolution=128, vpl_samples=64)
     results = []
     for be in (gl, blender_backend):
-        method = methods.create(be, gi, rsm, LpvConfig(grid_cells=16, variant="improved", geometry_volume=True),
+        method = methods.create(be, gi, rsm, LpvConfig(grid_cells=grid_cells, variant="improved", geometry_volume=True),
                                 VctConfig(voxel_cells=16, diffuse_cones=6))
         method.set_scene(scene)
         results.append(method.run().images)
     a, b = results
-    assert set(a) == set(b) == set(methods.get(name).products)
+    assert set(a) == set(b) == set(methods.get(method_name).products)
     for key in a:
         assert a[key][..., :3].max() > 0, key  # light, not just the coverage in alpha
         # Same GLSL bodies, same Mesa rasterizer and fp32 maths on both: equal to float32 rounding,
