@@ -244,6 +244,11 @@ def configs():
                                                       "geometry_volume": True}, {}),
         ("lpv-improved-gv-64", {"method": "lpv"}, {}, {"grid_cells": 64, "variant": "improved",
                                                       "geometry_volume": True}, {}),
+        # The defaults above run the far field (session 6); these are one grid, as timed in session 4.
+        ("lpv-improved-gv-32-one-grid", {"method": "lpv"}, {}, {"grid_cells": 32, "variant": "improved",
+                                                               "geometry_volume": True, "far_field": False}, {}),
+        ("lpv-improved-gv-64-one-grid", {"method": "lpv"}, {}, {"grid_cells": 64, "variant": "improved",
+                                                               "geometry_volume": True, "far_field": False}, {}),
         ("lpv-classic-32", {"method": "lpv"}, {}, {"grid_cells": 32, "variant": "classic"}, {}),
         ("lpv-improved-gv-32-3cascades", {"method": "lpv"}, {}, {"grid_cells": 32, "variant": "improved",
                                                                 "geometry_volume": True, "cascades": 3}, {}),
@@ -460,9 +465,10 @@ def run(scenes_dir: Path, out: Path, size: tuple[int, int], repeat: int, warmup:
                 if grid is not None:
                     result["grid_dims"] = list(grid.dims)
                 if hasattr(method, "lpv_config"):
-                    from addon.engine.methods.lpv import iterations_for
+                    from addon.engine.methods.lpv import iterations_for, near_steps_for
 
                     result["propagation_steps"] = iterations_for(method.lpv_config, method.grid)
+                    result["near_steps"] = near_steps_for(method.lpv_config, method.levels[-1].grid)
                 del method
             except Exception as exc:  # noqa: BLE001 - one failing config must not lose the others
                 result = {"error": f"{type(exc).__name__}: {exc}", "traceback": traceback.format_exc()}
