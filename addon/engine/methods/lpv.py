@@ -225,10 +225,6 @@ class LpvMethod(OneBounceMethod):
                               first_step=i == 0, geometry=level.blocking,
                               step_scale=1.0 if share is None else share(i + 1))
 
-    def reinject(self, previous: dict) -> None:
-        """The light the surfaces reflect of one bounce's accumulation -> snapshot set 0 (overwritten)."""
-        lpv_reinject.run(self.backend, previous, self.voxels, self.snapshots[0], self.grid)
-
     def add_bounces(self, timings: dict[str, float]) -> None:
         """Bounces 2..gi.bounces on top of the first bounce (in each grid's `accumulated` and in
         `indirect`). Each: every grid, coarsest first, re-injects what its surfaces reflect of the
