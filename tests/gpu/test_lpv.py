@@ -305,10 +305,10 @@ def test_point_source_irradiance_along_an_axis(gl):
 
 # -- far field ----------------------------------------------------------------------------------------
 def test_far_field_shares_count_every_distance_once():
-    # A packet at fine step s (distance ~s fine cells) is counted by the fine grid with fine_weight(s)
-    # and by the coarse grid at step s / 2 with coarse_weight(s / 2) = 1 - fine_weight(s): the shares
-    # sum to exactly 1 at every even distance; the fine grid counts everything up to K/2 and nothing
-    # from K on, so its last step with a share is K - 1.
+    # Light in flight for s fine steps is counted by the fine grid with fine_weight(s) and by the coarse
+    # grid at its step s / 2 (a coarse step moves light two fine cells) with coarse_weight(s / 2) =
+    # 1 - fine_weight(s): the shares sum to exactly 1 at every even time; the fine grid counts everything
+    # up to K/2 and nothing from K on, so its last step with a share is K - 1.
     for near in (8, 16, 17, 32):
         for s in range(1, 3 * near):
             w = lpv_far_field.fine_weight(s, near)

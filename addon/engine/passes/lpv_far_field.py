@@ -5,14 +5,16 @@ The improved transport moves light one axis step per step, so a grid needs its M
 the fine grid runs only its first `near_steps` K and a coarse grid (`grid_for`: same origin, cell 2h,
 ceil(dims / 2) cells; its own injection, and a geometry volume summed from the fine grid's voxels by
 `voxels`) its whole span, half as many steps for the same distance at 1/8 of the cells: ~4x less propagation
-work at 32 cells, and less error on every benchmark scene but thin-wall, also with the level corrected
-(measured, docs/LPV.md; in open space both read the same on-axis excess, so the gain is the per-step
-artefacts of walls, not of free flight). Each accumulates a share of its steps: the fine grid's step s with
-`fine_weight(s)` (1 up to K/2, falling linearly to 0 at K), the coarse grid's step s' with 1 - fine_weight(2
-s') (a coarse step covers two fine cells of distance), so a packet's light is counted once in sum at every
-distance, the switch spread over K/2 .. K cells instead of a ring at one distance. `add` adds the coarse
-accumulation to the fine one; everything downstream (lookup, re-injection, cascades' inflow, volume bakes)
-reads the sum.
+work at 32 cells, and less error on every benchmark scene but thin-wall (conference equal), also with the
+level corrected (measured, docs/LPV.md; in open space both read the same on-axis excess, so the gain is the
+per-step artefacts of walls, not of free flight). Each accumulates a share of its steps: the fine grid's
+step s with `fine_weight(s)` (1 up to K/2, falling linearly to 0 at K), the coarse grid's step s' with 1 -
+fine_weight(2 s'). The shares are by time of flight: a coarse step moves light two fine cells, so coarse
+step s' stands for fine steps 2 s' and 2 s' + 1, and the light is counted once in sum at every time; the
+switch is spread over K/2 .. K steps instead of one step. (Light does not arrive one cell per step: on an
+axis a point source's light passes r cells out over steps ~1.3 r .. 2.5 r, peaking near 1.9 r.) `add` adds
+the coarse accumulation to the fine one; everything downstream (lookup, re-injection, cascades' inflow,
+volume bakes) reads the sum.
 
 Inputs / outputs: `add`: the coarse accumulation `far_r/g/b` (RGBA32F 3D, L1 SH, as the propagation
 accumulates) -> the fine accumulation `acc_r/g/b` (read-write). `source`: a fine snapshot `fine_r/g/b` ->
@@ -71,7 +73,7 @@ def fine_weight(step: int, near_steps: int) -> float:
 
 def coarse_weight(step: int, near_steps: int) -> float:
     """The share of the coarse grid's step `step` (1-based): the rest of what the fine grid leaves out at
-    the same distance, 2 * step fine cells."""
+    the same time of flight, fine step 2 * step."""
     return 1.0 - fine_weight(2 * step, near_steps)
 
 
