@@ -75,7 +75,8 @@ class LpvConfig(_Validated):
     """Light propagation volume (method `lpv`): docs/LPV.md derives the units and the variants."""
 
     grid_cells: int = _num(32, 8, 256, "LPV cells along the scene's longest side")
-    iterations: int = _num(16, 1, 256, "propagation steps (classic); improved runs at least the grid's Manhattan span")
+    iterations: int = _num(16, 1, 256, "propagation steps (classic); improved runs at least the grid's Manhattan span "
+                           "(with a far field: near_steps on the grid, the span on the far field's)")
     # Defaults: the improved transport with occlusion (Cornell rel_rmse_8 0.42); the published scheme
     # stays a variant for comparison (1.15, no better than a constant: ../shared/BASELINE.md).
     variant: str = _choice("improved", ("classic", "improved"),
