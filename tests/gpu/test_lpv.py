@@ -370,6 +370,39 @@ def test_far_field_passes_equal_numpy(gl):
         np.testing.assert_allclose(gl.read(out[f"sh_{c}"]), want, rtol=0, atol=1e-5 * np.abs(want).max())
 
 
+def test_far_field_voxels_equal_numpy(gl):
+    # The coarse grid's geometry from the fine voxels: per axis projected area = children's sum / 4
+    # (cells^2 of a cell twice as wide), w = summed surface area / 4; offset = the children's surface
+    # positions (child centre -+0.5 fine cells + its offset) averaged with the child's projected area
+    # along that axis, halved into coarse cells; 0 where no child projects along it. Children beyond odd
+    # fine dims are absent. fp32 arithmetic: atol 1e-5.
+    rng = np.random.default_rng(11)
+    fine = Grid(np.zeros(3), 1.0, (5, 6, 3))
+    coarse = lpv_far_field.grid_for(fine)
+    fz, fy, fx = reversed(fine.dims)
+    cz, cy, cx = reversed(coarse.dims)
+    projected = rng.uniform(0, 1.5, (fz, fy, fx, 4)).astype(np.float32)
+    projected[..., :3] *= rng.random((fz, fy, fx, 3)) < 0.5  # many children with no surface on an axis
+    offset = rng.uniform(-0.5, 0.5, (fz, fy, fx, 4)).astype(np.float32)
+    out = lpv_far_field.voxels(gl, {"vox_projected": gl.texture(fine.dims, "RGBA32F", projected),
+                                    "vox_offset": gl.texture(fine.dims, "RGBA32F", offset)}, fine, coarse)
+    got_p, got_o = gl.read(out["vox_projected"]), gl.read(out["vox_offset"])
+    for z, y, x in np.ndindex(cz, cy, cx):
+        area, moment, surface = np.zeros(3), np.zeros(3), 0.0
+        for dz, dy, dx in np.ndindex(2, 2, 2):
+            cz_, cy_, cx_ = 2 * z + dz, 2 * y + dy, 2 * x + dx
+            if cz_ >= fz or cy_ >= fy or cx_ >= fx:
+                continue
+            p = projected[cz_, cy_, cx_]
+            position = np.array([dx, dy, dz]) - 0.5 + offset[cz_, cy_, cx_, :3]  # x, y, z
+            area += p[:3]
+            moment += p[:3] * position
+            surface += p[3]
+        want_o = np.where(area > 0, 0.5 * moment / np.maximum(area, 1e-30), 0.0)
+        np.testing.assert_allclose(got_p[z, y, x], [*(area / 4), surface / 4], atol=1e-5)
+        np.testing.assert_allclose(got_o[z, y, x, :3], want_o, atol=1e-5)
+
+
 def far_field_point_source_profile(gl, near, length=36, side=31):
     """point_source_profile's source and read-out through the far field: the fine grid's near steps
     plus a coarse grid (its source summed from the fine one, as for later bounces) over its span."""
