@@ -1,11 +1,12 @@
 """Bounce's bake against Cycles' bake curve: texel-space error vs time, and the Cycles-equivalent
 speed-up (time Cycles' bake needs to reach our rel_rmse_8 / our bake time), on the Cornell box.
 
-    .venv/bin/python tools/bake_speedup.py [--size 64] > table.md
+    .venv/bin/python tools/bake_speedup.py [--size 64] [--method rsm|lpv|vct] > table.md
 
 Reference: a Cycles bake at --ref-spp (seed 0); Cycles' curve: bakes at increasing spp with seed 1;
-Bounce: method rsm with voxel visibility, per object (setup = capture, upload and voxelization, once
-per file, reported apart). Prints a Markdown table for benchmarks/REPORT.md.
+Bounce: --method (rsm with voxel visibility by default; lpv and vct at their defaults), per object
+(setup = capture, upload and voxelization, once per file, reported apart). Prints a Markdown table for
+benchmarks/REPORT.md.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", type=int, default=64)
     ap.add_argument("--ref-spp", type=int, default=1024)
+    ap.add_argument("--method", default="rsm", choices=("rsm", "lpv", "vct"))
     args = ap.parse_args()
 
     import bpy
@@ -39,8 +41,9 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as tmp:
         blend = Path(tmp) / "cornell.blend"
         scenes.save("cornell", blend)
-        summary = bake_file(blend, Path(tmp) / "ours", list(OBJECTS), args.size, GIConfig(method="rsm"),
-                            RsmConfig(visibility="voxel"), "indirect", progress=False)
+        rsm = RsmConfig(visibility="voxel") if args.method == "rsm" else RsmConfig()
+        summary = bake_file(blend, Path(tmp) / "ours", list(OBJECTS), args.size, GIConfig(method=args.method),
+                            rsm, "indirect", progress=False)
         bpy.ops.wm.open_mainfile(filepath=str(blend))
         for name in OBJECTS:
             ours = images.read_exr(Path(tmp) / "ours" / f"{name}_indirect.exr")
@@ -59,7 +62,8 @@ def main() -> int:
                         f"(+ {summary['setup_ms']:.0f} ms setup per file) | "
                         + ", ".join(f"{c['spp']} spp {c['time_s']:.2f} s / {c['rel_rmse_8']:.3f}" for c in curve)
                         + f" | {bound}{up['speedup']:.2f}x |")
-    print(f"Cornell box, indirect, {args.size} x {args.size} texels; reference: Cycles bake {args.ref_spp} spp.\n")
+    print(f"Cornell box, indirect, method {args.method}, {args.size} x {args.size} texels; reference: Cycles bake "
+          f"{args.ref_spp} spp.\n")
     print("| object | rel_rmse_8 | bias | Bounce bake | Cycles bake: spp, time / rel_rmse_8 | speed-up |")
     print("| --- | --- | --- | --- | --- | --- |")
     print("\n".join(rows))
