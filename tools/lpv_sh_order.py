@@ -8,8 +8,9 @@ quadrature) and weights each step by the path-weight matrix integral Y_i Y_j / |
     .venv/bin/python tools/lpv_sh_order.py [--scenes cornell,window-room] [--band2 1.0]
 
 Scenes and Cycles references come from the bench's cache (out/bench; made if missing: 512 spp, 128 px,
-one bounce). --band2 scales the lookup's band-2 lobe (1: the clamped cosine). A research tool: slow
-(numpy), not part of the method.
+one bounce). --band2 scales the lookup's band-2 lobe (1: the clamped cosine). It first prints what a
+lit floor would read of its own light with six directional bins instead (`six_bin_self_reading`). A
+research tool: slow (numpy), not part of the method.
 """
 
 from __future__ import annotations
@@ -36,6 +37,24 @@ def operators():
     mats = {(a, s): np.einsum("k,ki,kj->ij", np.maximum(0.0, s * dirs[:, a]) * inv_l1 * weights, basis, basis)
             for a, s in AXES}
     return mats, np.einsum("k,ki,kj->ij", inv_l1 * weights, basis, basis)
+
+
+def six_bin_self_reading() -> tuple[np.ndarray, float]:
+    """Six directional bins (the improved transport's sectors, weights max(0, w.d) / |w|_1, each bin's
+    light spread over its sector by those weights): the shares of a floor's cosine lobe per bin, and
+    what the floor reads of its own light as arriving (light travelling down), over its front reading."""
+    from addon.engine import sh
+
+    dirs, weights = sh.sphere_quadrature(512, 1024)
+    sectors = [np.maximum(0.0, s * dirs[:, a]) / np.abs(dirs).sum(axis=1) for a, s in AXES]
+    own = np.maximum(0.0, dirs[:, 2]) / np.pi  # the floor's Lambertian lobe, unit flux
+    shares = np.array([np.sum(own * p * weights) for p in sectors])
+    back = front = 0.0
+    for share, p in zip(shares, sectors, strict=True):
+        shape = p / np.sum(p * weights)
+        back += share * np.sum(shape * np.maximum(0.0, -dirs[:, 2]) * weights)
+        front += share * np.sum(shape * np.maximum(0.0, dirs[:, 2]) * weights)
+    return shares, back / front
 
 
 def shifted(v: np.ndarray, axis: int, sign: float) -> np.ndarray:
@@ -159,6 +178,9 @@ def main() -> int:
 
     from addon.bridge import bench
 
+    shares, ratio = six_bin_self_reading()
+    print(f"six directional bins: a floor's cosine lobe per bin (+x -x +y -y +z -z) {np.round(shares, 3)}; it "
+          f"reads {ratio:.1%} of its own front reading as arriving\n")
     mats, path = operators()
     found, skipped = bench.resolve_scenes(args.scenes.split(","), bench.Options().shared_scenes)
     print(f"rel_rmse_8 / bias vs Cycles ({args.spp} spp, {args.res} px), one 32-cell grid, band-2 lookup x "
