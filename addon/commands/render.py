@@ -31,6 +31,8 @@ def add_arguments(p) -> None:
                    help="LPV geometry volume: a surface blocks the transfers on its side of its cell (default on)")
     p.add_argument("--far-field", action=argparse.BooleanOptionalAction, default=True,
                    help="LPV: run the near steps on the grid, the rest on a grid of twice the cell (default on)")
+    p.add_argument("--emitter-classes", action=argparse.BooleanOptionalAction, default=False,
+                   help="LPV: a surface reads no light from surfaces facing its way (six propagations)")
     p.add_argument("--near-steps", type=int, default=0, help="LPV far field: the grid's own steps (0: half its cells)")
     p.add_argument("--cascades", type=int, default=1, help="LPV: nested grids, the finest around the camera")
     p.add_argument("--cell-size", type=float, default=0.0,
@@ -51,7 +53,7 @@ def run(args) -> int:
                     voxel_cells=args.voxel_cells)
     lpv = LpvConfig(grid_cells=args.grid, iterations=args.iterations, variant=args.variant,
                     geometry_volume=args.geometry_volume, surface_offsets=args.surface_offsets,
-                    far_field=args.far_field, near_steps=args.near_steps,
+                    far_field=args.far_field, near_steps=args.near_steps, emitter_classes=args.emitter_classes,
                     cascades=args.cascades, cell_size_m=args.cell_size)
     vct = VctConfig(voxel_cells=args.voxel_cells, diffuse_cones=args.cones, step_ratio=args.step_ratio,
                     offset_cells=args.cone_offset, radiance=args.radiance, gather_scale=args.gather_scale)

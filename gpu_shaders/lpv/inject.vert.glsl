@@ -6,8 +6,13 @@
 // and points outside the grid are clipped. Not half a cell: Grid.fit centres the bounds' walls in their
 // cells, so half a cell put their VPLs exactly on a border where fp32 rounding picked the cell, and the
 // image changed by 45 % with the scene's scale.
+// EMITTER_CLASSES: the atlas holds the grid six times over, one block per emitter class (the normal's
+// dominant signed axis, lpv/emitter_class.glsl); the VPL goes into its class's block.
 #include "common/atlas.glsl"
 #include "common/sh.glsl"
+#ifdef EMITTER_CLASSES
+#include "lpv/emitter_class.glsl"
+#endif
 
 void main() {
     ivec2 t = ivec2(texel);
@@ -15,7 +20,12 @@ void main() {
     vec3 n = texelFetch(rsm_normal, t, 0).xyz;
     vec3 phi = texelFetch(rsm_flux, t, 0).rgb;
     vec3 g = (pos.xyz + (0.6 * cell_size) * n - grid_origin) / cell_size;
-    gl_Position = atlas_splat_position(ivec3(floor(g)), pos.w != 0.0, atlas_size);
+#ifdef EMITTER_CLASSES
+    int layer0 = emitter_class(n) * dims.z;
+#else
+    int layer0 = 0;
+#endif
+    gl_Position = atlas_splat_position_at(ivec3(floor(g)), layer0, pos.w != 0.0, atlas_size);
     vec4 lobe = sh_cosine_lobe(n) * (1.0 / SH_A0);
     v_r = phi.r * lobe;
     v_g = phi.g * lobe;

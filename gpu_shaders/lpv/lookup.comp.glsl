@@ -11,7 +11,15 @@
 // blended towards this one's with weight w = clamp((d - band_start) / band_cells, 0, 1), d the distance
 // in cells from the sample point to the nearest interior face (lpv_cascade.blend_weight is the twin).
 // The weights of a chain of cascades sum to 1, so no light is counted twice.
+// Emitter classes (docs/LPV.md, "Emitter classes"): EMITTER_PASS runs once per class with that class's
+// light alone in acc_*, and writes the signed lobe reading (before the clamp and the units) into
+// own_light at the pixels whose normal is of class `emitter`; OWN_LIGHT then reads the total and
+// subtracts own_light before the clamp, so a surface reads every class but its own. The reading is
+// linear in acc, so total - own is the reading of the other classes' sum.
 #include "common/sh.glsl"
+#ifdef EMITTER_PASS
+#include "lpv/emitter_class.glsl"
+#endif
 
 vec4 lobe_dot(ivec3 c, vec4 lobe) {
     return vec4(dot(texelFetch(acc_r, c, 0), lobe), dot(texelFetch(acc_g, c, 0), lobe),
@@ -20,15 +28,26 @@ vec4 lobe_dot(ivec3 c, vec4 lobe) {
 
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+#ifdef EMITTER_PASS
+    if (any(greaterThanEqual(px, imageSize(own_light)))) {
+#else
     if (any(greaterThanEqual(px, imageSize(indirect)))) {
+#endif
         return;
     }
     vec4 pos = texelFetch(gbuf_position, px, 0);
+#ifdef EMITTER_PASS
+    vec3 n = normalize(texelFetch(gbuf_normal, px, 0).xyz);
+    if (pos.w == 0.0 || emitter_class(n) != emitter) {
+        return;  // another pass's pixel; background pixels are never read
+    }
+#else
     if (pos.w == 0.0) {
         imageStore(indirect, px, vec4(0.0));
         return;
     }
     vec3 n = normalize(texelFetch(gbuf_normal, px, 0).xyz);
+#endif
     vec3 g = (pos.xyz + (lookup_offset_cells * cell_size) * n - grid_origin) / cell_size;
 #ifdef CASCADE
     vec3 d_lo = mix(vec3(1e30), g, bvec3(interior_lo));
@@ -60,14 +79,19 @@ void main() {
         w_aware += w * through;
     }
     // Every corner blocked (inside a solid): plain trilinear.
-    vec4 s = w_aware > 1e-4 ? sum_aware / w_aware : sum_plain;
-    vec3 e = max(s.rgb, vec3(0.0));
+    vec3 s = (w_aware > 1e-4 ? sum_aware / w_aware : sum_plain).rgb;
 #else
     vec3 uvw = g / vec3(dims);  // texel centres at (i + 0.5) / dims: linear filtering is trilinear SH
-    vec3 e = vec3(max(dot(texture(acc_r, uvw), lobe), 0.0),
-                  max(dot(texture(acc_g, uvw), lobe), 0.0),
-                  max(dot(texture(acc_b, uvw), lobe), 0.0));
+    vec3 s = vec3(dot(texture(acc_r, uvw), lobe), dot(texture(acc_g, uvw), lobe), dot(texture(acc_b, uvw), lobe));
 #endif
+#ifdef EMITTER_PASS
+    imageStore(own_light, px, vec4(s, 1.0));
+    return;
+#else
+#ifdef OWN_LIGHT
+    s -= texelFetch(own_light, px, 0).rgb;
+#endif
+    vec3 e = max(s, vec3(0.0));
     vec3 out_e = e / (cell_size * cell_size * SH_A0);
 #ifdef ACCUMULATE
     // One bounce's volume added to the earlier bounces' image: each bounce is clamped on its own, so a
@@ -78,4 +102,5 @@ void main() {
     out_e = mix(imageLoad(indirect, px).rgb, out_e, w_cascade);
 #endif
     imageStore(indirect, px, vec4(out_e, 1.0));
+#endif
 }

@@ -22,7 +22,11 @@ propagates on its own after lpv_cascade.inflow has added the light entering it f
 lookups run coarsest first, each finer one blended in across its band. With LpvConfig.far_field (improved,
 >= 32 cells) the coarsest grid runs only its near steps and a far-field grid of twice its cell
 (lpv_far_field: its own voxels and injection; later bounces' sources summed from the fine grid's) carries
-the light further; its accumulation is added to the fine one. Products: direct, indirect, albedo.
+the light further; its accumulation is added to the fine one. With emitter classes (LpvConfig.
+emitter_classes, improved, one cascade: `uses_emitter_classes`) the atlases hold one block per class of
+VPL normal, each class is unpacked and propagated on its own into `class_accumulated` and added to the
+total, and lpv_lookup.own records each pixel's own class's reading, which the lookup subtracts from the
+total's (first bounce; later bounces re-inject and look up the total). Products: direct, indirect, albedo.
 """
 
 from __future__ import annotations
@@ -67,6 +71,12 @@ def near_steps_for(config: LpvConfig, grid: Grid) -> int:
     return near if near < iterations_for(config, grid) else 0
 
 
+def uses_emitter_classes(config: LpvConfig) -> bool:
+    """Emitter classes apply to the improved variant with one cascade (a finer cascade's inflow would need
+    its parent's light per class)."""
+    return config.emitter_classes and config.variant == "improved" and config.cascades == 1
+
+
 class LpvVolume:
     """One grid's textures: snapshot sets (0 = the injection, kept for a finer cascade's inflow; 1 and 2
     ping-pong), the accumulation, the injection atlas, when asked for the voxels, and its far-field grid
@@ -82,7 +92,11 @@ class LpvVolume:
         dims = self.grid.dims
         self.snapshots = [{f"sh_{c}": be.texture(dims) for c in "rgb"} for _ in range(3)]
         self.accumulated = {f"acc_{c}": be.texture(dims) for c in "rgb"}
-        self.atlas, self.inject_atlas, self.inject_target = lpv_inject.atlas_target(be, self.grid)
+        classes = uses_emitter_classes(method.lpv_config)
+        self.atlas, self.inject_atlas, self.inject_target = lpv_inject.atlas_target(be, self.grid, classes)
+        # One emitter class's light (the far field adds its own into it; it needs none of its own).
+        self.class_accumulated = ({f"acc_{c}": be.texture(dims) for c in "rgb"}
+                                  if classes and not is_far_field else None)
         # One bounce's accumulation (the total is `accumulated`): what the next bounce re-injects.
         self.bounce_accumulated = ({f"acc_{c}": be.texture(dims) for c in "rgb"}
                                    if method.gi.bounces > 1 and not is_far_field else None)
@@ -157,13 +171,16 @@ class LpvMethod(OneBounceMethod):
         res = self.rsm_config.resolution
         self._reduce = rsm_reduce.factor_for(res, self.lpv_config.grid_cells)
         self._vpls = rsm_reduce.textures(self.backend, res, self._reduce) if self._reduce > 1 else None
-        self._points = atlas.texel_points(self.backend, res // self._reduce, lpv_inject.SPEC)
+        self._classes = uses_emitter_classes(self.lpv_config)
+        self._points = atlas.texel_points(self.backend, res // self._reduce, lpv_inject.spec(self._classes))
 
     def allocate_products(self, size: tuple[int, int]) -> None:
         super().allocate_products(size)
         # A later bounce's lookup over cascades, before it is added to `indirect` (add_bounces).
         several = self.lpv_config.cascades > 1 and self.gi.bounces > 1
         self._bounce_image = self.backend.texture(size) if several else None
+        # Emitter classes: each pixel's reading of its own class's light (lpv_lookup.own).
+        self._own_light = self.backend.texture(size) if uses_emitter_classes(self.lpv_config) else None
 
     def follow_camera(self) -> None:
         """Re-place the finer cascades where the camera has moved to another parent cell."""
@@ -193,7 +210,8 @@ class LpvMethod(OneBounceMethod):
                 rsm_reduce.run(self.backend, self.rsm, self._vpls, self._reduce)
                 vpls = self._vpls
             for level in self.grids():
-                lpv_inject.run(self.backend, level.inject_target, self._points, vpls, level.grid, level.atlas)
+                lpv_inject.run(self.backend, level.inject_target, self._points, vpls, level.grid, level.atlas,
+                               self._classes)
 
     def propagate(self, iterations: int | None = None, accumulated: dict | None = None,
                   level: LpvVolume | None = None) -> None:
@@ -269,8 +287,52 @@ class LpvMethod(OneBounceMethod):
                            vox_normal=self.lookup_vox(level),
                            cascade=level.cascade if i + 1 < len(self.levels) else None)
 
-    def compute(self, run_gbuffer: bool = True) -> dict[str, float]:
+    def propagate_levels(self, timings: dict[str, float]) -> None:
+        """The first bounce without emitter classes: every grid's injection unpacked and propagated into
+        its `accumulated`."""
         be = self.backend
+        # Coarsest first: a finer cascade's inflow reads its parent's propagated light.
+        for i in reversed(range(len(self.levels))):
+            level = self.levels[i]
+            with self.timed(timings, "lpv_inject"):
+                lpv_inject.unpack(be, level.inject_atlas, level.snapshots[0], level.grid, level.atlas)
+                if level.far is not None:
+                    far = level.far
+                    lpv_inject.unpack(be, far.inject_atlas, far.snapshots[0], far.grid, far.atlas)
+                if i + 1 < len(self.levels):
+                    parent = self.levels[i + 1]
+                    lpv_cascade.inflow(be, level.cascade, level.snapshots[0], parent.grid, parent.accumulated,
+                                       parent.snapshots[0], self.lpv_config.variant)
+            with self.timed(timings, "lpv_propagate"):
+                if len(self.levels) > 1:
+                    with self.timed(timings, f"lpv_propagate_cascade{i}"):
+                        self.propagate(level=level)
+                else:
+                    self.propagate(level=level)
+
+    def propagate_classes(self, timings: dict[str, float]) -> None:
+        """The first bounce with emitter classes (one grid, and its far field if any): each class
+        unpacked, propagated into `class_accumulated`, added to `accumulated`, and its reading at the
+        pixels of that class recorded; then the lookup reads the total less each pixel's own class."""
+        be, level = self.backend, self.levels[0]
+        zero.layers(be, list(level.accumulated.values()), 0, level.grid.dims[2])
+        for emitter in range(lpv_inject.CLASSES):
+            with self.timed(timings, "lpv_inject"):
+                lpv_inject.unpack(be, level.inject_atlas, level.snapshots[0], level.grid, level.atlas, emitter)
+                if level.far is not None:
+                    far = level.far
+                    lpv_inject.unpack(be, far.inject_atlas, far.snapshots[0], far.grid, far.atlas, emitter)
+            with self.timed(timings, "lpv_propagate"):
+                self.propagate(accumulated=level.class_accumulated, level=level)
+                lpv_reinject.add(be, level.class_accumulated, level.accumulated, level.grid)
+            with self.timed(timings, "lpv_lookup"):
+                lpv_lookup.own(be, self.gbuf, level.class_accumulated, self._own_light, level.grid, emitter,
+                               vox_normal=self.lookup_vox(level))
+        with self.timed(timings, "lpv_lookup"):
+            lpv_lookup.run(be, self.gbuf, level.accumulated, self.indirect, level.grid,
+                           vox_normal=self.lookup_vox(level), own_light=self._own_light)
+
+    def compute(self, run_gbuffer: bool = True) -> dict[str, float]:
         timings: dict[str, float] = {}
         with self.timed(timings, "total"):
             if len(self.levels) > 1:
@@ -279,25 +341,11 @@ class LpvMethod(OneBounceMethod):
             inner = super().compute(run_gbuffer)
             inner.pop("total", None)
             timings.update(inner)
-            # Coarsest first: a finer cascade's inflow reads its parent's propagated light.
-            for i in reversed(range(len(self.levels))):
-                level = self.levels[i]
-                with self.timed(timings, "lpv_inject"):
-                    lpv_inject.unpack(be, level.inject_atlas, level.snapshots[0], level.grid, level.atlas)
-                    if level.far is not None:
-                        far = level.far
-                        lpv_inject.unpack(be, far.inject_atlas, far.snapshots[0], far.grid, far.atlas)
-                    if i + 1 < len(self.levels):
-                        parent = self.levels[i + 1]
-                        lpv_cascade.inflow(be, level.cascade, level.snapshots[0], parent.grid, parent.accumulated,
-                                           parent.snapshots[0], self.lpv_config.variant)
-                with self.timed(timings, "lpv_propagate"):
-                    if len(self.levels) > 1:
-                        with self.timed(timings, f"lpv_propagate_cascade{i}"):
-                            self.propagate(level=level)
-                    else:
-                        self.propagate(level=level)
-            with self.timed(timings, "lpv_lookup"):
-                self.look_up(lambda level: level.accumulated, self.indirect)
+            if self._own_light is not None:
+                self.propagate_classes(timings)
+            else:
+                self.propagate_levels(timings)
+                with self.timed(timings, "lpv_lookup"):
+                    self.look_up(lambda level: level.accumulated, self.indirect)
             self.add_bounces(timings)
         return timings

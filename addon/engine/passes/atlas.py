@@ -24,8 +24,10 @@ class Atlas:
     size: tuple[int, int]
 
     @classmethod
-    def for_grid(cls, grid: Grid) -> Atlas:
+    def for_grid(cls, grid: Grid, blocks: int = 1) -> Atlas:
+        """The grid's z-layers `blocks` times over (block b's layer z is layer b * nz + z)."""
         nx, ny, nz = grid.dims
+        nz *= blocks
         tiles_x = math.ceil(math.sqrt(nz))
         return cls(tiles_x, (tiles_x * nx, math.ceil(nz / tiles_x) * ny))
 

@@ -12,6 +12,10 @@ at it (docs/LPV.md, "Geometry-aware lookup"). With `cascade` (a finer LPV cascad
 `indirect` holds the parent cascades' answer and is blended towards this grid's across the transition
 band inside its interior faces (lpv_cascade.blend_weight); run coarsest first. A later bounce over
 cascades is looked up that way into an image of its own, then `add_image` adds it to `indirect`.
+
+Emitter classes (one cascade; docs/LPV.md, "Emitter classes"): `own` runs once per class with that
+class's light alone, writing the signed reading at the pixels of that class into `own_light` (RGBA32F,
+camera size); `run` with own_light then subtracts it from the total's reading before the clamp.
 """
 
 from __future__ import annotations
@@ -22,10 +26,13 @@ from . import lpv_cascade
 from .lpv_cascade import Cascade
 
 
-def _spec(accumulate: bool, geometry_volume: bool, cascade: bool) -> ShaderSpec:
+def _spec(accumulate: bool, geometry_volume: bool, cascade: bool, own: str = "") -> ShaderSpec:
+    """own: "" (plain), "pass" (one emitter class's reading -> own_light) or "subtract" (the total's
+    reading minus own_light)."""
     defines = (("ACCUMULATE", "1"),) if accumulate else ()
     extra = ()
     uniforms = ()
+    image = Image("indirect", "2D", "RGBA32F", "read_write" if accumulate or cascade else "write")
     if geometry_volume:
         defines += (("GEOMETRY_VOLUME", "1"),)
         extra = (Sampler("vox_normal", "3D"),)
@@ -33,14 +40,21 @@ def _spec(accumulate: bool, geometry_volume: bool, cascade: bool) -> ShaderSpec:
         defines += (("CASCADE", "1"),)
         uniforms = (Var("interior_lo", "ivec3"), Var("interior_hi", "ivec3"), Var("band_start", "float"),
                     Var("band_cells", "float"))
+    if own == "pass":
+        defines += (("EMITTER_PASS", "1"),)
+        uniforms = (Var("emitter", "int"),)
+        image = Image("own_light", "2D", "RGBA32F", "write")
+    elif own == "subtract":
+        defines += (("OWN_LIGHT", "1"),)
+        extra += (Sampler("own_light", "2D"),)
     return ShaderSpec(
         name=("lpv_lookup_add" if accumulate else "lpv_lookup") + ("_gv" if geometry_volume else "")
-        + ("_cascade" if cascade else ""),
+        + ("_cascade" if cascade else "") + (f"_own_{own}" if own else ""),
         compute="lpv/lookup.comp.glsl",
         local_size=(8, 8, 1),
         samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("acc_r", "3D"),
                   Sampler("acc_g", "3D"), Sampler("acc_b", "3D")) + extra,
-        images=(Image("indirect", "2D", "RGBA32F", "read_write" if accumulate or cascade else "write"),),
+        images=(image,),
         uniforms=(Var("grid_origin", "vec3"), Var("cell_size", "float"), Var("dims", "ivec3"),
                   Var("lookup_offset_cells", "float")) + uniforms,
         defines=defines,
@@ -49,6 +63,7 @@ def _spec(accumulate: bool, geometry_volume: bool, cascade: bool) -> ShaderSpec:
 
 SPECS = {(acc, gv, cas): _spec(acc, gv, cas) for acc in (False, True) for gv in (False, True)
          for cas in (False, True) if not (acc and cas)}
+OWN_SPECS = {(own, gv): _spec(False, gv, False, own) for own in ("pass", "subtract") for gv in (False, True)}
 
 # A later bounce over cascades: `accumulate` cannot blend (the parent's share of this bounce would stay
 # in full under the finer cascade's), so the bounce is looked up into its own image and added.
@@ -62,14 +77,20 @@ ADD_IMAGE = ShaderSpec(
 
 
 def run(backend: Backend, gbuf: dict, acc: dict, indirect, grid: Grid, offset_cells: float = 0.5,
-        accumulate: bool = False, vox_normal=None, cascade: Cascade | None = None) -> None:
+        accumulate: bool = False, vox_normal=None, cascade: Cascade | None = None, own_light=None) -> None:
     """Write `indirect` from `acc`, or with `accumulate` add to it (one later bounce's volume), or with
     `cascade` (whose grid is `grid`) blend it in across its band; with `vox_normal` (the geometry volume)
-    the trilinear corners are weighted by their transmittance."""
-    spec = SPECS[(accumulate, vox_normal is not None, cascade is not None)]
+    the trilinear corners are weighted by their transmittance; with `own_light` (written by `own` for
+    every class; not with accumulate or cascade) each pixel's own class's reading is subtracted."""
+    if own_light is not None:
+        spec = OWN_SPECS[("subtract", vox_normal is not None)]
+    else:
+        spec = SPECS[(accumulate, vox_normal is not None, cascade is not None)]
     samplers = {"gbuf_position": gbuf["position"], "gbuf_normal": gbuf["normal"], **acc}
     if vox_normal is not None:
         samplers["vox_normal"] = vox_normal
+    if own_light is not None:
+        samplers["own_light"] = own_light
     uniforms = {"grid_origin": grid.origin_m, "cell_size": grid.cell_size_m, "dims": grid.dims,
                 "lookup_offset_cells": offset_cells}
     if cascade is not None:
@@ -77,6 +98,20 @@ def run(backend: Backend, gbuf: dict, acc: dict, indirect, grid: Grid, offset_ce
                         band_start=lpv_cascade.BAND_START_CELLS, band_cells=lpv_cascade.BAND_CELLS)
     backend.dispatch(backend.program(spec), group_count(indirect.size, spec.local_size), uniforms=uniforms,
                      samplers=samplers, images={"indirect": indirect})
+
+
+def own(backend: Backend, gbuf: dict, acc: dict, own_light, grid: Grid, emitter: int, offset_cells: float = 0.5,
+        vox_normal=None) -> None:
+    """own_light at the pixels whose normal is of class `emitter` := the signed reading of `acc` (that
+    class's light alone), as `run` reads it before the clamp; other pixels are left as they are."""
+    spec = OWN_SPECS[("pass", vox_normal is not None)]
+    samplers = {"gbuf_position": gbuf["position"], "gbuf_normal": gbuf["normal"], **acc}
+    if vox_normal is not None:
+        samplers["vox_normal"] = vox_normal
+    backend.dispatch(backend.program(spec), group_count(own_light.size, spec.local_size),
+                     uniforms={"grid_origin": grid.origin_m, "cell_size": grid.cell_size_m, "dims": grid.dims,
+                               "lookup_offset_cells": offset_cells, "emitter": emitter},
+                     samplers=samplers, images={"own_light": own_light})
 
 
 def add_image(backend: Backend, bounce_image, indirect) -> None:
