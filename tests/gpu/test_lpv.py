@@ -743,10 +743,11 @@ def corner_scene():
                  np.zeros((len(tris), 3), np.float32), [light], camera=cam)
 
 
-@pytest.mark.parametrize("variant", ["classic", "improved"])
-def test_method_output_is_finite_and_non_negative(gl, variant):
-    method = LpvMethod(gl, GIConfig(method="lpv"), RsmConfig(resolution=64),
-                       LpvConfig(grid_cells=12, variant=variant, geometry_volume=True))
+@pytest.mark.parametrize("variant, classes, bounces", [("classic", False, 1), ("improved", False, 1),
+                                                       ("improved", True, 1), ("improved", True, 2)])
+def test_method_output_is_finite_and_non_negative(gl, variant, classes, bounces):
+    method = LpvMethod(gl, GIConfig(method="lpv", bounces=bounces), RsmConfig(resolution=64),
+                       LpvConfig(grid_cells=12, variant=variant, geometry_volume=True, emitter_classes=classes))
     method.set_scene(corner_scene())
     result = method.run()
     ind = result.images["indirect"][..., :3]
