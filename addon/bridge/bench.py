@@ -39,13 +39,14 @@ SETTINGS: dict[str, tuple[dict, ...]] = {
     "rsm": ({"rsm.vpl_samples": 64}, {"rsm.vpl_samples": 256}, {"rsm.vpl_samples": 1024},
             {"rsm.vpl_samples": 256, "rsm.visibility": "voxel"}),
     # The published scheme as the baseline row, the improved transport at the three grids, and
-    # at 32 without surface offsets (each cell's blocking split half and half) and on one grid (no far
-    # field), docs/LPV.md.
+    # at 32 without surface offsets (each cell's blocking split half and half), on one grid (no far
+    # field) and with emitter classes, docs/LPV.md.
     "lpv": ({"lpv.variant": "classic", "lpv.geometry_volume": True},
             {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.grid_cells": 16},
             {"lpv.variant": "improved", "lpv.geometry_volume": True},
             {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.surface_offsets": False},
             {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.far_field": False},
+            {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.emitter_classes": True},
             {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.grid_cells": 64}),
     # The two grid sizes at the defaults (16 cones, docs/VCT.md), and the half-resolution gather.
     "vct": ({"vct.voxel_cells": 64}, {"vct.voxel_cells": 64, "vct.gather_scale": 2}, {"vct.voxel_cells": 128}),
