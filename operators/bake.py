@@ -85,10 +85,10 @@ class BOUNCE_OT_bake(bpy.types.Operator):
         self._objects = sorted((o for o in context.selected_objects), key=lambda o: o.name)
         self._next, self._done, self._failed = 0, 0, []
         try:
-            gi, rsm, _lpv, _vct = to_config(context.scene.bounce)  # bake.Baker takes neither yet: defaults
+            gi, rsm, lpv, vct = to_config(context.scene.bounce)
             if self.pass_name != "direct" and gi.method == "direct":
                 raise BounceError(f"pass {self.pass_name} needs an indirect method: set Bounce > GI > Method to rsm")
-            self._baker = bake.Baker(_backend(), context.evaluated_depsgraph_get(), gi, rsm, self.size)
+            self._baker = bake.Baker(_backend(), context.evaluated_depsgraph_get(), gi, rsm, self.size, lpv, vct)
         except BounceError as exc:
             self.report({"ERROR"}, str(exc))
             return False

@@ -1,7 +1,7 @@
 """Bounce's bake against Cycles' bake curve: texel-space error vs time, and the Cycles-equivalent
 speed-up (time Cycles' bake needs to reach our rel_rmse_8 / our bake time), on the Cornell box.
 
-    .venv/bin/python tools/bake_speedup.py [--size 64] [--method rsm|lpv|vct] > table.md
+    .venv/bin/python tools/bake_speedup.py [--size 64] [--method rsm|lpv|vct] [--emitter-classes] > table.md
 
 Reference: a Cycles bake at --ref-spp (seed 0); Cycles' curve: bakes at increasing spp with seed 1;
 Bounce: --method (rsm with voxel visibility by default; lpv and vct at their defaults), per object
@@ -27,6 +27,7 @@ def main() -> int:
     ap.add_argument("--size", type=int, default=64)
     ap.add_argument("--ref-spp", type=int, default=1024)
     ap.add_argument("--method", default="rsm", choices=("rsm", "lpv", "vct"))
+    ap.add_argument("--emitter-classes", action="store_true", help="lpv: LpvConfig.emitter_classes")
     args = ap.parse_args()
 
     import bpy
@@ -35,7 +36,7 @@ def main() -> int:
     from addon.bridge.bake import bake_file
     from addon.bridge.reference import cycles_bake
     from addon.engine import metrics
-    from addon.engine.config import GIConfig, RsmConfig
+    from addon.engine.config import GIConfig, LpvConfig, RsmConfig
 
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -43,7 +44,7 @@ def main() -> int:
         scenes.save("cornell", blend)
         rsm = RsmConfig(visibility="voxel") if args.method == "rsm" else RsmConfig()
         summary = bake_file(blend, Path(tmp) / "ours", list(OBJECTS), args.size, GIConfig(method=args.method),
-                            rsm, "indirect", progress=False)
+                            rsm, "indirect", progress=False, lpv=LpvConfig(emitter_classes=args.emitter_classes))
         bpy.ops.wm.open_mainfile(filepath=str(blend))
         for name in OBJECTS:
             ours = images.read_exr(Path(tmp) / "ours" / f"{name}_indirect.exr")
@@ -62,8 +63,9 @@ def main() -> int:
                         f"(+ {summary['setup_ms']:.0f} ms setup per file) | "
                         + ", ".join(f"{c['spp']} spp {c['time_s']:.2f} s / {c['rel_rmse_8']:.3f}" for c in curve)
                         + f" | {bound}{up['speedup']:.2f}x |")
-    print(f"Cornell box, indirect, method {args.method}, {args.size} x {args.size} texels; reference: Cycles bake "
-          f"{args.ref_spp} spp.\n")
+    classes = ", emitter classes" if args.emitter_classes and args.method == "lpv" else ""
+    print(f"Cornell box, indirect, method {args.method}{classes}, {args.size} x {args.size} texels; reference: "
+          f"Cycles bake {args.ref_spp} spp.\n")
     print("| object | rel_rmse_8 | bias | Bounce bake | Cycles bake: spp, time / rel_rmse_8 | speed-up |")
     print("| --- | --- | --- | --- | --- | --- |")
     print("\n".join(rows))

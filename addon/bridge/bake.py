@@ -165,7 +165,8 @@ def _default_camera(size: int) -> Camera:
 class Baker:
     """The scene captured and uploaded once; then bake_image / bake_vertex_colors per object."""
 
-    def __init__(self, backend, depsgraph, gi: GIConfig, rsm: RsmConfig, size: int = 512):
+    def __init__(self, backend, depsgraph, gi: GIConfig, rsm: RsmConfig, size: int = 512, lpv=None, vct=None):
+        """lpv, vct: the LpvConfig / VctConfig of those methods (their defaults when None)."""
         t0 = time.perf_counter()
         define_light_switch()
         self.depsgraph = depsgraph
@@ -173,7 +174,7 @@ class Baker:
         if scene.camera is None:
             scene.camera = _default_camera(size)  # only the G-buffer size is taken from it
         self.scene = scene
-        self.method = methods.get(gi.method)(backend, gi, rsm)
+        self.method = methods.create(backend, gi, rsm, lpv, vct)
         self.method.set_scene(scene)
         self.texels = TexelBaker(self.method)
         self.setup_ms = (time.perf_counter() - t0) * 1e3
@@ -278,9 +279,11 @@ def select_objects(names: list[str] | None, shard_index: int = 0, shard_count: i
 def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size: int = 512,
               gi: GIConfig | None = None, rsm: RsmConfig | None = None, pass_name: str = "indirect",
               target: str = "image", overwrite: bool = False, shard_index: int = 0, shard_count: int = 1,
-              save_blend: Path | None = None, margin: int = 16, progress: bool = True, backend=None) -> dict:
+              save_blend: Path | None = None, margin: int = 16, progress: bool = True, backend=None,
+              lpv=None, vct=None) -> dict:
     """Bake the objects of `blend` (see module docstring) into out_dir; returns the summary written to
-    out_dir/bake.json. Per-object problems are recorded, never raised; bad arguments raise BounceError."""
+    out_dir/bake.json. Per-object problems are recorded, never raised; bad arguments raise BounceError.
+    lpv, vct: the configs of those methods (defaults when None)."""
     from .pipeline import backend as default_backend
     from .pipeline import open_blend
 
@@ -301,7 +304,7 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
         raise SceneError(f"{blend}: no objects to bake" + (" in this shard" if shard_count > 1 else ""))
     t0 = time.perf_counter()
     be = backend or default_backend()
-    baker = Baker(be, bpy.context.evaluated_depsgraph_get(), gi, rsm, size)
+    baker = Baker(be, bpy.context.evaluated_depsgraph_get(), gi, rsm, size, lpv, vct)
     results: list[ObjectResult] = []
     taken: set[str] = set()
     from tqdm import tqdm

@@ -4,10 +4,11 @@ and DIR/bake.json lists them: one run bakes a whole set of .blend files (a farm 
 
 from __future__ import annotations
 
+import argparse
 import json
 from pathlib import Path
 
-from ..engine.config import GIConfig, LpvConfig, RsmConfig
+from ..engine.config import GIConfig, LpvConfig, RsmConfig, VctConfig
 from ..engine.errors import SceneError
 from ..engine.lightmap import PASSES, TARGETS, check_choice, parse_shard, safe_name
 from ._args import existing_blend
@@ -35,8 +36,10 @@ def add_arguments(p) -> None:
     p.add_argument("--visibility", default="voxel", help="VPL visibility for rsm: none or voxel")
     p.add_argument("--voxel-cells", type=int, default=64, help="voxel cells along the longest side")
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--grid", type=int, default=32, help="LPV cells along the longest side (volume)")
-    p.add_argument("--variant", default="improved", help="LPV transport for volumes: classic or improved")
+    p.add_argument("--grid", type=int, default=32, help="LPV cells along the longest side (lpv)")
+    p.add_argument("--variant", default="improved", help="LPV transport: classic or improved (lpv)")
+    p.add_argument("--emitter-classes", action=argparse.BooleanOptionalAction, default=False,
+                   help="LPV: a surface reads no light from surfaces facing its way (six propagations)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -62,8 +65,10 @@ def run(args) -> int:
     from ..bridge.bake import bake_file, bake_volume  # imports bpy: only when actually baking
 
     out = Path(args.out)
+    lpv = LpvConfig(grid_cells=args.grid, variant=args.variant, geometry_volume=True,
+                    emitter_classes=args.emitter_classes)
+    vct = VctConfig(voxel_cells=args.voxel_cells)
     if args.target == "volume":
-        lpv = LpvConfig(grid_cells=args.grid, variant=args.variant, geometry_volume=True)
         gi = GIConfig(method="lpv", seed=args.seed)
         for blend in blends:
             bake_volume(blend, out, gi, rsm, lpv, args.overwrite)
@@ -76,7 +81,7 @@ def run(args) -> int:
             out.mkdir(parents=True, exist_ok=True)
         summary = bake_file(blend, file_out, objects, args.size, gi, rsm, args.pass_name, args.target,
                             args.overwrite, index, count, Path(args.save_blend) if args.save_blend else None,
-                            args.margin, progress=not args.quiet)
+                            args.margin, progress=not args.quiet, lpv=lpv, vct=vct)
         files[str(blend)] = str(file_out / "bake.json")
         failed += [f"{blend.name}:{n}" for n, r in summary["objects"].items() if r["status"] == "error"]
     if len(blends) > 1:

@@ -36,6 +36,23 @@ def test_bake_images_of_selected_objects(cornell):
         assert px.reshape(-1, 4)[:, 3].min() == 1.0 and px.reshape(-1, 4)[:, :3].mean() > 0
 
 
+def test_bake_uses_the_scenes_lpv_settings(cornell):
+    # The operator builds the method from the scene's settings, LPV's included (it once took only the
+    # GI and RSM groups): the lit Floor baked with emitter classes reads the walls' light its own
+    # upward light cancels without them (docs/LPV.md, "Emitter classes"), so the two bakes differ.
+    s = cornell.scene.bounce
+    s.gi.method, s.lpv.grid_cells = "lpv", 16
+    select(cornell, "Floor")
+    means = []
+    for classes in (False, True):
+        s.lpv.emitter_classes = classes
+        assert bpy.ops.bounce.bake(size=16, pass_name="indirect", target="image") == {"FINISHED"}
+        px = np.empty(16 * 16 * 4, np.float32)
+        bpy.data.images["Floor_bounce_indirect"].pixels.foreach_get(px)
+        means.append(px.reshape(-1, 4)[:, :3].mean())
+    assert means[1] > 1.2 * means[0] > 0
+
+
 def test_bake_vertex_colors(cornell):
     select(cornell, "Floor")
     # The Floor's corners lie outside the spot's cone: direct is 0 there, the bounce is not.
