@@ -249,6 +249,9 @@ def configs():
                                                                "geometry_volume": True, "far_field": False}, {}),
         ("lpv-improved-gv-64-one-grid", {"method": "lpv"}, {}, {"grid_cells": 64, "variant": "improved",
                                                                "geometry_volume": True, "far_field": False}, {}),
+        # Emitter classes (session 7, off by default): six propagations; docs/LPV.md estimates ~2.7 ms.
+        ("lpv-improved-gv-32-classes", {"method": "lpv"}, {}, {"grid_cells": 32, "variant": "improved",
+                                                              "geometry_volume": True, "emitter_classes": True}, {}),
         ("lpv-classic-32", {"method": "lpv"}, {}, {"grid_cells": 32, "variant": "classic"}, {}),
         ("lpv-improved-gv-32-3cascades", {"method": "lpv"}, {}, {"grid_cells": 32, "variant": "improved",
                                                                 "geometry_volume": True, "cascades": 3}, {}),
