@@ -35,7 +35,8 @@ GROUPS = {
                         "test_million_triangle_floor"],
     "temporal": ["test_light_moving_1mm_per_frame"],
 }
-EMPTY = {"ringing": "No case: ringing belongs to SH-based propagation (LPV), and no such method is built yet."}
+EMPTY = {"ringing": "No case yet: ringing belongs to SH-based propagation (`lpv`, whose readings are clamped at 0; "
+                   "its negative L1 lobes show in the energy and leak cases instead)."}
 GROUP_OF = {test: group for group, tests in GROUPS.items() for test in tests}
 
 

@@ -51,6 +51,22 @@ KNOWN_DEFECTS = {
 }
 
 
+# Known defects of `lpv+classes` (the defaults with LpvConfig.emitter_classes): the five others of the
+# list above pass with classes (a surface no longer reads its own light, nor popping above the bound).
+CLASSES = "lpv with emitter classes: "
+CLASSES_KNOWN_DEFECTS = {
+    "test_camera_inside_closed_block[lpv+classes]": "indirect 0.059 inside a closed block: leaks through one-cell "
+                                                    "walls (as without classes)",
+    "test_white_closed_box_conserves_flux[lpv+classes]": "indirect flux 1.07 P in a closed white box (exact P, "
+                                                         "bound 0.9..1.02; 0.88 P without classes): the walls' "
+                                                         "own light no longer cancels part of what arrives, and "
+                                                         "the L1 transfer's excess at walls shows",
+    "test_light_inside_closed_box_stays_inside[lpv+classes]": "indirect 0.14 x P/(6 pi) outside a closed box "
+                                                              "(0.10 without classes): light leaked through a "
+                                                              "wall facing away read negative there and is now "
+                                                              "left out with the receiver's own class",
+}
+
 # Known defects of `vct` (defaults: 64 cells, 16 cones), measured on llvmpipe, 48 px. A voxel holds
 # both faces of a wall thinner than a cell, and a cone passing near it reads the far face's light.
 VCT = "vct: "
@@ -72,6 +88,9 @@ def pytest_collection_modifyitems(items):
         reason = KNOWN_DEFECTS.get(item.name)
         if reason is not None:
             item.add_marker(pytest.mark.xfail(strict=True, reason=LPV + reason))
+        reason = CLASSES_KNOWN_DEFECTS.get(item.name)
+        if reason is not None:
+            item.add_marker(pytest.mark.xfail(strict=True, reason=CLASSES + reason))
         reason = VCT_KNOWN_DEFECTS.get(item.name)
         if reason is not None:
             item.add_marker(pytest.mark.xfail(strict=True, reason=VCT + reason))

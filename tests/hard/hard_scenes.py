@@ -10,12 +10,13 @@ import numpy as np
 import pytest
 
 from addon.engine import methods
-from addon.engine.config import METHODS, GIConfig, RsmConfig
+from addon.engine.config import METHODS, GIConfig, LpvConfig, RsmConfig
 from addon.engine.scene import Camera, Light, Scene
 from addon.engine.transforms import look_along, perspective
 
 # Every shipped method; a later method joins the suite by joining config.METHODS.
-ALL_METHODS = (*METHODS, "rsm+voxel")  # every method, and rsm with its voxel visibility
+# Every method, rsm with its voxel visibility, and lpv with emitter classes (LpvConfig.emitter_classes).
+ALL_METHODS = (*METHODS, "rsm+voxel", "lpv+classes")
 
 # rsm without visibility lets one bounce through walls: a known property of the method (its
 # `--visibility voxel` option is the fix), marked here once so every leak test says so the same way.
@@ -98,9 +99,12 @@ def sun(direction, strength, color=(1, 1, 1)):
 
 
 def make(gl, name, rsm_res=128, vpl=64):
-    """A method by name; "rsm+voxel" is the rsm method with voxel-traced visibility."""
+    """A method by name; "rsm+voxel" is the rsm method with voxel-traced visibility, "lpv+classes" lpv
+    with emitter classes."""
     method, _, variant = name.partition("+")
     kw = {"resolution": rsm_res, "vpl_samples": vpl}
+    if variant == "classes":
+        return methods.create(gl, GIConfig(method=method), RsmConfig(**kw), LpvConfig(emitter_classes=True))
     if variant:
         kw["visibility"] = variant
     return methods.get(method)(gl, GIConfig(method=method), RsmConfig(**kw))
