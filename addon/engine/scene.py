@@ -38,6 +38,10 @@ class Light:
     size_y_m: float = 0.0
     axis_x: np.ndarray = field(default_factory=lambda: np.array([1.0, 0.0, 0.0]))  # area light's local X
     name: str = ""
+    # An opaque disc of this radius at position_m facing `direction`: the emitter's own surface (emissive
+    # meshes, light_views.emissive_lights). Light the RSM's surfels reflect back towards it does not pass
+    # it (rsm.frag.glsl: their flux times 1 - the disc's view factor); 0 = none.
+    occluder_radius_m: float = 0.0
 
     def __post_init__(self):
         if self.kind not in LIGHT_KINDS:

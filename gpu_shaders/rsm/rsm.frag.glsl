@@ -26,6 +26,20 @@ void main() {
         flux = v_albedo * light_intensity(light_kind, w, emit_axis, light_color_intensity, spot_cos_half, spot_blend) * solid_angle;
         float dist = length(v_pos_ws - light_pos_ws);
         area_m2 = solid_angle * dist * dist / max(-dot(n, w), MIN_COS);
+        if (occluder_radius > 0.0) {
+            // The emitter's own surface, a disc of that radius at the light facing emit_axis, takes the
+            // share of the surfel's reflected light that goes back at it: its view factor from the
+            // surfel (light_views.disc_view_factor; exact for a surfel parallel to it, weighted by how
+            // parallel it is otherwise).
+            vec3 d = v_pos_ws - light_pos_ws;
+            float h = dot(d, emit_axis);
+            float h2 = h * h;
+            float a2 = max(dot(d, d) - h2, 0.0);
+            float r2 = occluder_radius * occluder_radius;
+            float root = sqrt(max((h2 + a2 + r2) * (h2 + a2 + r2) - 4.0 * a2 * r2, 1e-30));
+            float view_factor = 0.5 * (1.0 - (h2 + a2 - r2) / root);
+            flux *= 1.0 - clamp(view_factor * max(-dot(n, emit_axis), 0.0), 0.0, 1.0);
+        }
     }
     out_position = vec4(v_pos_ws, 1.0);
     out_normal = vec4(n, area_m2);

@@ -103,6 +103,46 @@ def test_rsm_method_refuses_several_bounces(gl):
         RsmMethod(gl, GIConfig(method="rsm", bounces=2), RsmConfig())
 
 
+def test_rsm_flux_behind_an_emitter_loses_what_goes_back_at_it(gl):
+    # An emissive panel's back lamp (AREA, 0.28 m disc) 2 cm below a ceiling of albedo 0.8, tilted
+    # planes around: with the occluder every RSM texel's flux is the plain flux times 1 - F(h, a, r) x
+    # cos, F the view factor to the disc (light_views.disc_view_factor) and cos how parallel the surfel
+    # is to it, from the texel's own position and normal; without it, unchanged.
+    from addon.engine.passes.light_views import disc_view_factor
+
+    cam = Camera(look_along([0, -3, 1], [0, 1, 0.2], [0, 0, 1]), perspective(np.radians(50), 0.1, 100), 8, 8)
+    rects = [rect([-2, -2, 2.0], [0, 4, 0], [4, 0, 0]),  # the ceiling, facing down
+             rect([-2, -2, 1.0], [0, 0, 1.5], [0, 4, 0.2])]  # a tilted wall at x = -2
+    faces = {}
+    for radius in (0.0, 0.28):
+        light = Light("AREA", [0, 0, 1.98], [0, 0, 1], [1, 1, 1], power_w=50.0, occluder_radius_m=radius)
+        method = RsmMethod(gl, GIConfig(method="rsm"), RsmConfig(resolution=128))
+        method.set_scene(scene_of(rects, [[0.8] * 3, [0.5] * 3], light, cam))
+        read, per_face = [], method.per_light_view
+
+        def keep_face(view, timings, method=method, read=read, per_face=per_face):
+            per_face(view, timings)
+            read.append([gl.read(method.rsm[k]).astype(np.float64) for k in ("position", "normal", "flux")])
+
+        method.per_light_view = keep_face
+        method.run()
+        faces[radius] = [np.concatenate([f[i].reshape(-1, 4) for f in read]) for i in range(3)]
+    pos, nrm, _ = faces[0.28]
+    flux = {r: f[2][:, :3] for r, f in faces.items()}
+    nrm = nrm[:, :3]
+    hit = pos[:, 3] != 0
+    assert hit.mean() > 0.5
+    d = pos[:, :3] - (np.array([0, 0, 1.98]) - method.origin_m)  # RSM positions are re-centred
+    h = d[:, 2]
+    a = np.sqrt(np.maximum(np.sum(d * d, axis=-1) - h * h, 0.0))
+    cos = np.maximum(-nrm[:, 2], 0.0)  # the RSM's normals face the light
+    keep = 1.0 - np.clip(disc_view_factor(h, a, 0.28) * cos, 0.0, 1.0)
+    assert keep[hit].min() < 0.1 and keep[hit].max() > 0.99  # against the disc, and far from it
+    # fp32 evaluation of the same formula: 1e-5 of the brightest texel.
+    np.testing.assert_allclose(flux[0.28][hit], flux[0.0][hit] * keep[hit][:, None],
+                               atol=1e-5 * flux[0.0].max())
+
+
 def exact_wall_indirect_occluded(y0, z0, albedo, sun, fence_x, fence_h, n=1500):
     """As exact_wall_indirect, with a fence at x = fence_x of height fence_h between wall and floor:
     the segment to floor point (x, y) crosses the fence plane at height z0 * (1 - fence_x / x)."""

@@ -70,11 +70,26 @@ def emissive_lights(positions_m: np.ndarray, emission: np.ndarray, scene_extent_
         power = float(flux.max())
         color = flux / power
         if np.linalg.norm(net) > 0.5 * total_area:
-            lights.append(Light("AREA", position, net, color, power_w=power, name="emissive"))
-            lights.append(Light("AREA", position, -net, color, power_w=power, name="emissive (back)"))
+            # The emitter is opaque: what its light's surfels reflect back at it stops there (a ceiling
+            # 2 cm behind a panel sends most of its light into the panel's back), modelled as a disc of
+            # the group's area (disc_view_factor).
+            radius = float(np.sqrt(total_area / np.pi))
+            lights.append(Light("AREA", position, net, color, power_w=power, name="emissive",
+                                occluder_radius_m=radius))
+            lights.append(Light("AREA", position, -net, color, power_w=power, name="emissive (back)",
+                                occluder_radius_m=radius))
         else:
             lights.append(Light("POINT", position, [0, 0, -1], color, power_w=power, name="emissive"))
     return lights
+
+
+def disc_view_factor(height_m, offset_m, radius_m):
+    """View factor from a small surface element to a disc parallel to it, `height_m` in front of it and
+    `offset_m` off its axis (rsm.frag.glsl's twin): F = (1 - (h^2 + a^2 - r^2) / sqrt((h^2 + a^2 +
+    r^2)^2 - 4 a^2 r^2)) / 2 (r^2 / (h^2 + r^2) on the axis; 1 against the disc, 0 beside it)."""
+    h2, a2, r2 = (np.square(np.asarray(v, np.float64)) for v in (height_m, offset_m, radius_m))
+    root = np.sqrt(np.maximum((h2 + a2 + r2) ** 2 - 4.0 * a2 * r2, 1e-300))
+    return 0.5 * (1.0 - (h2 + a2 - r2) / root)
 
 
 def light_intensity(light: Light) -> np.ndarray:
@@ -117,6 +132,7 @@ def _common_uniforms(light: Light, emit_axis: np.ndarray, texel_scale: float) ->
         "light_color_intensity": light_intensity(light),
         "spot_cos_half": float(np.cos(light.spot_size_rad / 2.0)) if spot else -1.0,
         "spot_blend": float(light.spot_blend) if spot else 0.0,
+        "occluder_radius": float(light.occluder_radius_m),
     }
 
 

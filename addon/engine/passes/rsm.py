@@ -4,7 +4,9 @@ Inputs: scene triangles (pos_ws, normal_ws, albedo), a LightView (light_views.py
 resolution^2, GL row 0 = bottom): position (world, m; w = 1 where geometry), normal (world, facing the
 light), flux (W reflected by the texel's surfel: albedo x I(w) x texel solid angle, or albedo x sun
 irradiance x texel area). The flux sums to the light's reflected power (tested against the analytic
-cone integral).
+cone integral). With Light.occluder_radius_m (an emissive mesh's lamp: the emitter's own surface) the
+flux is reduced by the view factor from the surfel to that disc, light_views.disc_view_factor: what the
+surfel sends back at the emitter stops there.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ SPEC = ShaderSpec(
         Var("face_axis", "vec3"), Var("light_kind", "int"),
         Var("emit_axis", "vec3"), Var("spot_cos_half", "float"),
         Var("light_color_intensity", "vec3"), Var("spot_blend", "float"),
+        Var("occluder_radius", "float"),
     ),
     attributes=(Var("pos_ws", "vec3"), Var("normal_ws", "vec3"), Var("albedo", "vec3")),
     varyings=(Var("v_pos_ws", "vec3"), Var("v_normal_ws", "vec3"), Var("v_albedo", "vec3")),
