@@ -13,13 +13,21 @@
 // phi / pi * cosine_lobe(m) (flux 2 sqrt(pi) c0 = phi, as inject.vert.glsl does for a VPL), split over
 // the neighbours B = A + d by max(0, m.d) / |m|_1 (a partition of unity over the 6 axes: phi is kept).
 // Not in A itself: A's own geometry volume would block half of it on the first step out.
+// Emitter classes (docs/LPV.md): OWN_PASS runs once per class with that class's light alone in acc_*
+// and writes, at the cells whose side n (own_front) or -n (own_back) is of class `emitter`, the signed
+// reading arriving() makes there before its clamp; OWN_LIGHT subtracts those from the total's reading
+// before the clamp, so a surface's re-emission counts no light from surfaces facing its way (a lit
+// floor's own upward light no longer cancels the light arriving at it).
 #include "common/sh.glsl"
+#ifdef OWN_PASS
+#include "lpv/emitter_class.glsl"
+#endif
 
 // E_m * h^2 per colour: the previous bounce's light arriving at cell c's surface on the side facing m.
 // Trilinear at c's centre + m / 2 over the corners that do not block along m (1 - min(1, projected
 // area along m)), renormalised: c's own surface blocks, so c's own light -- mostly what its surface
 // emitted the other way -- is not read as arriving; 0 where every corner blocks (inside a solid).
-vec3 arriving(ivec3 c, vec3 m) {
+vec3 arriving_signed(ivec3 c, vec3 m) {
     vec3 t = vec3(c) + 0.5 * m;  // cell-index space: centres at integers
     ivec3 i0 = ivec3(floor(t));
     vec3 f = t - vec3(i0);
@@ -39,8 +47,15 @@ vec3 arriving(ivec3 c, vec3 m) {
                                     dot(texelFetch(acc_b, q, 0), lobe));
         weight += w * through;
     }
-    return weight > 1e-4 ? max(sum / weight, vec3(0.0)) : vec3(0.0);
+    return weight > 1e-4 ? sum / weight : vec3(0.0);
 }
+
+#ifndef OWN_PASS
+// arriving_signed less `own` (the reading of the surfaces facing the same way), clamped at 0.
+vec3 arriving(ivec3 c, vec3 m, vec3 own) {
+    return max(arriving_signed(c, m) - own, vec3(0.0));
+}
+
 
 // The flux (W, rgb) cell a reflects and the side m it reflects to; zero without a surface: empty cells
 // have w = 0, and opposite faces in one cell cancel to n = 0.
@@ -50,8 +65,15 @@ vec3 reflected(ivec3 a, out vec3 m) {
     if (nv.w <= 0.0 || dot(nv.xyz, nv.xyz) == 0.0) {
         return vec3(0.0);
     }
-    vec3 e_front = arriving(a, nv.xyz);
-    vec3 e_back = arriving(a, -nv.xyz);
+#ifdef OWN_LIGHT
+    vec3 own_f = texelFetch(own_front, a, 0).rgb;
+    vec3 own_b = texelFetch(own_back, a, 0).rgb;
+#else
+    vec3 own_f = vec3(0.0);
+    vec3 own_b = vec3(0.0);
+#endif
+    vec3 e_front = arriving(a, nv.xyz, own_f);
+    vec3 e_back = arriving(a, -nv.xyz, own_b);
     bool front = dot(e_front, vec3(1.0)) >= dot(e_back, vec3(1.0));
     m = front ? nv.xyz : -nv.xyz;
     return texelFetch(vox_albedo, a, 0).rgb * nv.w * (front ? e_front : e_back);
@@ -87,3 +109,21 @@ void main() {
     imageStore(sh_g, b, out_g);
     imageStore(sh_b, b, out_b);
 }
+#else
+void main() {
+    ivec3 a = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(a, dims))) {
+        return;
+    }
+    vec4 nv = texelFetch(vox_normal, a, 0);
+    if (nv.w <= 0.0 || dot(nv.xyz, nv.xyz) == 0.0) {
+        return;  // no surface: never read
+    }
+    if (emitter_class(nv.xyz) == emitter) {
+        imageStore(own_front, a, vec4(arriving_signed(a, nv.xyz), 0.0));
+    }
+    if (emitter_class(-nv.xyz) == emitter) {
+        imageStore(own_back, a, vec4(arriving_signed(a, -nv.xyz), 0.0));
+    }
+}
+#endif

@@ -168,7 +168,8 @@ def test_navigating_gives_preview_then_full_quality(cornell):
 @pytest.mark.parametrize("name", ["direct", "rsm", "lpv", "lpv-far-field", "lpv-emitter-classes", "vct"])
 def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, name):
     # lpv at 16 cells runs one grid; "lpv-far-field" at 32 cells adds the far field's passes;
-    # "lpv-emitter-classes" (16 cells) the classes' injection, unpacks and own-light lookups.
+    # "lpv-emitter-classes" (16 cells, 2 bounces) the classes' injection, unpacks, own-light lookups and
+    # own-class re-injection.
     from addon.bridge import scenes
     from addon.bridge.capture import SceneCache
     from addon.engine import methods
@@ -177,7 +178,9 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
     scenes.build("cornell-glossy" if name == "vct" else "cornell")  # vct: its glossy product too
     scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 64, 48)
     method_name, grid_cells = ("lpv", 32) if name == "lpv-far-field" else (name.split("-")[0], 16)
-    gi, rsm = GIConfig(method=method_name, resolution=64), RsmConfig(resolution=128, vpl_samples=64)
+    bounces = 2 if name == "lpv-emitter-classes" else 1  # the classes' re-injection passes too
+    gi = GIConfig(method=method_name, resolution=64, bounces=bounces)
+    rsm = RsmConfig(resolution=128, vpl_samples=64)
     results = []
     for be in (gl, blender_backend):
         lpv = LpvConfig(grid_cells=grid_cells, variant="improved", geometry_volume=True,

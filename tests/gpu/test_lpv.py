@@ -621,11 +621,13 @@ def trilinear(v, g):
     return out
 
 
-def reference_reinject(acc, vox_normal, vox_albedo, vox_projected):
+def reference_reinject(acc, vox_normal, vox_albedo, vox_projected, side_acc=None):
     """numpy twin of reinject.comp.glsl: per cell A with a surface, phi = albedo * w * max(0, c . lobe(-m))
     on the better lit side m, c trilinear at A's centre + m / 2 over the corners q weighted by their
     transmittance along m, 1 - min(1, P_q . |m|), renormalised (0 if every corner blocks); sent to A + d
-    as phi / pi * lobe(m) x max(0, m.d) / |m|_1. Returns (snapshot per channel, phi per cell (z, y, x, 3))."""
+    as phi / pi * lobe(m) x max(0, m.d) / |m|_1. side_acc(m), when given, is the volume each side m reads
+    instead of acc (emitter classes: the total less m's class). Returns (snapshot per channel, phi per
+    cell (z, y, x, 3))."""
     shape = vox_normal.shape[:3]
     out = [np.zeros(shape + (4,)) for _ in range(3)]
     phi_cells = np.zeros(shape + (3,))
@@ -639,7 +641,8 @@ def reference_reinject(acc, vox_normal, vox_albedo, vox_projected):
             w = np.prod([f[k] if corner[k] else 1.0 - f[k] for k in range(3)])
             q = np.clip(i0 + corner, 0, np.array(shape[::-1]) - 1)
             through = 1.0 - min(1.0, vox_projected[q[2], q[1], q[0], :3].astype(np.float64) @ np.abs(m))
-            total += w * through * np.array([a[q[2], q[1], q[0]] @ sh.cosine_lobe_l1(-m) for a in acc])
+            read = acc if side_acc is None else side_acc(m)
+            total += w * through * np.array([a[q[2], q[1], q[0]] @ sh.cosine_lobe_l1(-m) for a in read])
             weight += w * through
         return np.maximum(total / weight, 0.0) if weight > 1e-4 else np.zeros(3)
 
@@ -719,6 +722,47 @@ def test_reinjected_flux_is_albedo_times_irradiance_times_area(gl):
     # Every share stays in the grid, so the snapshot's flux is the reflected flux exactly:
     # 2 sqrt(pi) c0 summed = sum over surfaces of albedo * E * area.
     np.testing.assert_allclose(flux(got), phi.reshape(-1, 3).sum(axis=0), rtol=1e-5)
+
+
+def test_reinjection_with_emitter_classes_reflects_the_other_classes_light(gl):
+    # reinject_case's surfaces under six random class volumes C_k and their total T: lpv_reinject.own once
+    # per class, then the re-injection of T with own_front / own_back, must equal numpy's re-injection in
+    # which each side m reads T - C_class(m) (the reading is linear before its clamp).
+    rng = np.random.default_rng(8)
+    grid = Grid(np.zeros(3), 0.25, (6, 7, 5))
+    _, vox_normal, vox_albedo, vox_projected = reinject_case(rng, grid.dims)
+    shape = tuple(reversed(grid.dims))
+
+    def random_lobes():  # per cell a lobe of random direction and strength, as reinject_case's
+        n = rng.normal(size=shape + (3,))
+        n /= np.linalg.norm(n, axis=-1, keepdims=True)
+        return (rng.uniform(0.1, 1.0, size=shape + (1,)) * sh.cosine_lobe_l1(n) / np.pi).astype(np.float32)
+
+    classes = [[random_lobes() for _ in range(3)] for _ in range(6)]
+    total = [np.sum([c[ch] for c in classes], axis=0, dtype=np.float32) for ch in range(3)]
+    voxels = {k: gl.texture(grid.dims, "RGBA32F", v) for k, v in
+              (("vox_normal", vox_normal), ("vox_albedo", vox_albedo), ("vox_projected", vox_projected))}
+    own = {k: gl.texture(grid.dims) for k in ("own_front", "own_back")}
+    for e, c in enumerate(classes):
+        tex = {f"acc_{ch}": gl.texture(grid.dims, "RGBA32F", a) for ch, a in zip("rgb", c, strict=True)}
+        lpv_reinject.own(gl, tex, voxels, own, grid, e)
+    snapshot = volumes(gl, grid.dims)
+    tex = {f"acc_{ch}": gl.texture(grid.dims, "RGBA32F", a) for ch, a in zip("rgb", total, strict=True)}
+    lpv_reinject.run(gl, tex, voxels, snapshot, grid, own=own)
+    got = [gl.read(snapshot[f"sh_{c}"]) for c in "rgb"]
+
+    def side_acc(m):
+        k = int(lpv_inject.emitter_class(m[None])[0])
+        return [t - c for t, c in zip(total, classes[k], strict=True)]
+
+    want, phi = reference_reinject(total, vox_normal, vox_albedo, vox_projected, side_acc)
+    plain, _ = reference_reinject(total, vox_normal, vox_albedo, vox_projected)
+    assert np.count_nonzero(phi.sum(axis=-1)) >= 4
+    scale = max(np.abs(w).max() for w in want)
+    assert max(np.abs(w - p).max() for w, p in zip(want, plain, strict=True)) > 0.1 * scale  # classes matter
+    for got_c, want_c in zip(got, want, strict=True):
+        # fp32 sums of six classes' readings: 1e-5 of the scale.
+        np.testing.assert_allclose(got_c, want_c, atol=1e-5 * scale)
 
 
 # -- the method ---------------------------------------------------------------------------------------

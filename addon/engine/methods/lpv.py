@@ -26,7 +26,9 @@ the light further; its accumulation is added to the fine one. With emitter class
 emitter_classes, improved, one cascade: `uses_emitter_classes`) the atlases hold one block per class of
 VPL normal, each class is unpacked and propagated on its own into `class_accumulated` and added to the
 total, and lpv_lookup.own records each pixel's own class's reading, which the lookup subtracts from the
-total's (first bounce; later bounces re-inject and look up the total). Products: direct, indirect, albedo.
+total's; with later bounces lpv_reinject.own records each surface side's own-class reading too, which
+the second bounce's re-injection subtracts (later bounces propagate and look up their total). Products:
+direct, indirect, albedo.
 """
 
 from __future__ import annotations
@@ -94,9 +96,12 @@ class LpvVolume:
         self.accumulated = {f"acc_{c}": be.texture(dims) for c in "rgb"}
         classes = uses_emitter_classes(method.lpv_config)
         self.atlas, self.inject_atlas, self.inject_target = lpv_inject.atlas_target(be, self.grid, classes)
-        # One emitter class's light (the far field adds its own into it; it needs none of its own).
+        # One emitter class's light (the far field adds its own into it; it needs none of its own), and
+        # with later bounces each surface side's reading of its own class (lpv_reinject.own).
         self.class_accumulated = ({f"acc_{c}": be.texture(dims) for c in "rgb"}
                                   if classes and not is_far_field else None)
+        self.own_reinject = ({k: be.texture(dims) for k in ("own_front", "own_back")}
+                             if classes and not is_far_field and method.gi.bounces > 1 else None)
         # One bounce's accumulation (the total is `accumulated`): what the next bounce re-injects.
         self.bounce_accumulated = ({f"acc_{c}": be.texture(dims) for c in "rgb"}
                                    if method.gi.bounces > 1 and not is_far_field else None)
@@ -253,11 +258,13 @@ class LpvMethod(OneBounceMethod):
         bounce alone."""
         be, levels = self.backend, self.levels
         previous = [level.accumulated for level in levels]  # each holds bounce 1 alone until the first add
-        for _ in range(self.gi.bounces - 1):
+        for bounce in range(self.gi.bounces - 1):
             for i in reversed(range(len(levels))):
                 level = levels[i]
                 with self.timed(timings, "lpv_reinject"):
-                    lpv_reinject.run(be, previous[i], level.voxels, level.snapshots[0], level.grid)
+                    # With emitter classes the first bounce's surfaces reflect the other classes' light.
+                    lpv_reinject.run(be, previous[i], level.voxels, level.snapshots[0], level.grid,
+                                     own=level.own_reinject if bounce == 0 else None)
                     if i + 1 < len(levels):
                         parent = levels[i + 1]
                         lpv_cascade.inflow(be, level.cascade, level.snapshots[0], parent.grid,
@@ -328,6 +335,10 @@ class LpvMethod(OneBounceMethod):
             with self.timed(timings, "lpv_lookup"):
                 lpv_lookup.own(be, self.gbuf, level.class_accumulated, self._own_light, level.grid, emitter,
                                vox_normal=self.lookup_vox(level))
+            if level.own_reinject is not None:
+                with self.timed(timings, "lpv_reinject"):
+                    lpv_reinject.own(be, level.class_accumulated, level.voxels, level.own_reinject, level.grid,
+                                     emitter)
         with self.timed(timings, "lpv_lookup"):
             lpv_lookup.run(be, self.gbuf, level.accumulated, self.indirect, level.grid,
                            vox_normal=self.lookup_vox(level), own_light=self._own_light)

@@ -12,9 +12,15 @@ as arriving: the sun-lit roof of window-room re-emitted its own light into the r
 Its Lambertian lobe phi / pi * cosine_lobe(m) goes to the neighbours A + d in the shares
 max(0, m.d) / |m|_1 (sum 1). Gather form: one compute invocation per
 cell reads its 6 neighbours; no atomics. `add` sums one bounce's accumulation into the total.
+
+Emitter classes (docs/LPV.md): `own` runs once per class with that class's light alone and writes the
+signed reading on each surface's side of that class into `own_front` / `own_back` (RGBA32F 3D); `run`
+with them subtracts it before the clamp, so a surface reflects the light of the other classes only.
 """
 
 from __future__ import annotations
+
+import dataclasses
 
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
@@ -28,6 +34,18 @@ SPEC = ShaderSpec(
     images=tuple(Image(f"sh_{c}", "3D", "RGBA32F", "write") for c in "rgb"),
     uniforms=(Var("dims", "ivec3"),),
 )
+OWN_LIGHT = dataclasses.replace(SPEC, name="lpv_reinject_own_light", defines=(("OWN_LIGHT", "1"),),
+                                samplers=SPEC.samplers + (Sampler("own_front", "3D"), Sampler("own_back", "3D")))
+OWN_PASS = ShaderSpec(
+    name="lpv_reinject_own_pass",
+    compute="lpv/reinject.comp.glsl",
+    local_size=(4, 4, 4),
+    samplers=tuple(Sampler(f"acc_{c}", "3D") for c in "rgb") + (Sampler("vox_normal", "3D"),
+                                                                 Sampler("vox_projected", "3D")),
+    images=(Image("own_front", "3D", "RGBA32F", "write"), Image("own_back", "3D", "RGBA32F", "write")),
+    uniforms=(Var("dims", "ivec3"), Var("emitter", "int")),
+    defines=(("OWN_PASS", "1"),),
+)
 
 ADD = ShaderSpec(
     name="lpv_add",
@@ -39,12 +57,24 @@ ADD = ShaderSpec(
 )
 
 
-def run(backend: Backend, acc: dict, voxels: dict, snapshot: dict, grid: Grid) -> None:
+def run(backend: Backend, acc: dict, voxels: dict, snapshot: dict, grid: Grid, own: dict | None = None) -> None:
     """acc (keys acc_r/g/b) -> snapshot (keys sh_r/g/b), overwritten in every cell; `voxels`: the
-    voxelizer's vox_normal, vox_albedo and vox_projected."""
-    samplers = {**acc, **{k: voxels[k] for k in ("vox_normal", "vox_albedo", "vox_projected")}}
-    backend.dispatch(backend.program(SPEC), group_count(grid.dims, SPEC.local_size), uniforms={"dims": grid.dims},
+    voxelizer's vox_normal, vox_albedo and vox_projected; `own` (keys own_front, own_back, written by
+    `own` for every class): each side's own-class reading is subtracted."""
+    spec = SPEC if own is None else OWN_LIGHT
+    samplers = {**acc, **{k: voxels[k] for k in ("vox_normal", "vox_albedo", "vox_projected")}, **(own or {})}
+    backend.dispatch(backend.program(spec), group_count(grid.dims, spec.local_size), uniforms={"dims": grid.dims},
                      samplers=samplers, images=snapshot)
+
+
+def own(backend: Backend, acc: dict, voxels: dict, out: dict, grid: Grid, emitter: int) -> None:
+    """out (keys own_front, own_back) at the surfaces whose side +n / -n is of class `emitter` := the
+    signed reading of acc (that class's light alone) there, as `run` reads it before the clamp; other
+    cells are left as they are."""
+    backend.dispatch(backend.program(OWN_PASS), group_count(grid.dims, OWN_PASS.local_size),
+                     uniforms={"dims": grid.dims, "emitter": emitter},
+                     samplers={**acc, "vox_normal": voxels["vox_normal"], "vox_projected": voxels["vox_projected"]},
+                     images=out)
 
 
 def add(backend: Backend, bounce: dict, total: dict, grid: Grid) -> None:
