@@ -94,7 +94,7 @@ class LpvVolume:
         dims = self.grid.dims
         self.snapshots = [{f"sh_{c}": be.texture(dims) for c in "rgb"} for _ in range(3)]
         self.accumulated = {f"acc_{c}": be.texture(dims) for c in "rgb"}
-        classes = uses_emitter_classes(method.lpv_config)
+        classes = method.classes
         self.atlas, self.inject_atlas, self.inject_target = lpv_inject.atlas_target(be, self.grid, classes)
         # One emitter class's light (the far field adds its own into it; it needs none of its own), and
         # with later bounces each surface side's reading of its own class (lpv_reinject.own).
@@ -148,6 +148,7 @@ class LpvMethod(OneBounceMethod):
         super().__init__(backend, gi, rsm_config)
         self.lpv_config = lpv_config if lpv_config is not None else LpvConfig()
         self.levels: list[LpvVolume] = []
+        self.classes = uses_emitter_classes(self.lpv_config)  # fixed with the config
 
     # The finest grid's textures (the only grid when cascades = 1).
     grid = property(lambda self: self.levels[0].grid)
@@ -176,8 +177,7 @@ class LpvMethod(OneBounceMethod):
         res = self.rsm_config.resolution
         self._reduce = rsm_reduce.factor_for(res, self.lpv_config.grid_cells)
         self._vpls = rsm_reduce.textures(self.backend, res, self._reduce) if self._reduce > 1 else None
-        self._classes = uses_emitter_classes(self.lpv_config)
-        self._points = atlas.texel_points(self.backend, res // self._reduce, lpv_inject.spec(self._classes))
+        self._points = atlas.texel_points(self.backend, res // self._reduce, lpv_inject.spec(self.classes))
 
     def allocate_products(self, size: tuple[int, int]) -> None:
         super().allocate_products(size)
@@ -185,7 +185,7 @@ class LpvMethod(OneBounceMethod):
         several = self.lpv_config.cascades > 1 and self.gi.bounces > 1
         self._bounce_image = self.backend.texture(size) if several else None
         # Emitter classes: each pixel's reading of its own class's light (lpv_lookup.own).
-        self._own_light = self.backend.texture(size) if uses_emitter_classes(self.lpv_config) else None
+        self._own_light = self.backend.texture(size) if self.classes else None
 
     def follow_camera(self) -> None:
         """Re-place the finer cascades where the camera has moved to another parent cell."""
@@ -216,7 +216,7 @@ class LpvMethod(OneBounceMethod):
                 vpls = self._vpls
             for level in self.grids():
                 lpv_inject.run(self.backend, level.inject_target, self._points, vpls, level.grid, level.atlas,
-                               self._classes)
+                               self.classes)
 
     def propagate(self, iterations: int | None = None, accumulated: dict | None = None,
                   level: LpvVolume | None = None) -> None:
@@ -352,7 +352,7 @@ class LpvMethod(OneBounceMethod):
             inner = super().compute(run_gbuffer)
             inner.pop("total", None)
             timings.update(inner)
-            if self._own_light is not None:
+            if self.classes:
                 self.propagate_classes(timings)
             else:
                 self.propagate_levels(timings)
