@@ -169,17 +169,11 @@ def test_navigating_gives_preview_then_full_quality(cornell):
 def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, name):
     # lpv at 16 cells runs one grid; "lpv-far-field" at 32 cells adds the far field's passes;
     # "lpv-emitter-classes" (16 cells) the classes' injection, unpacks and own-light lookups.
-    import gc
-
     from addon.bridge import scenes
     from addon.bridge.capture import SceneCache
     from addon.engine import methods
     from addon.engine.config import GIConfig, LpvConfig, RsmConfig, VctConfig
 
-    # Release the GL objects earlier tests dropped before this one allocates: in session 7 the suite's
-    # growth left this test's moderngl run with GL_INVALID_OPERATION and an empty G-buffer when they were
-    # released mid-run (not diagnosed further; docs/LPV.md "Not done").
-    gc.collect()
     scenes.build("cornell-glossy" if name == "vct" else "cornell")  # vct: its glossy product too
     scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 64, 48)
     method_name, grid_cells = ("lpv", 32) if name == "lpv-far-field" else (name.split("-")[0], 16)

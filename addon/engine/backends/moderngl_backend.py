@@ -9,6 +9,7 @@ from __future__ import annotations
 import ctypes
 import ctypes.util
 import functools
+import gc
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -87,11 +88,18 @@ def _in_own_context(method):
         saved = self._egl.save()
         if saved and saved[3] == self._own_context:
             return method(self, *args, **kwargs)
+        # No cyclic garbage collection while our context is current: a collection here can free Blender
+        # gpu objects (textures, framebuffers) whose release then deletes GL names in *this* context,
+        # i.e. our objects of the same names (a test late in the suite lost its G-buffer that way).
+        collecting = gc.isenabled()
+        gc.disable()
         try:
             with self.ctx:
                 return method(self, *args, **kwargs)
         finally:
             self._egl.restore(saved)
+            if collecting:
+                gc.enable()
 
     return wrapper
 
