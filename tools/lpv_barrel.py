@@ -94,14 +94,15 @@ def trilinear(volume: np.ndarray, point_xyz: np.ndarray) -> np.ndarray:
     frac = p - base
     out = np.zeros(4)
     for corner in np.ndindex(2, 2, 2):
-        w = np.prod([f if c else 1.0 - f for f, c in zip(frac, corner)])
+        w = np.prod([f if c else 1.0 - f for f, c in zip(frac, corner, strict=True)])
         i = base + np.array(corner)
         out += w * volume[:, i[0] % volume.shape[1], i[1], i[2]]
     return out
 
 
-def exact_irradiance(point: np.ndarray, normal: np.ndarray, points: np.ndarray, normals: np.ndarray,
-                     ds: float) -> float:
+def exact_irradiance(
+    point: np.ndarray, normal: np.ndarray, points: np.ndarray, normals: np.ndarray, ds: float
+) -> float:
     """Irradiance at a vault point from the vault of exitance 1 (2D form-factor kernel, no occlusion:
     a concave arc sees all of itself)."""
     d = points - point
@@ -118,7 +119,7 @@ def vault_readings(radius: float, classes: str, receiver_angles_deg: list[float]
     points, normals, ds = arc(radius, centre)
     n_classes = 1 if classes == "none" else (6 if classes == "axes" else int(classes))
     injected = np.zeros((n_classes, 4, GRID_X, GRID_YZ, GRID_YZ))
-    for point, normal in zip(points, normals):
+    for point, normal in zip(points, normals, strict=True):
         cell = np.floor(point + INJECT_OFFSET * normal).astype(int)
         flux = ds * 1.0  # exitance 1 over ds x one cell along x
         lobe = flux / np.pi * sh.cosine_lobe_l1(np.array([0.0, normal[0], normal[1]]))
