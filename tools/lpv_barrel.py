@@ -12,7 +12,9 @@ the exact irradiance the vault receives from itself (2D kernel cos1 cos2 / (2 d)
 
 --classes: `none` (one volume), `axes` (the method's six signed-axis emitter classes: a receiver
 reads the total less its own class), or an integer K (K angular classes in the vault's plane, to
-ask whether finer classes would help). A research tool: slow (numpy), not part of the method.
+ask whether finer classes would help). --own-exact adds, with classes, the exact light of the
+receiver's own class (what a gather over that class's VPLs would add). A research tool: slow
+(numpy), not part of the method.
 """
 
 from __future__ import annotations
@@ -113,8 +115,10 @@ def exact_irradiance(
     return float(np.sum(cos_r * cos_e / (2.0 * dist)) * ds)
 
 
-def vault_readings(radius: float, classes: str, receiver_angles_deg: list[float]) -> list[tuple]:
-    """[(angle from the springing in degrees, exact, LPV)] on the vault of `radius` cells."""
+def vault_readings(radius: float, classes: str, receiver_angles_deg: list[float], own_exact: bool = False) -> list:
+    """[(angle from the springing in degrees, exact, LPV)] on the vault of `radius` cells. own_exact (with
+    classes): add the exact irradiance from the receiver's own class, what a gather over that class's
+    VPLs would add to the volume's reading of the other classes."""
     centre = np.array([GRID_YZ / 2 + 0.3, GRID_YZ / 2 + 0.1])  # off the cell lattice: no alignment luck
     points, normals, ds = arc(radius, centre)
     n_classes = 1 if classes == "none" else (6 if classes == "axes" else int(classes))
@@ -136,6 +140,9 @@ def vault_readings(radius: float, classes: str, receiver_angles_deg: list[float]
             coeffs = coeffs - trilinear(volumes[class_of(normal, classes)], lookup)
         # the light arriving at the surface travels along -n (grids store direction of travel)
         lpv = float(sh.irradiance(coeffs, -np.array([0.0, normal[0], normal[1]])))
+        if own_exact and classes != "none":
+            own = np.array([class_of(n, classes) == class_of(normal, classes) for n in normals])
+            lpv += exact_irradiance(point, normal, points[own], normals[own], ds)
         rows.append((angle, exact_irradiance(point, normal, points, normals, ds), lpv))
     return rows
 
@@ -144,13 +151,14 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--radii", default="2.2,4.4,8.8", help="vault radii in cells")
     ap.add_argument("--classes", default="none,axes", help="comma list of none, axes, or an integer K")
+    ap.add_argument("--own-exact", action="store_true", help="with classes: add the own class's exact light")
     args = ap.parse_args(argv)
     angles = [90.0, 60.0, 36.0, 18.0]
     print("| classes | radius (cells) | " + " | ".join(f"{a:.0f} deg: LPV / exact" for a in angles) + " |")
     print("| --- | --- |" + " --- |" * len(angles))
     for classes in args.classes.split(","):
         for radius in (float(r) for r in args.radii.split(",")):
-            rows = vault_readings(radius, classes, angles)
+            rows = vault_readings(radius, classes, angles, args.own_exact)
             cells = " | ".join(f"{lpv / exact:.2f}" for _, exact, lpv in rows)
             print(f"| {classes} | {radius:g} | {cells} |", flush=True)
     return 0
