@@ -43,6 +43,8 @@ def add_arguments(p) -> None:
     p.add_argument("--radiance", default="anisotropic", help="voxel radiance: anisotropic or isotropic (vct)")
     p.add_argument("--gather-scale", type=int, default=1,
                    help="cones at one pixel per n x n block, upsampled along edges (vct)")
+    p.add_argument("--filtered-injection", action=argparse.BooleanOptionalAction, default=True,
+                   help="vct: share each VPL between the 2 x 2 nearest cells along its surface (default on)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--repeat", type=int, default=3, help="timed runs after a warm-up (median reported)")
 
@@ -56,7 +58,8 @@ def run(args) -> int:
                     far_field=args.far_field, near_steps=args.near_steps, emitter_classes=args.emitter_classes,
                     cascades=args.cascades, cell_size_m=args.cell_size)
     vct = VctConfig(voxel_cells=args.voxel_cells, diffuse_cones=args.cones, step_ratio=args.step_ratio,
-                    offset_cells=args.cone_offset, radiance=args.radiance, gather_scale=args.gather_scale)
+                    offset_cells=args.cone_offset, radiance=args.radiance, gather_scale=args.gather_scale,
+                    filtered_injection=args.filtered_injection)
     blend = existing_blend(args.blend)
     out = output_dir(args.out)
     from ..bridge.pipeline import render_file  # imports bpy: only when actually rendering

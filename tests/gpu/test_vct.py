@@ -110,8 +110,8 @@ def test_levels_fit_side_by_side(dims):
 
 # -- passes --------------------------------------------------------------------------------------------
 def test_injection_splits_flux_by_direction(gl):
-    """Two VPLs in one cell: each adds (phi, A / h^2) * max(0, n.t) to direction t, exactly (a sum of 2
-    floats)."""
+    """Unfiltered, two VPLs in one cell: each adds (phi, A / h^2) * max(0, n.t) to direction t, exactly
+    (a sum of 2 floats)."""
     grid = Grid(np.zeros(3), 1.0, (4, 3, 5))
     atlas = Atlas.for_grid(grid)
     res = 2
@@ -130,8 +130,9 @@ def test_injection_splits_flux_by_direction(gl):
         gl.write(rsm[k], a)
     textures = vct_pyramid.direction_textures(gl, atlas.size)
     target = gl.target([textures[d] for d in DIRECTIONS])
-    points = atlas_pass.texel_points(gl, res, vct_inject.SPEC)
-    vct_inject.run(gl, target, points, rsm, grid, atlas)
+    points = atlas_pass.texel_points(gl, res, vct_inject.spec(False))
+    no_geometry = gl.texture(grid.dims)  # the unfiltered splat does not read it
+    vct_inject.run(gl, target, points, rsm, grid, atlas, no_geometry, filtered=False)
     z = 3
     row, col = (z // atlas.tiles_x) * 3 + 1, (z % atlas.tiles_x) * 4 + 2
     expected = {"px": [*(0.6 * flux[0, 0, :3]), 0.6 * 0.25], "nx": 0, "py": [*flux[0, 1, :3], 0.5], "ny": 0,
@@ -141,6 +142,99 @@ def test_injection_splits_flux_by_direction(gl):
         np.testing.assert_allclose(got[row, col], np.broadcast_to(expected[d], 4), rtol=1e-6, atol=1e-7,
                                    err_msg=d)
         assert np.count_nonzero(got) == np.count_nonzero(got[row, col])  # nothing elsewhere
+
+
+def filtered_injection(gl, grid, projected_xyz, pos, nrm, flux):
+    """Run the filtered injection of VPLs (n, 3) (surfel area 1 m^2 each) into a fresh scratch atlas over
+    a volume whose projected areas are projected_xyz (X, Y, Z, 3); the six direction volumes (z, y, x, 4)."""
+    atlas = Atlas.for_grid(grid)
+    n = len(pos)
+    res = int(np.ceil(np.sqrt(n)))
+    rsm = {}
+    for key, rows in (("position", np.c_[pos, np.ones(n)]), ("normal", np.c_[nrm, np.ones(n)]),
+                      ("flux", np.c_[flux, np.zeros(n)])):
+        image = np.zeros((res * res, 4), np.float32)
+        image[:n] = rows
+        rsm[key] = gl.texture((res, res), data=image.reshape(res, res, 4))
+    textures = vct_pyramid.direction_textures(gl, atlas.size)
+    target = gl.target([textures[d] for d in DIRECTIONS])
+    points = atlas_pass.texel_points(gl, res, vct_inject.spec(True), vct_inject.points_per_texel(True))
+    projected = np.zeros((*reversed(grid.dims), 4), np.float32)
+    projected[..., :3] = projected_xyz.transpose(2, 1, 0, 3)
+    vct_inject.run(gl, target, points, rsm, grid, atlas, gl.texture(grid.dims, data=projected), filtered=True)
+    nx, ny, nz = grid.dims
+    out = {}
+    for d in DIRECTIONS:
+        flat = gl.read(textures[d])
+        out[d] = np.stack([flat[(z // atlas.tiles_x) * ny:(z // atlas.tiles_x + 1) * ny,
+                                (z % atlas.tiles_x) * nx:(z % atlas.tiles_x + 1) * nx] for z in range(nz)])
+    return out
+
+
+def test_filtered_injection_equals_numpy_twin(gl):
+    """Random VPLs (all six normal classes, some at the grid's border, some where no neighbour holds
+    geometry) over a volume with random empty cells: every direction volume equals the numpy twin's
+    accumulation (vct_inject.filtered_cells) to fp32 sum order, and the flux is shared, not made or lost."""
+    rng = np.random.default_rng(7)
+    grid = Grid(np.array([-0.3, 0.1, 0.2]), 0.25, (5, 4, 6))
+    projected = rng.random((*grid.dims, 3)) * (rng.random((*grid.dims, 3)) < 0.6)
+    n = 200
+    pos = grid.origin_m + rng.random((n, 3)) * np.array(grid.dims) * grid.cell_size_m
+    nrm = rng.normal(size=(n, 3))
+    nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+    flux = rng.random((n, 3)) + 0.1
+    got = filtered_injection(gl, grid, projected, pos, nrm, flux)
+    cells, weights = vct_inject.filtered_cells(pos, nrm, projected, grid)
+    np.testing.assert_allclose(weights.sum(axis=1), 1.0, atol=1e-12)
+    assert (weights < 1.0).any() and (weights == 1.0).any()  # both shared and whole VPLs occur
+    area = 1.0 / grid.cell_size_m**2
+    for axis, d_pos, d_neg in ((0, "px", "nx"), (1, "py", "ny"), (2, "pz", "nz")):
+        for d, sign in ((d_pos, 1.0), (d_neg, -1.0)):
+            expected = np.zeros((*reversed(grid.dims), 4))
+            lobe = np.maximum(0.0, sign * nrm[:, axis])
+            for k in range(4):
+                c, w = cells[:, k], weights[:, k] * lobe
+                inside = np.all((c >= 0) & (c < np.array(grid.dims)), axis=1) & (w > 0)
+                np.add.at(expected, (c[inside, 2], c[inside, 1], c[inside, 0]),
+                          np.c_[flux[inside] * w[inside, None], area * w[inside]])
+            np.testing.assert_allclose(got[d], expected, rtol=2e-5, atol=1e-5, err_msg=d)
+
+
+def test_filtered_injection_moves_flux_continuously():
+    """A VPL on a floor (normal +z) sliding 0.02 cells per frame across a cell border, every cell holding
+    floor: its flux is shared linearly between the two cells whose centres it lies between (weight 1 -
+    fraction past the first centre), so no frame moves more than 0.02 of it -- where the point splat
+    moved all of it at the border."""
+    grid = Grid(np.zeros(3), 1.0, (4, 3, 2))
+    projected = np.ones((*grid.dims, 3))
+    xs = np.arange(1.0, 3.0, 0.02)
+    pos = np.c_[xs, np.full_like(xs, 1.5), np.full_like(xs, 0.3)]
+    cells, weights = vct_inject.filtered_cells(pos, np.tile([0.0, 0.0, 1.0], (len(xs), 1)), projected, grid)
+    share = np.zeros((len(xs), grid.dims[0]))
+    for k in range(4):
+        np.add.at(share, (np.arange(len(xs)), cells[:, k, 0]), weights[:, k])
+    assert np.all(cells[:, :, 2] == 0)  # the floor's layer along its normal
+    np.testing.assert_allclose(share.sum(axis=1), 1.0, atol=1e-12)
+    np.testing.assert_allclose(share[np.isclose(xs, 1.5)][0], [0, 1, 0, 0], atol=1e-12)  # on a centre: that cell
+    np.testing.assert_allclose(share[np.isclose(xs, 2.0)][0], [0, 0.5, 0.5, 0], atol=1e-9)  # on a border: half
+    assert np.abs(np.diff(share, axis=0)).max() <= 0.02 + 1e-9
+
+
+def test_filtered_injection_keeps_flux_off_cells_without_geometry():
+    """A wall (normal +x) whose neighbour cell along y holds nothing facing x: the VPL's whole flux stays
+    in the cell that does (renormalised), none goes into the empty one; with no such cell at all it
+    falls back to its own cell."""
+    grid = Grid(np.zeros(3), 1.0, (2, 2, 2))
+    projected = np.zeros((*grid.dims, 3))
+    projected[0, 0, :, 0] = 1.0  # cells (0, 0, z) hold geometry facing x; (0, 1, z) none
+    pos = np.array([[0.2, 0.9, 0.5]])  # between the centres of y = 0 and y = 1, z on a centre
+    cells, weights = vct_inject.filtered_cells(pos, np.array([[1.0, 0.0, 0.0]]), projected, grid)
+    kept = weights[0] > 0
+    np.testing.assert_array_equal(cells[0, kept], [[0, 0, 0]])
+    np.testing.assert_allclose(weights[0, kept], [1.0])
+    cells, weights = vct_inject.filtered_cells(pos, np.array([[1.0, 0.0, 0.0]]), np.zeros_like(projected), grid)
+    np.testing.assert_array_equal(cells[0, 0], [0, 0, 0])
+    np.testing.assert_allclose(weights[0], [1.0, 0.0, 0.0, 0.0])
 
 
 def test_add_light_caps_flux_where_footprints_overhang_the_geometry(gl):

@@ -77,9 +77,6 @@ VCT_KNOWN_DEFECTS = {
     "test_light_inside_closed_box_stays_inside[vct]": "indirect outside up to 0.22 x P/(6 pi) (exact 0; 0.029 "
                                                       "before exact voxel areas): the box's one-cell walls hold "
                                                       "its lit inner faces, now with their exact, partial opacity",
-    "test_light_moving_1mm_per_frame[vct]": "frame-to-frame change 0.011 against 0.007: a VPL's flux moves a "
-                                            "whole voxel when it crosses a cell border (injection is not "
-                                            "filtered)",
 }
 
 

@@ -58,7 +58,9 @@ class VctMethod(OneBounceMethod):
         self.light_flux = vct_pyramid.direction_textures(be, self.atlas.size)
         self._light_target = be.target([self.light_flux[d] for d in DIRECTIONS])
         self._pending_light: int | None = None
-        self._points = atlas.texel_points(be, self.rsm_config.resolution, vct_inject.SPEC)
+        filtered = cfg.filtered_injection
+        self._points = atlas.texel_points(be, self.rsm_config.resolution, vct_inject.spec(filtered),
+                                          vct_inject.points_per_texel(filtered))
         self.pyramid = vct_pyramid.pyramid_textures(be, self.grid)
         if self.gi.bounces > 1:
             self.next_bounce = vct_pyramid.direction_textures(be, self.grid.dims)
@@ -88,7 +90,8 @@ class VctMethod(OneBounceMethod):
         with self.timed(timings, "vct_inject"):
             if self._pending_light is not None and view.light_index != self._pending_light:
                 self._flush_light()
-            vct_inject.run(self.backend, self._light_target, self._points, self.rsm, self.grid, self.atlas)
+            vct_inject.run(self.backend, self._light_target, self._points, self.rsm, self.grid, self.atlas,
+                           self.voxels["vox_projected"], self.vct_config.filtered_injection)
             self._pending_light = view.light_index
 
     def _flush_light(self) -> None:

@@ -32,14 +32,15 @@ class Atlas:
         return cls(tiles_x, (tiles_x * nx, math.ceil(nz / tiles_x) * ny))
 
 
-def splat_spec(name: str, vertex: str, fragment: str, varyings: tuple, outputs: tuple) -> ShaderSpec:
+def splat_spec(name: str, vertex: str, fragment: str, varyings: tuple, outputs: tuple,
+               samplers: tuple = ()) -> ShaderSpec:
     """A splatting program's declaration: the RSM samplers, grid and atlas uniforms and the texel
     attribute that `splat` and `texel_points` provide, plus the program's own varyings and outputs."""
     return ShaderSpec(
         name=name,
         vertex=vertex,
         fragment=fragment,
-        samplers=(Sampler("rsm_position", "2D"), Sampler("rsm_normal", "2D"), Sampler("rsm_flux", "2D")),
+        samplers=(Sampler("rsm_position", "2D"), Sampler("rsm_normal", "2D"), Sampler("rsm_flux", "2D"), *samplers),
         uniforms=(Var("grid_origin", "vec3"), Var("cell_size", "float"), Var("dims", "ivec3"),
                   Var("tiles_x", "int"), Var("atlas_size", "ivec2")),
         attributes=(Var("texel", "vec2"),),
@@ -48,18 +49,22 @@ def splat_spec(name: str, vertex: str, fragment: str, varyings: tuple, outputs: 
     )
 
 
-def texel_points(backend: Backend, resolution: int, spec: ShaderSpec):
-    """The point mesh: one vertex per RSM texel (its integer coordinates, attribute `texel`), made once
-    per RSM size for the splatting program `spec`."""
+def texel_points(backend: Backend, resolution: int, spec: ShaderSpec, copies: int = 1):
+    """The point mesh: `copies` consecutive vertices per RSM texel (its integer coordinates, attribute
+    `texel`; a program tells the copies apart by gl_VertexID % copies), made once per RSM size for the
+    splatting program `spec`."""
     j, i = np.mgrid[0:resolution, 0:resolution]
     texels = np.stack([i.ravel(), j.ravel()], axis=1).astype(np.float32)
+    texels = np.repeat(texels, copies, axis=0)
     return backend.mesh(backend.program(spec), {"texel": texels}, "points")
 
 
-def splat(backend: Backend, spec: ShaderSpec, target, points, rsm: dict, grid: Grid, atlas: Atlas) -> None:
+def splat(backend: Backend, spec: ShaderSpec, target, points, rsm: dict, grid: Grid, atlas: Atlas,
+          samplers: dict | None = None) -> None:
     """Draw one RSM face's VPLs with `spec` into the atlas textures behind `target`, added."""
     backend.draw(backend.program(spec), target, points,
                  uniforms={"grid_origin": grid.origin_m, "cell_size": grid.cell_size_m, "dims": grid.dims,
                            "tiles_x": atlas.tiles_x, "atlas_size": atlas.size},
-                 samplers={"rsm_position": rsm["position"], "rsm_normal": rsm["normal"], "rsm_flux": rsm["flux"]},
+                 samplers={"rsm_position": rsm["position"], "rsm_normal": rsm["normal"], "rsm_flux": rsm["flux"],
+                           **(samplers or {})},
                  blend="add")

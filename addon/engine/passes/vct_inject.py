@@ -4,7 +4,10 @@ one light at a time.
 run (per RSM face): additive point splats of the face's VPLs into a light's scratch atlas: six RGBA32F
 2D textures of atlas.size, one per direction ("px" .. "nz") attached to `target` in DIRECTIONS order;
 per cell and axis direction t of travel, rgb = the sum over its VPLs of phi * max(0, n.t) (W) and a =
-of their surfel areas A * max(0, n.t) / h^2 (RSM footprints, cross-section fractions).
+of their surfel areas A * max(0, n.t) / h^2 (RSM footprints, cross-section fractions). Filtered (the
+default, VctConfig.filtered_injection): each VPL is shared between the 2 x 2 cells nearest it along its
+surface (`filtered_cells`, four points per texel), so its flux moves continuously with the light;
+unfiltered: one point into the cell holding it.
 add_light (once per light, after its faces): adds rgb x min(1, 4 x projected area along t / a) to the
 flux atlas vct_pyramid.level0 reads: a VPL whose footprint overhangs the sliver of geometry its cell
 holds no longer makes that cell hundreds of times brighter than the surface
@@ -17,6 +20,10 @@ layers-as-tiles atlas (passes/atlas.py), one draw per face; the light's addition
 
 from __future__ import annotations
 
+import dataclasses
+
+import numpy as np
+
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
 from .atlas import Atlas, splat, splat_spec
@@ -25,7 +32,54 @@ DIRECTIONS = ("px", "nx", "py", "ny", "pz", "nz")  # travel along +x, -x, +y, -y
 
 SPEC = splat_spec("vct_inject", "vct/inject.vert.glsl", "vct/inject.frag.glsl",
                   varyings=tuple(Var(f"v_{d}", "vec4") for d in DIRECTIONS),
-                  outputs=tuple(Var(f"out_{d}", "vec4") for d in DIRECTIONS))
+                  outputs=tuple(Var(f"out_{d}", "vec4") for d in DIRECTIONS),
+                  samplers=(Sampler("vox_projected", "3D"),))
+SPEC_FILTERED = dataclasses.replace(SPEC, name="vct_inject_filtered", defines=(("FILTERED_INJECTION", "1"),))
+FILTER_CORNERS = 4  # points per RSM texel when filtered: atlas.texel_points(copies=FILTER_CORNERS)
+
+
+def spec(filtered: bool) -> ShaderSpec:
+    """The injection program (its point mesh, atlas.texel_points with points_per_texel(filtered) copies)."""
+    return SPEC_FILTERED if filtered else SPEC
+
+
+def points_per_texel(filtered: bool) -> int:
+    return FILTER_CORNERS if filtered else 1
+
+
+def filtered_cells(positions: np.ndarray, normals: np.ndarray, projected: np.ndarray, grid: Grid):
+    """The filtered injection's twin (gpu_shaders/vct/inject.vert.glsl): per VPL (n, 3) the four cells
+    (n, 4, 3) and weights (n, 4). Along the normal's dominant axis a (lpv_inject.emitter_class's tie
+    rule) the cell layer holding the VPL; along the two others the bilinear weights of the 2 x 2 cells
+    whose centres surround it, each kept only where that cell holds geometry facing a (projected (X, Y,
+    Z, 3) in cells^2, > 0) and renormalised; where none does, all of it in the VPL's own cell."""
+    g = (np.asarray(positions, np.float64) - grid.origin_m) / grid.cell_size_m
+    axis = np.argmax(np.abs(normals), axis=1)
+    n = len(g)
+    others = np.array([[1, 2], [0, 2], [0, 1]])[axis]  # (n, 2)
+    across = np.take_along_axis(g, others, axis=1) - 0.5
+    base = np.floor(across).astype(int)
+    frac = across - base
+    layer = np.floor(g[np.arange(n), axis]).astype(int)
+    corners = np.array([[0, 0], [1, 0], [0, 1], [1, 1]])  # corner k = (k & 1, k >> 1), as the shader
+    cells = np.zeros((n, 4, 3), int)
+    weights = np.zeros((n, 4))
+    dims = np.array(grid.dims)
+    for k, (i, j) in enumerate(corners):
+        c = np.zeros((n, 3), int)
+        c[np.arange(n), axis] = layer
+        c[np.arange(n), others[:, 0]] = base[:, 0] + i
+        c[np.arange(n), others[:, 1]] = base[:, 1] + j
+        inside = np.all((c >= 0) & (c < dims), axis=1)
+        cc = np.clip(c, 0, dims - 1)
+        facing = np.where(inside, projected[cc[:, 0], cc[:, 1], cc[:, 2], axis], 0.0) > 0.0
+        w = np.where(i, frac[:, 0], 1 - frac[:, 0]) * np.where(j, frac[:, 1], 1 - frac[:, 1])
+        cells[:, k], weights[:, k] = c, np.where(facing, w, 0.0)
+    total = weights.sum(axis=1, keepdims=True)
+    none = total[:, 0] <= 0.0
+    weights = np.where(total > 0.0, weights / np.where(total > 0.0, total, 1.0), 0.0)
+    cells[none, 0], weights[none, 0] = np.floor(g[none]).astype(int), 1.0
+    return cells, weights
 
 ADD_LIGHT = ShaderSpec(
     name="vct_add_light",
@@ -37,9 +91,11 @@ ADD_LIGHT = ShaderSpec(
 )
 
 
-def run(backend: Backend, target, points, rsm: dict, grid: Grid, atlas: Atlas) -> None:
-    """Add one RSM face's VPLs into the light's scratch atlas behind `target` (six textures)."""
-    splat(backend, SPEC, target, points, rsm, grid, atlas)
+def run(backend: Backend, target, points, rsm: dict, grid: Grid, atlas: Atlas, vox_projected,
+        filtered: bool = True) -> None:
+    """Add one RSM face's VPLs into the light's scratch atlas behind `target` (six textures); `points`
+    made for spec(filtered)."""
+    splat(backend, spec(filtered), target, points, rsm, grid, atlas, {"vox_projected": vox_projected})
 
 
 def add_light(backend: Backend, light: dict, flux: dict, vox_projected, grid: Grid, atlas: Atlas) -> None:
