@@ -43,8 +43,9 @@ def add_arguments(p) -> None:
     p.add_argument("--radiance", default="anisotropic", help="voxel radiance: anisotropic or isotropic (vct)")
     p.add_argument("--gather-scale", type=int, default=1,
                    help="cones at one pixel per n x n block, upsampled along edges (vct)")
-    p.add_argument("--filtered-injection", action=argparse.BooleanOptionalAction, default=True,
-                   help="vct: share each VPL between the 2 x 2 nearest cells along its surface (default on)")
+    p.add_argument("--filtered-injection", action=argparse.BooleanOptionalAction, default=False,
+                   help="vct: share each VPL between the 2 x 2 nearest cells along its surface (no flicker as "
+                        "lights move; slower)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--repeat", type=int, default=3, help="timed runs after a warm-up (median reported)")
 

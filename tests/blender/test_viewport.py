@@ -165,16 +165,18 @@ def test_navigating_gives_preview_then_full_quality(cornell):
     np.testing.assert_array_equal(full.view, preview.view)
 
 
-@pytest.mark.parametrize("name", ["direct", "rsm", "lpv", "lpv-far-field", "lpv-emitter-classes", "vct"])
+@pytest.mark.parametrize("name", ["direct", "rsm", "lpv", "lpv-far-field", "lpv-emitter-classes", "vct",
+                                  "vct-filtered"])
 def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, name):
     # lpv at 16 cells runs one grid; "lpv-far-field" at 32 cells adds the far field's passes;
-    # "lpv-emitter-classes" (16 cells) the classes' injection, unpacks and own-light lookups.
+    # "lpv-emitter-classes" (16 cells) the classes' injection, unpacks and own-light lookups;
+    # "vct-filtered" the filtered injection (gl_VertexID, the projected-area fetches).
     from addon.bridge import scenes
     from addon.bridge.capture import SceneCache
     from addon.engine import methods
     from addon.engine.config import GIConfig, LpvConfig, RsmConfig, VctConfig
 
-    scenes.build("cornell-glossy" if name == "vct" else "cornell")  # vct: its glossy product too
+    scenes.build("cornell-glossy" if name.startswith("vct") else "cornell")  # vct: its glossy product too
     scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 64, 48)
     method_name, grid_cells = ("lpv", 32) if name == "lpv-far-field" else (name.split("-")[0], 16)
     gi = GIConfig(method=method_name, resolution=64)
@@ -184,7 +186,7 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
         lpv = LpvConfig(grid_cells=grid_cells, variant="improved", geometry_volume=True,
                         emitter_classes=name == "lpv-emitter-classes")
         method = methods.create(be, gi, rsm, lpv,
-                                VctConfig(voxel_cells=16, diffuse_cones=6))
+                                VctConfig(voxel_cells=16, diffuse_cones=6, filtered_injection=name == "vct-filtered"))
         method.set_scene(scene)
         results.append(method.run().images)
     a, b = results

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from addon.engine import methods
-from addon.engine.config import METHODS, GIConfig, LpvConfig, RsmConfig
+from addon.engine.config import METHODS, GIConfig, LpvConfig, RsmConfig, VctConfig
 from addon.engine.scene import Camera, Light, Scene
 from addon.engine.transforms import look_along, perspective
 
@@ -100,11 +100,13 @@ def sun(direction, strength, color=(1, 1, 1)):
 
 def make(gl, name, rsm_res=128, vpl=64):
     """A method by name; "rsm+voxel" is the rsm method with voxel-traced visibility, "lpv+classes" lpv
-    with emitter classes."""
+    with emitter classes, "vct+filtered" vct with filtered injection."""
     method, _, variant = name.partition("+")
     kw = {"resolution": rsm_res, "vpl_samples": vpl}
     if variant == "classes":
         return methods.create(gl, GIConfig(method=method), RsmConfig(**kw), LpvConfig(emitter_classes=True))
+    if variant == "filtered":
+        return methods.create(gl, GIConfig(method=method), RsmConfig(**kw), vct=VctConfig(filtered_injection=True))
     if variant:
         kw["visibility"] = variant
     return methods.get(method)(gl, GIConfig(method=method), RsmConfig(**kw))

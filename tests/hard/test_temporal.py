@@ -10,7 +10,8 @@ from hard_scenes import scene as make_scene
 pytestmark = [pytest.mark.gpu, pytest.mark.slow]
 
 
-@pytest.mark.parametrize("name", ALL_METHODS)
+# vct+filtered: the option made for this case (VctConfig.filtered_injection, off by default for speed).
+@pytest.mark.parametrize("name", (*ALL_METHODS, "vct+filtered"))
 def test_light_moving_1mm_per_frame(gl, figures, name):
     # Physical change per frame: E = I cos / d^2 with d >= d_min = 0.5 m (light at y = 0.5 to the wall
     # y = 1) changes by |dE / E| <= 2 delta / d + delta / d (the cosine) = 3 x 1 mm / 0.5 m = 6e-3 at most

@@ -4,10 +4,10 @@ one light at a time.
 run (per RSM face): additive point splats of the face's VPLs into a light's scratch atlas: six RGBA32F
 2D textures of atlas.size, one per direction ("px" .. "nz") attached to `target` in DIRECTIONS order;
 per cell and axis direction t of travel, rgb = the sum over its VPLs of phi * max(0, n.t) (W) and a =
-of their surfel areas A * max(0, n.t) / h^2 (RSM footprints, cross-section fractions). Filtered (the
-default, VctConfig.filtered_injection): each VPL is shared between the 2 x 2 cells nearest it along its
-surface (`filtered_cells`, four points per texel), so its flux moves continuously with the light;
-unfiltered: one point into the cell holding it.
+of their surfel areas A * max(0, n.t) / h^2 (RSM footprints, cross-section fractions): one point into
+the cell holding the VPL, or filtered (VctConfig.filtered_injection) shared between the 2 x 2 cells
+nearest it along its surface (`filtered_cells`, four points per texel), so its flux moves continuously
+with the light.
 add_light (once per light, after its faces): adds rgb x min(1, 4 x projected area along t / a) to the
 flux atlas vct_pyramid.level0 reads: a VPL whose footprint overhangs the sliver of geometry its cell
 holds no longer makes that cell hundreds of times brighter than the surface
@@ -92,7 +92,7 @@ ADD_LIGHT = ShaderSpec(
 
 
 def run(backend: Backend, target, points, rsm: dict, grid: Grid, atlas: Atlas, vox_projected,
-        filtered: bool = True) -> None:
+        filtered: bool = False) -> None:
     """Add one RSM face's VPLs into the light's scratch atlas behind `target` (six textures); `points`
     made for spec(filtered)."""
     splat(backend, spec(filtered), target, points, rsm, grid, atlas, {"vox_projected": vox_projected})
