@@ -131,8 +131,7 @@ def test_injection_splits_flux_by_direction(gl):
     textures = vct_pyramid.direction_textures(gl, atlas.size)
     target = gl.target([textures[d] for d in DIRECTIONS])
     points = atlas_pass.texel_points(gl, res, vct_inject.spec(False))
-    no_geometry = gl.texture(grid.dims)  # the unfiltered splat does not read it
-    vct_inject.run(gl, target, points, rsm, grid, atlas, no_geometry, filtered=False)
+    vct_inject.run(gl, target, points, rsm, grid, atlas)
     z = 3
     row, col = (z // atlas.tiles_x) * 3 + 1, (z % atlas.tiles_x) * 4 + 2
     expected = {"px": [*(0.6 * flux[0, 0, :3]), 0.6 * 0.25], "nx": 0, "py": [*flux[0, 1, :3], 0.5], "ny": 0,
@@ -161,7 +160,7 @@ def filtered_injection(gl, grid, projected_xyz, pos, nrm, flux):
     points = atlas_pass.texel_points(gl, res, vct_inject.spec(True), vct_inject.points_per_texel(True))
     projected = np.zeros((*reversed(grid.dims), 4), np.float32)
     projected[..., :3] = projected_xyz.transpose(2, 1, 0, 3)
-    vct_inject.run(gl, target, points, rsm, grid, atlas, gl.texture(grid.dims, data=projected), filtered=True)
+    vct_inject.run(gl, target, points, rsm, grid, atlas, gl.texture(grid.dims, data=projected))
     nx, ny, nz = grid.dims
     out = {}
     for d in DIRECTIONS:

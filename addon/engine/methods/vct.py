@@ -91,7 +91,7 @@ class VctMethod(OneBounceMethod):
             if self._pending_light is not None and view.light_index != self._pending_light:
                 self._flush_light()
             vct_inject.run(self.backend, self._light_target, self._points, self.rsm, self.grid, self.atlas,
-                           self.voxels["vox_projected"], self.vct_config.filtered_injection)
+                           self.voxels["vox_projected"] if self.vct_config.filtered_injection else None)
             self._pending_light = view.light_index
 
     def _flush_light(self) -> None:

@@ -27,14 +27,16 @@ import numpy as np
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
 from .atlas import Atlas, splat, splat_spec
+from .lpv_inject import emitter_class
 
 DIRECTIONS = ("px", "nx", "py", "ny", "pz", "nz")  # travel along +x, -x, +y, -y, +z, -z
 
 SPEC = splat_spec("vct_inject", "vct/inject.vert.glsl", "vct/inject.frag.glsl",
                   varyings=tuple(Var(f"v_{d}", "vec4") for d in DIRECTIONS),
-                  outputs=tuple(Var(f"out_{d}", "vec4") for d in DIRECTIONS),
-                  samplers=(Sampler("vox_projected", "3D"),))
-SPEC_FILTERED = dataclasses.replace(SPEC, name="vct_inject_filtered", defines=(("FILTERED_INJECTION", "1"),))
+                  outputs=tuple(Var(f"out_{d}", "vec4") for d in DIRECTIONS))
+# Filtered: reads the voxelizer's projected areas to keep a VPL's share out of cells without its surface.
+SPEC_FILTERED = dataclasses.replace(SPEC, name="vct_inject_filtered", defines=(("FILTERED_INJECTION", "1"),),
+                                    samplers=(*SPEC.samplers, Sampler("vox_projected", "3D")))
 FILTER_CORNERS = 4  # points per RSM texel when filtered: atlas.texel_points(copies=FILTER_CORNERS)
 
 
@@ -54,7 +56,7 @@ def filtered_cells(positions: np.ndarray, normals: np.ndarray, projected: np.nda
     whose centres surround it, each kept only where that cell holds geometry facing a (projected (X, Y,
     Z, 3) in cells^2, > 0) and renormalised; where none does, all of it in the VPL's own cell."""
     g = (np.asarray(positions, np.float64) - grid.origin_m) / grid.cell_size_m
-    axis = np.argmax(np.abs(normals), axis=1)
+    axis = emitter_class(np.asarray(normals)) // 2
     n = len(g)
     others = np.array([[1, 2], [0, 2], [0, 1]])[axis]  # (n, 2)
     across = np.take_along_axis(g, others, axis=1) - 0.5
@@ -91,11 +93,12 @@ ADD_LIGHT = ShaderSpec(
 )
 
 
-def run(backend: Backend, target, points, rsm: dict, grid: Grid, atlas: Atlas, vox_projected,
-        filtered: bool = False) -> None:
-    """Add one RSM face's VPLs into the light's scratch atlas behind `target` (six textures); `points`
-    made for spec(filtered)."""
-    splat(backend, spec(filtered), target, points, rsm, grid, atlas, {"vox_projected": vox_projected})
+def run(backend: Backend, target, points, rsm: dict, grid: Grid, atlas: Atlas, vox_projected=None) -> None:
+    """Add one RSM face's VPLs into the light's scratch atlas behind `target` (six textures): filtered
+    when given the voxelizer's vox_projected, else one point per VPL; `points` made for spec(filtered)."""
+    filtered = vox_projected is not None
+    splat(backend, spec(filtered), target, points, rsm, grid, atlas,
+          {"vox_projected": vox_projected} if filtered else None)
 
 
 def add_light(backend: Backend, light: dict, flux: dict, vox_projected, grid: Grid, atlas: Atlas) -> None:
