@@ -126,7 +126,7 @@ class VctConfig(_Validated):
     specular_side_cap: float = _num(0.05, 0.02, 1.0, "specular cone's sampled voxel side at most this x distance")
     # On: a VPL is shared bilinearly between the 2 x 2 cells nearest it along its surface (those holding
     # geometry facing its normal's axis), so its flux moves continuously as a light moves: a light moving
-    # 1 mm per frame flickers by 1.1 % per frame with one cell per VPL, 0.29 % filtered (docs/VCT.md,
+    # 1 mm per frame flickers by 1.1 % per frame with one cell per VPL, 0.3 % filtered (docs/VCT.md,
     # "Filtered injection"). Off by default: four point splats per VPL instead of one made the injection
     # 3-6x slower on llvmpipe (the VCT update up to 2.4x), for no accuracy.
     filtered_injection: bool = field(default=False, metadata={
