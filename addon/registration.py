@@ -1,5 +1,5 @@
 """Registers the Blender side of Bounce. Order matters: properties first (panels and operators read
-scene.bounce), preferences next, then operators and panels, then the viewport draw handler and the
+scene.bounce), then operators and panels, then the viewport draw handler and the
 live-update handlers; unregister runs the reverse so nothing is
 left pointing at a class that is gone.
 
@@ -10,11 +10,11 @@ unregister(): a handler left behind survives disabling the add-on and runs stale
 from __future__ import annotations
 
 from .. import operators, panels
-from . import preferences, properties
+from . import properties
 from .bridge import live, viewport
 
 # Handlers last: they read scene.bounce and draw what the panels configure.
-_MODULES = (properties, preferences, operators, panels, viewport, live)
+_MODULES = (properties, operators, panels, viewport, live)
 
 
 def register() -> None:

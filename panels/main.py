@@ -21,14 +21,17 @@ class BOUNCE_PT_main(bpy.types.Panel):
         layout.use_property_split = True
         layout.use_property_decorate = False
         settings = context.scene.bounce
-        layout.active = settings.enabled
+        # Greyed while the overlay is off, but still editable: bakes read the same settings, and a bake
+        # does not need the overlay.
+        settings_column = layout.column()
+        settings_column.active = settings.enabled
         # Every field of each group, in the config's order: a new config field appears without edits here.
         # A method's own group (LPV) only while that method is selected.
         for attr in CONFIGS:
             if GROUP_METHOD.get(attr, settings.gi.method) != settings.gi.method:
                 continue
             group = getattr(settings, attr)
-            column = layout.column(heading=attr.upper())
+            column = settings_column.column(heading=attr.upper())
             for name in group.bl_rna.properties.keys():
                 if name not in {"rna_type", "name"}:
                     column.prop(group, name)

@@ -3,8 +3,10 @@
 1. Download the binary wheels of moderngl and glcontext for every Python that Blender 4.2+ ships
    (3.11 up to 5.0, 3.13 from 5.1) and every platform of the manifest into wheels/.
 2. Write that list into the manifest's `wheels`, so the manifest never names a wheel we did not fetch.
-3. Build with Blender's own packaging tool (shipped inside the bpy module), which validates the
-   manifest and puts only each platform's wheels into its zip.
+3. Copy the add-on's own files, by an allow-list (`ALLOWED`), into a staging folder, so nothing a user or
+   a test leaves in the checkout (c.blend, ref/, out/, caches) can reach a zip.
+4. Build from that folder with Blender's own packaging tool (shipped inside the bpy module), which
+   validates the manifest and puts only each platform's wheels into its zip.
 
 Usage: python tools/build_extension.py --out dist
 """
@@ -14,8 +16,10 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import re
+import shutil
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -31,6 +35,11 @@ PIP_PLATFORMS = {
     "windows-x64": "win_amd64",
     "macos-arm64": "macosx_11_0_arm64",
 }
+
+# What a zip holds: root file -> itself, package folder -> its files with these suffixes (no caches, no
+# data a user may have saved inside). The wheels are added from wheels/ by the manifest's list.
+ALLOWED_FILES = ("__init__.py", "blender_manifest.toml")
+ALLOWED_DIRS = {"addon": (".py",), "operators": (".py",), "panels": (".py",), "gpu_shaders": (".glsl",)}
 
 _WHEELS_BLOCK = re.compile(r"^wheels = \[.*?^\]", re.MULTILINE | re.DOTALL)
 
@@ -100,19 +109,34 @@ def write_manifest_wheels(wheels: list[str]) -> bool:
     return True
 
 
+def allowed_paths(root: Path) -> list[Path]:
+    """The add-on's files under `root`, relative to it, sorted: what a zip may hold besides wheels."""
+    paths = [Path(name) for name in ALLOWED_FILES if (root / name).is_file()]
+    for folder, suffixes in ALLOWED_DIRS.items():
+        for path in sorted((root / folder).rglob("*")):
+            rel = path.relative_to(root)
+            if path.is_file() and path.suffix in suffixes and "__pycache__" not in rel.parts:
+                paths.append(rel)
+    return sorted(paths)
+
+
+def stage(root: Path, dest: Path) -> None:
+    """Copy the allowed files and the wheels of root into dest (the build's source folder)."""
+    for rel in allowed_paths(root):
+        (dest / rel).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(root / rel, dest / rel)
+    (dest / "wheels").mkdir()
+    for wheel in (root / "wheels").glob("*.whl"):
+        shutil.copy2(wheel, dest / "wheels" / wheel.name)
+
+
 def build(out_dir: Path) -> list[Path]:
     out_dir.mkdir(parents=True, exist_ok=True)
-    cmd = [
-        sys.executable,
-        str(blender_ext_script()),
-        "build",
-        "--source-dir",
-        str(ROOT),
-        "--output-dir",
-        str(out_dir),
-        "--split-platforms",
-    ]
-    result = subprocess.run(cmd, capture_output=True, text=True)
+    with tempfile.TemporaryDirectory(prefix="bounce-build-") as staging:
+        stage(ROOT, Path(staging))
+        cmd = [sys.executable, str(blender_ext_script()), "build", "--source-dir", staging,
+               "--output-dir", str(out_dir.resolve()), "--split-platforms"]
+        result = subprocess.run(cmd, capture_output=True, text=True)
     if result.returncode != 0:
         raise BuildError(f"blender_ext.py build failed:\n{result.stdout}{result.stderr}".strip())
     return sorted(out_dir.glob("bounce-*.zip"))

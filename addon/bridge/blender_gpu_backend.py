@@ -31,6 +31,7 @@ from ..engine.backends.base import (
 )
 from ..engine.errors import ShaderCompileError
 from ..engine.shader_source import load, load_stages
+from . import compat
 from .gpu_init import ensure_gpu
 
 _ACCESS = {"read": {"READ"}, "write": {"WRITE"}, "read_write": {"READ", "WRITE"}}
@@ -212,8 +213,8 @@ class BlenderGPUBackend(Backend):
         for entry in color:
             tex, layer = entry if isinstance(entry, tuple) else (entry, None)
             size = tex.size[:2]
-            slots.append({"texture": tex.gl, "layer": layer} if layer is not None else tex.gl)
-        fbo = gpu.types.GPUFrameBuffer(color_slots=tuple(slots), depth_slot=depth.gl if depth else None)
+            slots.append(compat.layer_attachment(tex.gl, layer) if layer is not None else tex.gl)
+        fbo = compat.framebuffer(tuple(slots), depth.gl if depth else None)
         attached = tuple(e[0] if isinstance(e, tuple) else e for e in color) + ((depth,) if depth else ())
         return _Target(fbo, tuple(size), tuple(t.gl for t in attached))
 

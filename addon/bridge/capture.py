@@ -26,6 +26,7 @@ import bpy
 import numpy as np
 
 from ..engine.scene import AREA_SHAPES, Camera, Light, Scene
+from . import compat
 
 NEUTRAL_ALBEDO = 0.8  # Cycles' own fallback surface is a 0.8 grey diffuse
 
@@ -171,7 +172,7 @@ def material_values(mat, images: dict | None = None, textures: list | None = Non
     images = {} if images is None else images
     if mat is None:
         return np.full(3, NEUTRAL_ALBEDO), np.zeros(3), None  # Cycles' default surface
-    if mat.node_tree is None:
+    if not compat.uses_nodes(mat):
         return np.array(mat.diffuse_color[:3], np.float64), np.zeros(3), None
     node = _surface_node(mat.node_tree, "OUTPUT_MATERIAL", "Surface")
     problems: list[str] = []
@@ -208,7 +209,7 @@ def material_glossy(mat, images: dict | None = None) -> tuple[np.ndarray, float]
     2 x Specular IOR Level (0.5: the IOR's own F0) x Specular Tint, over what is not metal. Other
     surfaces (Diffuse, Emission, unsupported) carry no glossy lobe here."""
     images = {} if images is None else images
-    tree = getattr(mat, "node_tree", None)
+    tree = mat.node_tree if mat is not None and compat.uses_nodes(mat) else None
     node = _surface_node(tree, "OUTPUT_MATERIAL", "Surface") if tree is not None else None
     if node is None or node.type != "BSDF_PRINCIPLED":
         return np.zeros(3), 1.0
@@ -228,7 +229,7 @@ def world_color(world, warnings: list[str]) -> np.ndarray:
     """Constant world radiance: Background colour x strength (textures -> their average + a warning)."""
     if world is None:
         return np.zeros(3)
-    if world.node_tree is None:
+    if not compat.uses_nodes(world):
         return np.array(world.color[:3], np.float64)
     node = _surface_node(world.node_tree, "OUTPUT_WORLD", "Surface")
     if node is None:
@@ -362,10 +363,11 @@ def _light(obj, m: np.ndarray, scale: float, warnings: list[str]) -> Light | Non
     axis_len = np.linalg.norm(m[:3, :3], axis=0)  # world length of local X, Y, Z
     kw = dict(kind=kind, position_m=m[:3, 3] * scale, direction=-m[:3, 2], color=np.array(ld.color[:3]),
               axis_x=m[:3, 0] / max(axis_len[0], 1e-30), name=obj.name)
+    energy = float(ld.energy) * compat.light_exposure_factor(ld)  # what Cycles emits
     if kind == "SUN":
-        kw.update(sun_strength=float(ld.energy), sun_angle_rad=float(ld.angle))
+        kw.update(sun_strength=energy, sun_angle_rad=float(ld.angle))
     else:
-        kw["power_w"] = float(ld.energy)
+        kw["power_w"] = energy
     if kind == "SPOT":
         kw.update(spot_size_rad=float(ld.spot_size), spot_blend=float(ld.spot_blend))
     if kind in ("POINT", "SPOT") and ld.shadow_soft_size > 0:

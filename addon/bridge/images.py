@@ -1,5 +1,9 @@
 """EXR input/output with OpenImageIO only (no bpy), so references can be read outside Blender.
 
+OpenImageIO is imported on first use, not with this module: Blender builds need not have it (Debian's
+has none) and the extension does not ship it, so the paths a user runs inside Blender (the overlay, the
+bake operator's packed images) never import it; the CLI's venv installs it from requirements.txt.
+
 Arrays are float32 (h, w, c) with row 0 = the TOP of the image (EXR order; GL read-backs must be
 flipped before writing). Channels are R, G, B[, A]. Pixels are written as 32-bit FLOAT: half floats
 lose ~3 decimal digits, which is more than the noise floor we want to measure.
@@ -10,11 +14,19 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-import OpenImageIO as oiio
 
-from ..engine.errors import SceneError
+from ..engine.errors import BackendUnavailable, SceneError
 
 _CHANNELS = {3: ("R", "G", "B"), 4: ("R", "G", "B", "A")}
+
+
+def _oiio():
+    try:
+        import OpenImageIO
+    except ImportError:
+        raise BackendUnavailable("reading or writing EXR files needs the OpenImageIO module, which this Python "
+                                 "lacks: run the command line from the project's venv (make test sets it up)") from None
+    return OpenImageIO
 
 
 def write_exr(path, pixels) -> None:
@@ -23,6 +35,7 @@ def write_exr(path, pixels) -> None:
     if px.ndim != 3 or px.shape[2] not in _CHANNELS:
         raise ValueError(f"write_exr wants (h, w, 3|4) pixels, got shape {px.shape}")
     h, w, c = px.shape
+    oiio = _oiio()
     spec = oiio.ImageSpec(w, h, c, oiio.FLOAT)
     spec.channelnames = _CHANNELS[c]
     if c == 4:
@@ -38,23 +51,25 @@ def write_exr(path, pixels) -> None:
         out.close()
 
 
-def _open(path) -> oiio.ImageInput:
+def _open(path):
+    """An OpenImageIO ImageInput."""
     if not Path(path).is_file():
         raise SceneError(f"no such image: {path}")
+    oiio = _oiio()
     inp = oiio.ImageInput.open(str(path))
     if inp is None:
         raise SceneError(f"cannot read image {path}: {oiio.geterror()}")
     return inp
 
 
-def _read_subimage(inp: oiio.ImageInput, sub: int, path) -> tuple[np.ndarray, list[str]]:
+def _read_subimage(inp, sub: int, path) -> tuple[np.ndarray, list[str]]:
     """Pixels and channel names of one subimage. Name the subimage explicitly: in OIIO 3.0 the
     short read_image(chbegin, chend, format) form leaves inp.spec() pointing at subimage 0."""
     if not inp.seek_subimage(sub, 0):
         raise SceneError(f"cannot read image {path}: no subimage {sub}")
     spec = inp.spec()
     names = list(spec.channelnames)
-    px = inp.read_image(sub, 0, 0, spec.nchannels, oiio.FLOAT)
+    px = inp.read_image(sub, 0, 0, spec.nchannels, _oiio().FLOAT)
     if px is None:
         raise SceneError(f"cannot read image {path}: {inp.geterror()}")
     return np.asarray(px, dtype=np.float32).reshape(spec.height, spec.width, spec.nchannels), names

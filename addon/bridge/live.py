@@ -55,6 +55,7 @@ class LiveState:
     # Written by the viewport overlay, read by the panel.
     last_update_ms: float = 0.0
     info: str = ""
+    note: str | None = None         # the overlay shows something other than what was asked, and why
     error: str | None = None
 
 
@@ -78,7 +79,8 @@ def status() -> str:
     if STATE.scene is None:
         return "Waiting for the first update"
     warnings = f", {len(STATE.scene.warnings)} capture warning(s)" if STATE.scene.warnings else ""
-    return f"{STATE.info or 'captured'}{warnings}"
+    note = f"; {STATE.note}" if STATE.note else ""
+    return f"{STATE.info or 'captured'}{warnings}{note}"
 
 
 # ---------------------------------------------------------------------------------------------- capture

@@ -15,6 +15,7 @@ import numpy as np
 from mathutils import Vector
 
 from ..engine.errors import ConfigError, SceneError
+from . import compat
 
 # Cornell box albedos (linear), as in BASELINE.md.
 RED = (0.63, 0.065, 0.05)
@@ -50,7 +51,7 @@ def _reset(name: str, res: tuple[int, int]) -> bpy.types.Scene:
     scene.unit_settings.scale_length = 1.0
     world = bpy.data.worlds.new("World")
     world.color = (0.0, 0.0, 0.0)
-    background = world.node_tree.nodes["Background"]
+    background = compat.node_tree(world).nodes["Background"]
     background.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
     background.inputs["Strength"].default_value = 0.0
     scene.world = world
@@ -85,7 +86,7 @@ def _light(name: str, kind: str, location, energy: float, direction=(0.0, 0.0, -
     light = bpy.data.lights.new(name, kind)
     light.energy = energy  # W for point/spot/area, W/m^2 (strength) for sun
     light.color = (1.0, 1.0, 1.0)
-    light.exposure = 0.0
+    compat.clear_light_exposure(light)
     light.use_shadow = True
     if kind in {"POINT", "SPOT"}:
         light.shadow_soft_size = 0.0
@@ -106,7 +107,7 @@ def _material(name: str, color=(0.0, 0.0, 0.0), image=None, emission: float = 0.
     ~3 % it takes from the diffuse lobe), roughness 1, metallic 0. Base colour from `color` or `image`.
     `specular_level` > 0 adds the dielectric glossy layer (IOR 1.5: F0 = 0.08 x level) of `roughness`."""
     mat = bpy.data.materials.new(name)
-    bsdf = mat.node_tree.nodes["Principled BSDF"]
+    bsdf = compat.node_tree(mat).nodes["Principled BSDF"]
     bsdf.inputs["Base Color"].default_value = (*color, 1.0)
     bsdf.inputs["Metallic"].default_value = 0.0
     bsdf.inputs["Roughness"].default_value = roughness

@@ -158,9 +158,24 @@ def _restored_gpu_state():
 _present_batch = None
 
 
+def shown_view(method, view_mode: str) -> tuple[str, str | None]:
+    """The view the overlay can show for this method, and a note when it is not the one asked for,
+    instead of stopping the overlay or adding nothing: the Voxels view needs the rsm method's voxel
+    grid (others show their indirect light), and the Indirect view a method with indirect light
+    (`direct` shows its direct light)."""
+    if view_mode == "VOXELS" and not hasattr(method, "voxel_view"):
+        view_mode, note = "INDIRECT", f"the Voxels view needs method rsm; {method.name} shows its indirect light"
+    else:
+        note = None
+    if view_mode == "INDIRECT" and getattr(method, "indirect", None) is None:
+        return "DIRECT", f"{method.name} computes no indirect light: showing its direct light"
+    return view_mode, note
+
+
 def present(method, view_mode: str, exposure: float, strength: float) -> None:
     """Add (albedo x (w_d direct + w_i indirect) + w_i glossy) x 2^exposure x strength to the bound
-    framebuffer; glossy (vct's reflected light, already radiance) only where the method has it."""
+    framebuffer; glossy (vct's reflected light, already radiance) only where the method has it.
+    `view_mode` must be one the method can show (`shown_view`)."""
     global _present_batch
     prog = backend().program(PRESENT)
     if _present_batch is None:
@@ -168,8 +183,6 @@ def present(method, view_mode: str, exposure: float, strength: float) -> None:
     w_direct, w_indirect = MODE_WEIGHTS[view_mode]
     use_albedo = 1.0
     if view_mode == "VOXELS":
-        if not hasattr(method, "voxel_view"):
-            raise ValueError(f"the Voxels view needs a voxel method (rsm); {method.name} has no grid")
         indirect, use_albedo = method.voxel_view(), 0.0
     else:
         indirect = getattr(method, "indirect", None)
@@ -241,9 +254,10 @@ def _draw(context, settings) -> None:
         gpu_runs += 1
         state.last_update_ms = (time.perf_counter() - t0) * 1e3  # uploads included
         state.info = f"{gi.method}, {width} x {height} px ({quality}): {state.last_update_ms:.1f} ms"
+    view_mode, state.note = shown_view(overlay.method, settings.view_mode)
     with _restored_gpu_state(), framebuffer.bind():
         gpu.state.viewport_set(*region_viewport)
-        present(overlay.method, settings.view_mode, settings.exposure, settings.strength)
+        present(overlay.method, view_mode, settings.exposure, settings.strength)
 
 
 # ----------------------------------------------------------------------------------------- registration

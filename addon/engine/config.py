@@ -137,7 +137,10 @@ class VctConfig(_Validated):
 class GIConfig(_Validated):
     """What to compute and at which output resolution."""
 
-    method: str = _choice("direct", METHODS, "GI method")
+    # rsm: the best error for its time on the benchmark scenes at 128 px (benchmarks/REPORT.md: Cycles'
+    # time to its error over its own time is 1.5x on cornell at 256 VPLs, lpv 0.28x, vct 0.24x), and a
+    # default that adds indirect light, so a first Enable and a first Bake show something.
+    method: str = _choice("rsm", METHODS, "GI method")
     bounces: int = _num(1, 1, 8, "indirect diffuse bounces (Cycles diffuse_bounces)")
     resolution: int = _num(256, 8, 8192, "long side of the output image in pixels")
     seed: int = _num(0, 0, 2**31 - 1, "seed of every stochastic choice")

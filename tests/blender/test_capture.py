@@ -202,6 +202,15 @@ def test_lights(fresh_blend):
     assert len(s.warnings) == 1
 
 
+def test_light_exposure_scales_power(fresh_blend):
+    # Blender 4.4+ multiplies a lamp's energy by 2^exposure (Light > Exposure); Cycles emits that.
+    _lamp("POINT", energy=100.0, exposure=1.5)
+    _lamp("SUN", energy=3.0, exposure=-1.0)
+    by = {li.kind: li for li in cap.capture(_dg()).lights}
+    assert by["POINT"].power_w == pytest.approx(100.0 * 2**1.5, rel=1e-6)
+    assert by["SUN"].sun_strength == pytest.approx(1.5, rel=1e-6)
+
+
 def test_emission_principled_and_emission_shader(fresh_blend):
     plane, cube = _plane_cube()
     plane.data.materials.append(_principled("Glow", **{"Emission Color": (1, 0.5, 0.25, 1),

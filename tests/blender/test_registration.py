@@ -38,18 +38,18 @@ def _operator_registered() -> bool:
 
 
 def _all_classes(bounce) -> list[type]:
-    from bounce.addon import preferences, properties
+    from bounce.addon import properties
 
-    return [*properties.classes, preferences.BOUNCE_AP_preferences, *bounce.operators.classes, *bounce.panels.classes]
+    return [*properties.classes, *bounce.operators.classes, *bounce.panels.classes]
 
 
 def test_register_unregister_twice_leaves_nothing_behind(bounce, fresh_blend):
     before = _handler_counts()
     assert "load_post" in before and "depsgraph_update_post" in before
     classes = _all_classes(bounce)
-    # 5 property groups (gi, rsm, lpv, vct, settings), preferences, 2 operators (report_renderer, bake),
+    # 5 property groups (gi, rsm, lpv, vct, settings), 2 operators (report_renderer, bake),
     # 3 panels (main, its viewport sub-panel, the sidebar tab)
-    assert len(classes) == 11
+    assert len(classes) == 10
     for _ in range(2):
         bounce.register()
         try:
@@ -64,15 +64,11 @@ def test_register_unregister_twice_leaves_nothing_behind(bounce, fresh_blend):
         assert _handler_counts() == before
 
 
-def test_preferences_idname_is_the_package_name(registered):
-    from bounce.addon.preferences import BOUNCE_AP_preferences
-
-    assert BOUNCE_AP_preferences.bl_idname == "bounce"
-    rna = BOUNCE_AP_preferences.bl_rna.properties
-    assert [item.identifier for item in rna["backend"].enum_items] == ["BLENDER", "MODERNGL"]
-    assert rna["backend"].default == "BLENDER"
-    budget = rna["memory_budget_mb"]
-    assert (budget.default, budget.hard_min, budget.hard_max) == (1024, 64, 16384)
+def test_no_addon_preferences(registered):
+    # The backend and memory-budget preferences were never read: removed rather than left as dead
+    # settings. An AddonPreferences class would be found by bl_idname == the package name.
+    assert not any(issubclass(cls, bpy.types.AddonPreferences)
+                   for cls in bpy.types.AddonPreferences.__subclasses__() if cls.bl_idname == "bounce")
 
 
 def test_report_renderer_operator_finishes(registered, capfd):

@@ -220,6 +220,25 @@ def test_voxels_view_shows_the_grid_on_the_surfaces(cornell):
     assert close_to[0].any() and close_to[1].any()
 
 
+@pytest.mark.parametrize("method, view, shown", [("lpv", "VOXELS", "INDIRECT"), ("direct", "INDIRECT", "DIRECT"),
+                                                 ("direct", "VOXELS", "DIRECT")])
+def test_view_a_method_cannot_show_falls_back_with_a_note(cornell, method, view, shown):
+    # The overlay keeps drawing (no error, light added) what the method has, and the panel says why.
+    from bounce.addon.bridge import live, viewport
+
+    settings = cornell.scene.bounce
+    settings.gi.method, settings.gi.resolution, settings.lpv.grid_cells = method, 32, 16
+    settings.view_mode = view
+    pixels = draw_offscreen(viewport, cornell)
+    assert live.STATE.error is None
+    assert viewport.shown_view(viewport.overlay_for(1, "full").method, view)[0] == shown
+    assert (pixels - np.array(CLEAR, np.float32))[..., :3].max() > 0.1
+    assert method in live.status() and ("Voxels" in live.status() or "no indirect" in live.status())
+    settings.view_mode = shown  # a view it can show: the note goes
+    draw_offscreen(viewport, cornell)
+    assert live.STATE.note is None
+
+
 def test_excluded_light_is_left_out(bounce, fresh_blend):
     # Light > Bounce unticked: the capture leaves the lamp out, and the switch survives a save/reload
     # and is honoured without the add-on registered (the CLI), through the saved ID property.

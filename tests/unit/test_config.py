@@ -9,7 +9,7 @@ from addon.engine.errors import ConfigError
 
 
 def test_defaults_are_valid():
-    assert GIConfig().method == "direct"
+    assert GIConfig().method == "rsm"
     assert RsmConfig().resolution == 256
 
 
