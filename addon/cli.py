@@ -2,6 +2,7 @@
 NAME, HELP, add_arguments(parser) and run(args) -> int; modules import bpy lazily inside run().
 
 Exit status: 0 success; 2 with one line on stderr for a BounceError (bad input); 1 for internal errors.
+A run that fails removes the output directory (--out) it created, when that is still empty.
 """
 
 from __future__ import annotations
@@ -12,6 +13,8 @@ import pkgutil
 import sys
 
 from . import commands
+from .commands._args import removed_on_failure
+from .commands._settings import in_flag_terms
 from .engine.errors import BounceError
 
 
@@ -39,8 +42,11 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    try:
-        return int(args._run(args) or 0)
-    except BounceError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    with removed_on_failure(getattr(args, "out", None)) as report_status:
+        try:
+            code = int(args._run(args) or 0)
+        except BounceError as exc:
+            print(f"error: {in_flag_terms(str(exc))}", file=sys.stderr)
+            code = 2
+        report_status(code)
+    return code

@@ -50,7 +50,7 @@ class ObjectResult:
 
     def to_dict(self) -> dict:
         return {"file": self.file, "size": self.size, "time_ms": round(self.time_ms, 2), "status": self.status,
-                "message": self.message}
+                "message": self.message, "warnings": list(self.notes)}
 
     def line(self) -> str:
         where = f" -> {self.file}" if self.file else ""
@@ -216,7 +216,9 @@ def image_name(obj_name: str, pass_name: str) -> str:
 
 
 def store_image(name: str, rgba: np.ndarray):
-    """A float Blender image `name` holding rgba (row 0 = top), packed into the .blend."""
+    """A float Blender image `name` holding rgba (row 0 = top), packed into the .blend and kept by it: a
+    new image has no users until a material reads it, and Blender drops datablocks without users when
+    it saves, so the bake gets a fake user (the user clears it to let the image go)."""
     h, w = rgba.shape[:2]
     img = bpy.data.images.get(name)
     if img is not None and (tuple(img.size) != (w, h) or not img.is_float):
@@ -229,6 +231,7 @@ def store_image(name: str, rgba: np.ndarray):
     img.pixels.foreach_set(np.ascontiguousarray(rgba[::-1], np.float32).ravel())  # Blender: row 0 = bottom
     img.file_format = "OPEN_EXR"
     img.pack()
+    img.use_fake_user = True
     return img
 
 
@@ -248,6 +251,35 @@ def store_vertex_colors(mesh, name: str, colors: np.ndarray):
 
 def attribute_name(pass_name: str) -> str:
     return f"bounce_{pass_name}"
+
+
+# ------------------------------------------------------------------------------------- nothing baked
+
+def _emits(light) -> bool:
+    strength = light.sun_strength if light.kind == "SUN" else light.power_w
+    return strength > 0 and bool(np.any(np.asarray(light.color) > 0))
+
+
+def empty_light_warning(scene) -> str | None:
+    """Why every value baked from the captured engine Scene would be zero, or None: no light with
+    power > 0 and no emissive triangle. A lit world does not help: no method lights with it yet."""
+    if any(_emits(light) for light in scene.lights) or bool(np.any(scene.emission > 0)):
+        return None
+    if np.any(scene.world_color > 0):
+        return "the scene's only light is the world colour, which Bounce does not light with: every baked value is zero"
+    return "the scene has no light sources (no light with power > 0, no emissive surface): every baked value is zero"
+
+
+ZERO_LIGHT = "no light: every baked value is zero"
+
+
+def zero_light_warning(values: np.ndarray) -> str | None:
+    """A warning when an object's bake holds no light where it is covered (values (..., 4), alpha =
+    coverage; vertex colours: alpha 1), or None. Its objects are lit by nothing this pass computes."""
+    covered = values[..., 3] > 0.5
+    if covered.any() and not np.any(values[..., :3][covered] != 0):
+        return ZERO_LIGHT
+    return None
 
 
 # ----------------------------------------------------------------------------------------- command line
@@ -276,14 +308,18 @@ def select_objects(names: list[str] | None, shard_index: int = 0, shard_count: i
     return shard(set(names), shard_index, shard_count)
 
 
-def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size: int = 512,
+IMAGE_SIZE_TEXELS = 512  # a lightmap's side when none is given
+
+
+def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size: int | None = None,
               gi: GIConfig | None = None, rsm: RsmConfig | None = None, pass_name: str = "indirect",
               target: str = "image", overwrite: bool = False, shard_index: int = 0, shard_count: int = 1,
               save_blend: Path | None = None, margin: int = 16, progress: bool = True, backend=None,
               lpv=None, vct=None) -> dict:
     """Bake the objects of `blend` (see module docstring) into out_dir; returns the summary written to
     out_dir/bake.json. Per-object problems are recorded, never raised; bad arguments raise BounceError.
-    lpv, vct: the configs of those methods (defaults when None)."""
+    size: the lightmap side (IMAGE_SIZE_TEXELS when None). gi, rsm, lpv, vct: the configs (their
+    defaults when None). A bake that yields no light is recorded under "warnings" and told on stderr."""
     from .pipeline import backend as default_backend
     from .pipeline import open_blend
 
@@ -291,44 +327,73 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
     check_choice(target, TARGETS, "--target")
     if target == "volume":
         raise ConfigError("a volume is one per scene, not per object: use bake_volume (--target volume)")
+    size = IMAGE_SIZE_TEXELS if size is None else size
     if not 8 <= size <= 8192:
         raise ConfigError(f"--size must be in 8..8192, got {size}")
-    gi = gi or GIConfig(method="rsm")
-    rsm = rsm or RsmConfig(visibility="voxel")
+    gi, rsm = gi or GIConfig(), rsm or RsmConfig()
     out_dir = check_output_dir(Path(out_dir))
     if save_blend is not None and Path(save_blend).resolve() == Path(blend).resolve():
         raise ConfigError("--save-blend must not be the input file (the .blend is never modified)")
+    say = _stderr_lines(progress)
+    say(f"bake: opening {blend}")
     open_blend(blend)
     names = select_objects(objects, shard_index, shard_count)
     if not names:
         raise SceneError(f"{blend}: no objects to bake" + (" in this shard" if shard_count > 1 else ""))
     t0 = time.perf_counter()
     be = backend or default_backend()
+    say(f"bake: capturing the scene, method {gi.method} setup")
     baker = Baker(be, bpy.context.evaluated_depsgraph_get(), gi, rsm, size, lpv, vct)
-    results: list[ObjectResult] = []
-    taken: set[str] = set()
+    results = _bake_objects(baker, names, out_dir, size, pass_name, target, overwrite, margin, progress)
+    saved = None
+    if save_blend is not None and target == "vertex-colors":
+        bpy.ops.wm.save_as_mainfile(filepath=str(save_blend), copy=True, compress=False)
+        saved = str(save_blend)
+    warnings = _file_warnings(baker.scene, results)
+    for warning in warnings:
+        print(f"warning: {Path(blend).name}: {warning}", file=sys.stderr)
+    summary = {
+        "blend": str(blend), "method": gi.method, "pass": pass_name, "target": target, "size": size,
+        "config": {"gi": gi.to_dict(), "rsm": rsm.to_dict()}, "renderer": be.renderer,
+        "setup_ms": round(baker.setup_ms, 2), "total_ms": round((time.perf_counter() - t0) * 1e3, 2),
+        "shard": [shard_index, shard_count], "saved_blend": saved,
+        "scene_warnings": list(baker.scene.warnings), "warnings": warnings,
+        "objects": {r.name: r.to_dict() for r in results},
+    }
+    (out_dir / "bake.json").write_text(json.dumps(summary, indent=2))
+    return summary
+
+
+def _stderr_lines(enabled: bool):
+    """print() to stderr when enabled (progress), else a no-op."""
+    if not enabled:
+        return lambda line: None
+    return lambda line: print(line, file=sys.stderr, flush=True)
+
+
+def _bake_objects(baker: Baker, names: list[str], out_dir: Path, size: int, pass_name: str, target: str,
+                  overwrite: bool, margin: int, progress: bool) -> list[ObjectResult]:
     from tqdm import tqdm
 
+    results, taken = [], set()
     bar = tqdm(names, desc="bake", unit="obj", file=sys.stderr, disable=not progress)
     for name in bar:
         bar.set_postfix_str(name[:30])
         res = _bake_one(baker, name, out_dir, size, pass_name, target, overwrite, margin, taken)
         results.append(res)
         tqdm.write(res.line(), file=sys.stdout)
-    saved = None
-    if save_blend is not None and target == "vertex-colors":
-        bpy.ops.wm.save_as_mainfile(filepath=str(save_blend), copy=True, compress=False)
-        saved = str(save_blend)
-    summary = {
-        "blend": str(blend), "method": gi.method, "pass": pass_name, "target": target, "size": size,
-        "config": {"gi": gi.to_dict(), "rsm": rsm.to_dict()}, "renderer": be.renderer,
-        "setup_ms": round(baker.setup_ms, 2), "total_ms": round((time.perf_counter() - t0) * 1e3, 2),
-        "shard": [shard_index, shard_count], "saved_blend": saved,
-        "scene_warnings": list(baker.scene.warnings),
-        "objects": {r.name: r.to_dict() for r in results},
-    }
-    (out_dir / "bake.json").write_text(json.dumps(summary, indent=2))
-    return summary
+    return results
+
+
+def _file_warnings(scene, results: list[ObjectResult]) -> list[str]:
+    """The file's warnings: a scene without light, or a run that baked nothing."""
+    warnings = [w for w in [empty_light_warning(scene)] if w]
+    if not any(r.status in ("ok", "warning") for r in results):
+        warnings.append("nothing baked: every object was skipped or failed")
+    dark = [r.name for r in results if ZERO_LIGHT in r.notes]
+    if dark and not warnings:  # the scene is lit, yet these objects receive none of this pass's light
+        warnings.append(f"{len(dark)} object(s) baked no light: {', '.join(dark)}")
+    return warnings
 
 
 def _bake_one(baker: Baker, name: str, out_dir: Path, size: int, pass_name: str, target: str, overwrite: bool,
@@ -345,16 +410,17 @@ def _bake_one(baker: Baker, name: str, out_dir: Path, size: int, pass_name: str,
             if path.exists() and not overwrite:
                 res.status, res.message = "skipped", "file exists (use --overwrite)"
                 return res
-            rgba, notes = baker.bake_image(obj, size, pass_name, margin)
-            images.write_exr(path, rgba)
+            values, notes = baker.bake_image(obj, size, pass_name, margin)
+            images.write_exr(path, values)
             res.size = [size, size]
         else:
-            colors, notes = baker.bake_vertex_colors(obj, pass_name)
-            store_vertex_colors(obj.data, attribute_name(pass_name), colors)
+            values, notes = baker.bake_vertex_colors(obj, pass_name)
+            store_vertex_colors(obj.data, attribute_name(pass_name), values)
             res.file = f"{obj.data.name}:{attribute_name(pass_name)}"
-            res.size = [len(colors), 1]
-        if notes:
-            res.status, res.message = "warning", "; ".join(notes)
+            res.size = [len(values), 1]
+        res.notes = notes + [w for w in [zero_light_warning(values)] if w]
+        if res.notes:
+            res.status, res.message = "warning", "; ".join(res.notes)
     except (SceneError, ConfigError) as exc:
         res.status, res.message = "error", str(exc)
     finally:
@@ -363,7 +429,7 @@ def _bake_one(baker: Baker, name: str, out_dir: Path, size: int, pass_name: str,
 
 
 def bake_volume(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, lpv, overwrite: bool = False,
-                backend=None) -> dict:
+                backend=None, progress: bool = True) -> dict:
     """The LPV's indirect light of the whole scene as a volume for engines: DIR/<stem>_lpv_sh.npz.
 
     Layout (numpy .npz): `sh_r`, `sh_g`, `sh_b` float32 (z, y, x, 4) — per colour, L1 SH in the order
@@ -389,9 +455,12 @@ def bake_volume(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, lpv, o
     path = out_dir / f"{safe_name(Path(blend).stem)}_lpv_sh.npz"
     if path.exists() and not overwrite:
         raise SceneError(f"{path} exists (use --overwrite)")
+    say = _stderr_lines(progress)
+    say(f"bake: opening {blend}")
     open_blend(blend)
     define_light_switch()
     t0 = time.perf_counter()
+    say("bake: capturing the scene, propagating the LPV")
     scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 64, 64)
     if scene.camera is None:
         scene.camera = _default_camera(64)  # the volume does not depend on a view
@@ -404,7 +473,11 @@ def bake_volume(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, lpv, o
     extra = {} if method.vox_normal is None else {"vox_normal": be.read(method.vox_normal)}
     np.savez_compressed(path, **sh, **extra, origin_m=grid.origin_m + method.origin_m,
                         cell_size_m=grid.cell_size_m, dims=np.array(grid.dims))
+    warnings = [w for w in [empty_light_warning(scene)] if w]
+    for warning in warnings:
+        print(f"warning: {Path(blend).name}: {warning}", file=sys.stderr)
     summary = {"blend": str(blend), "file": str(path), "dims": list(grid.dims), "cell_size_m": grid.cell_size_m,
-               "time_ms": round((time.perf_counter() - t0) * 1e3, 2), "config": {"lpv": method.lpv_config.to_dict()}}
+               "time_ms": round((time.perf_counter() - t0) * 1e3, 2), "config": {"lpv": method.lpv_config.to_dict()},
+               "warnings": warnings}
     print(f"{Path(blend).name}: volume {grid.dims[0]}x{grid.dims[1]}x{grid.dims[2]} -> {path}")
     return summary

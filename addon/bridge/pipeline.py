@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import statistics
+from collections.abc import Callable
 from pathlib import Path
 
 import bpy
@@ -38,12 +39,14 @@ def open_blend(path: Path) -> None:
 
 
 def render_file(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, repeat: int = 3,
-                lpv: LpvConfig | None = None, vct: VctConfig | None = None) -> dict:
+                lpv: LpvConfig | None = None, vct: VctConfig | None = None,
+                progress: Callable[[str], None] = lambda step: None) -> dict:
     """Render `blend` with gi.method; write <product>.exr for each product and stats.json; return stats.
 
     The timing is the median of `repeat` full updates after one warm-up (programs compiled, geometry
-    uploaded): what a user waits for when a light moves.
+    uploaded): what a user waits for when a light moves. `progress(step)` is told each step.
     """
+    progress(f"opening {blend}")
     open_blend(blend)
     define_light_switch()  # read the per-light include switch saved in the file
     scene = bpy.context.scene
@@ -51,12 +54,17 @@ def render_file(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, repeat
         raise SceneError(f"{blend}: the scene has no camera")
     width, height = image_size(scene, gi.resolution)
     captured = SceneCache().update(bpy.context.evaluated_depsgraph_get(), width, height)
+    progress(f"method {gi.method}: uploading {captured.triangle_count} triangles, warm-up run (compiles shaders)")
     be = backend()
     method = methods.create(be, gi, rsm, lpv, vct)
     method.set_scene(captured)
     method.run()  # warm-up
-    runs = [method.run() for _ in range(repeat)]
+    runs = []
+    for i in range(repeat):
+        progress(f"timed run {i + 1}/{repeat}")
+        runs.append(method.run())
     result = runs[-1]
+    progress(f"writing {out_dir}")
     for name, pixels in result.images.items():
         images.write_exr(out_dir / f"{name}.exr", pixels)
     notes = list(captured.warnings)

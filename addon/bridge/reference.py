@@ -18,6 +18,7 @@ from __future__ import annotations
 import json
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -31,8 +32,13 @@ PASSES = {"indirect": "Diffuse Indirect", "direct": "Diffuse Direct", "albedo": 
 GLOSSY_PASSES = ("Glossy Indirect", "Glossy Color")  # multiplied into glossy.exr
 
 
-def check_settings(spp: int, bounces: int, res: int) -> None:
+SEED_MAX = 2**31 - 1  # Cycles' seed is a signed 32-bit int, at least 0
+
+
+def check_settings(spp: int, bounces: int, res: int, seed: int = 0) -> None:
     """Raise ConfigError (CLI: exit 2, one line) for values outside what a reference can be."""
+    if not 0 <= seed <= SEED_MAX:  # Cycles would clamp it and the stats would name a seed it did not use
+        raise ConfigError(f"--seed must be in 0..{SEED_MAX}, got {seed}")
     if spp < 1:
         raise ConfigError(f"--spp must be >= 1, got {spp}")
     if not 1 <= bounces <= 8:
@@ -143,14 +149,16 @@ def _render(bpy, exr_path) -> float:
 
 
 def render_reference(blend_path, out_dir, spp: int = 1024, bounces: int = 1, res: int = 256,
-                     seed: int = 0, glossy: bool = False) -> dict:
+                     seed: int = 0, glossy: bool = False, progress: Callable[[str], None] = lambda step: None) -> dict:
     """Render the Cycles reference of `blend_path` into `out_dir` (see module docstring).
 
-    Returns the stats dict also written to out_dir/stats.json. Raises ConfigError for values out of
-    range and SceneError for a missing/unreadable file or a scene without a camera. Opens the file in
-    the running Blender session (the current file is replaced).
+    Returns the stats dict also written to out_dir/stats.json; its seed is the one Cycles rendered
+    with (read back from Cycles). Raises ConfigError for values out of range and SceneError for a
+    missing/unreadable file or a scene without a camera. Opens the file in the running Blender session
+    (the current file is replaced). `progress(step)` is told each step.
     """
-    check_settings(spp, bounces, res)
+    check_settings(spp, bounces, res, seed)
+    progress(f"opening {blend_path}")
     bpy, scene = _open_blend(blend_path)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -158,6 +166,7 @@ def render_reference(blend_path, out_dir, spp: int = 1024, bounces: int = 1, res
     with tempfile.TemporaryDirectory(prefix="bounce_ref_") as tmp:
         exr = Path(tmp) / "passes.exr"
         info = _configure(bpy, scene, spp, bounces, width, height, seed, exr, glossy)
+        progress(f"Cycles on {info['device']}: {width} x {height} px, {spp} spp")
         render_time = _render(bpy, exr)
         layers = images.read_multilayer(exr)
     missing = [p for p in (*PASSES.values(), "Combined", *(GLOSSY_PASSES if glossy else ())) if p not in layers]
@@ -178,7 +187,7 @@ def render_reference(blend_path, out_dir, spp: int = 1024, bounces: int = 1, res
         "res": res,
         "width": width,
         "height": height,
-        "seed": seed,
+        "seed": info["cycles"]["seed"],
         "glossy": glossy,
         "blender_version": bpy.app.version_string,
         **info,

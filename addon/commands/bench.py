@@ -7,11 +7,15 @@ DIR/<scene>.png; caches scenes and Cycles references under --cache. Prints one J
 
 from __future__ import annotations
 
+import contextlib
 import json
+import os
 from pathlib import Path
 
+from ..engine.config import GIConfig
 from ..engine.errors import ConfigError
-from ._args import output_dir
+from ._args import add_quiet, output_dir
+from ._settings import add_field_flag
 
 NAME = "bench"
 HELP = "benchmark methods against Cycles: error vs time report (REPORT.md) and plots"
@@ -31,11 +35,23 @@ def add_arguments(p) -> None:
     p.add_argument("--methods", help="comma-separated methods (default: every implemented method)")
     p.add_argument("--quick", action="store_true",
                    help="CI size: reference 128 spp, Cycles curve 1/4/16 spp, 2 timed runs")
-    p.add_argument("--res", type=int, default=128, help="long side in pixels (default 128)")
+    add_field_flag(p, GIConfig, "resolution", "--res", default=128, doc="long side in pixels")
     p.add_argument("--ref-spp", type=int, help="reference samples per pixel (default 1024; --quick: 128)")
-    p.add_argument("--bounces", type=int, default=1, help="diffuse bounces, 1..8 (default 1)")
+    add_field_flag(p, GIConfig, "bounces")
     p.add_argument("--out", default="benchmarks", help="report directory (default benchmarks)")
     p.add_argument("--cache", default="out/bench", help="scenes, references and runs cache (default out/bench)")
+    add_quiet(p)
+
+
+@contextlib.contextmanager
+def _quiet_stderr(quiet: bool):
+    """bridge/bench.py draws its progress bar on sys.stderr: --quiet sends it nowhere (skipped scenes
+    are still listed in the JSON line and REPORT.md; errors are printed after the run)."""
+    if not quiet:
+        yield
+        return
+    with open(os.devnull, "w") as devnull, contextlib.redirect_stderr(devnull):
+        yield
 
 
 def run(args) -> int:
@@ -53,7 +69,8 @@ def run(args) -> int:
         command=bench.command_line(scenes, methods, args.quick, args.res, ref_spp, args.bounces, args.out,
                                    args.cache),
     )
-    result = bench.run_bench(opt)
+    with _quiet_stderr(args.quiet):
+        result = bench.run_bench(opt)
     print(json.dumps({"report": str(opt.out / "REPORT.md"), "scenes": [s["name"] for s in result["scenes"]],
                       "skipped": result["skipped"]}))
     return 0

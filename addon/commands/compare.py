@@ -3,6 +3,8 @@
 If B has an alpha channel it is the reference's geometry mask (alpha > 0.5 counts, as written by
 `reference`); a plain RGB reference counts every pixel. Images of different sizes: exit 2. HDR-FLIP is
 added when the flip-evaluator package is installed (requirements.txt pins it), else reported as null.
+Only linear float images are compared (OpenEXR, Radiance HDR): a PNG, JPEG or TIFF holds display-encoded
+integers (sRGB), whose errors mean something else; they exit 2.
 """
 
 from __future__ import annotations
@@ -22,9 +24,34 @@ def add_arguments(parser) -> None:
     parser.add_argument("reference", metavar="B.exr", help="reference (its alpha, if any, is the mask)")
 
 
+# OpenImageIO's names of the formats that hold scene-linear floats.
+LINEAR_FORMATS = ("openexr", "hdr")
+
+
+def _file_format(path) -> tuple[str, str]:
+    """OpenImageIO's format name and pixel type of a readable image file (read_exr has opened it)."""
+    import OpenImageIO as oiio
+
+    inp = oiio.ImageInput.open(str(path))
+    try:
+        return inp.format_name(), str(inp.spec().format)
+    finally:
+        inp.close()
+
+
+def check_linear(path) -> None:
+    """Refuse an image whose file format is not linear float (ConfigError: exit 2, one line)."""
+    name, pixel_type = _file_format(path)
+    if name not in LINEAR_FORMATS:
+        raise ConfigError(f"{path}: a {name} file ({pixel_type} pixels) is not linear float, as PNG, JPEG and "
+                          "TIFF are taken to be display-encoded: compare linear EXR images (or .hdr)")
+
+
 def compare_files(test_path, reference_path) -> dict:
     a = images.read_exr(test_path)
     b = images.read_exr(reference_path)
+    check_linear(test_path)
+    check_linear(reference_path)
     if a.shape[:2] != b.shape[:2]:
         raise ConfigError(f"images differ in size: {test_path} is {a.shape[1]}x{a.shape[0]}, "
                           f"{reference_path} is {b.shape[1]}x{b.shape[0]}")

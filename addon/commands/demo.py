@@ -9,7 +9,8 @@ import numpy as np
 
 from ..engine import metrics
 from ..engine.config import GIConfig, RsmConfig
-from ._args import output_dir
+from ._args import add_quiet, output_dir, progress
+from ._settings import add_field_flag
 
 NAME = "demo"
 HELP = "build the demo Cornell box, render it with Bounce and with Cycles, write images and a report"
@@ -17,8 +18,9 @@ HELP = "build the demo Cornell box, render it with Bounce and with Cycles, write
 
 def add_arguments(p) -> None:
     p.add_argument("--out", default="out/demo", help="output directory")
-    p.add_argument("--res", type=int, default=128, help="long side of the images in pixels")
+    add_field_flag(p, GIConfig, "resolution", "--res", default=128, doc="long side of the images in pixels")
     p.add_argument("--spp", type=int, default=64, help="Cycles samples per pixel for the comparison")
+    add_quiet(p)
 
 
 def _png(path: Path, linear_rgb: np.ndarray) -> None:
@@ -31,19 +33,24 @@ def _png(path: Path, linear_rgb: np.ndarray) -> None:
 
 
 def run(args) -> int:
+    from ..bridge.reference import check_settings
+
+    check_settings(args.spp, 1, args.res)
     out = output_dir(args.out)
     from ..bridge import images, scenes
     from ..bridge.pipeline import render_file
     from ..bridge.reference import render_reference
 
+    say = progress(args.quiet)
     blend = out / "cornell.blend"
-    print(f"building the Cornell box -> {blend}")
+    say(f"building the Cornell box -> {blend}")
     scenes.save("cornell", blend)
-    print("rendering direct and indirect light with Bounce (method rsm, voxel visibility; moderngl)")
-    stats = render_file(blend, out, GIConfig(method="rsm", resolution=args.res), RsmConfig(visibility="voxel"))
-    print(f"rendering the same with Cycles ({args.spp} spp) for comparison")
+    say("rendering direct and indirect light with Bounce (method rsm, voxel visibility; moderngl)")
+    stats = render_file(blend, out, GIConfig(method="rsm", resolution=args.res), RsmConfig(visibility="voxel"),
+                        progress=say)
+    say(f"rendering the same with Cycles ({args.spp} spp) for comparison")
     ref_dir = out / "cycles"
-    ref = render_reference(blend, ref_dir, spp=args.spp, bounces=1, res=args.res, seed=0)
+    ref = render_reference(blend, ref_dir, spp=args.spp, bounces=1, res=args.res, seed=0, progress=say)
 
     albedo = images.read_exr(out / "albedo.exr")
     mask = images.read_exr(ref_dir / "direct.exr")[..., 3] > 0.5

@@ -13,17 +13,34 @@ from pathlib import Path
 
 import numpy as np
 
+from ..engine.config import GIConfig
+from ..engine.errors import ConfigError
 from ._args import output_dir
+from ._settings import add_field_flag
 
 NAME = "screenshot"
 HELP = "render the Cornell box with and without the viewport overlay (headless) into PNGs"
+# The overlay's view modes: bridge/viewport.py's MODE_WEIGHTS keys, restated because that module imports
+# Blender's gpu module and the arguments are checked before Blender loads (a test keeps them equal).
+VIEWS = ("COMBINED", "INDIRECT", "DIRECT", "VOXELS")
 
 
 def add_arguments(p) -> None:
     p.add_argument("--out", default="docs/images", help="output directory")
-    p.add_argument("--res", type=int, default=320, help="image side in pixels")
-    p.add_argument("--method", default="rsm", help="overlay method (direct or rsm)")
-    p.add_argument("--view", default="INDIRECT", help="overlay view mode: INDIRECT (default), COMBINED, DIRECT, VOXELS")
+    add_field_flag(p, GIConfig, "resolution", "--res", default=320, doc="image side in pixels")
+    add_field_flag(p, GIConfig, "method", doc="overlay method")
+    p.add_argument("--view", default="INDIRECT", choices=VIEWS, metavar="{" + ",".join(VIEWS) + "}",
+                   help="overlay view mode (default: INDIRECT); VOXELS: the method's voxel grid (rsm)")
+
+
+def _check_view(view: str, method: str) -> None:
+    """VOXELS shows a voxel grid: refuse a method without one before anything is drawn."""
+    from ..engine import methods
+    from ..engine.config import METHODS
+
+    if view == "VOXELS" and not hasattr(methods.get(method), "voxel_view"):
+        gridded = ", ".join(m for m in METHODS if hasattr(methods.get(m), "voxel_view"))
+        raise ConfigError(f"--view VOXELS shows a method's voxel grid: --method {method} has none (use {gridded})")
 
 
 def _srgb(linear: np.ndarray) -> np.ndarray:
@@ -51,6 +68,7 @@ def _workbench(bpy, path: Path, size: int) -> np.ndarray:
 
 
 def run(args) -> int:
+    _check_view(args.view, args.method)
     out = output_dir(args.out)
     import bpy
     import gpu
