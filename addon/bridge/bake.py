@@ -386,10 +386,11 @@ def _bake_objects(baker: Baker, names: list[str], out_dir: Path, size: int, pass
 
 
 def _file_warnings(scene, results: list[ObjectResult]) -> list[str]:
-    """The file's warnings: a scene without light, or a run that baked nothing."""
+    """The file's warnings: a scene without light, or a run that baked nothing (failures are errors,
+    told as such)."""
     warnings = [w for w in [empty_light_warning(scene)] if w]
-    if not any(r.status in ("ok", "warning") for r in results):
-        warnings.append("nothing baked: every object was skipped or failed")
+    if all(r.status == "skipped" for r in results):
+        warnings.append("nothing baked: every object's file exists (use --overwrite)")
     dark = [r.name for r in results if ZERO_LIGHT in r.notes]
     if dark and not warnings:  # the scene is lit, yet these objects receive none of this pass's light
         warnings.append(f"{len(dark)} object(s) baked no light: {', '.join(dark)}")

@@ -81,6 +81,7 @@ def test_bake_reports_each_object_and_keeps_files_inside(blend, tmp_path):
     assert r2.returncode == 0
     floor2 = json.loads((out / "bake.json").read_text())["objects"]["Floor"]
     assert floor2["status"] == "skipped" and "--overwrite" in floor2["message"]
+    assert "nothing baked" in json.loads((out / "bake.json").read_text())["warnings"][0]
 
 
 def test_shard_and_vertex_colors_into_a_copy(blend, tmp_path):
@@ -113,3 +114,36 @@ def test_bad_input_exits_2_with_one_line(blend, tmp_path, args, words):
     assert r.returncode == 2
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error:") and words in lines[0], r.stderr
+
+
+DARK = """
+import bpy, sys
+sys.path.insert(0, {root!r})
+from addon.bridge import scenes
+scenes.build("cornell")
+for light in [o for o in bpy.data.objects if o.type == "LIGHT"]:
+    bpy.data.objects.remove(light)
+bpy.ops.wm.save_as_mainfile(filepath={out!r})
+"""
+
+
+def test_a_scene_without_light_is_baked_with_a_warning(tmp_path):
+    # Valid but black: exit 0, and bake.json and stderr say why every value is zero.
+    dark = tmp_path / "dark.blend"
+    subprocess.run([sys.executable, "-c", DARK.format(root=str(ROOT), out=str(dark))], check=True,
+                   capture_output=True)
+    out = tmp_path / "out"
+    r = cli("bake", str(dark), "--out", str(out), "--objects", "Floor", *FAST)
+    assert r.returncode == 0, r.stderr
+    summary = json.loads((out / "bake.json").read_text())
+    assert len(summary["warnings"]) == 1 and "no light sources" in summary["warnings"][0]
+    floor = summary["objects"]["Floor"]
+    assert floor["status"] == "warning" and floor["warnings"] == ["no light: every baked value is zero"]
+    assert any(line.startswith("warning:") and "no light sources" in line for line in r.stderr.splitlines())
+
+
+def test_a_lit_bake_has_no_warnings(blend, tmp_path):
+    r = cli("bake", str(blend), "--out", str(tmp_path), "--objects", "Floor", *FAST)
+    assert r.returncode == 0, r.stderr
+    summary = json.loads((tmp_path / "bake.json").read_text())
+    assert summary["warnings"] == [] and summary["objects"]["Floor"]["warnings"] == []
