@@ -235,7 +235,7 @@ def test_cli_reference_and_compare(scene_4x3, ref32, tmp_path):
     r = cli("reference", scene_4x3[0], "--out", out, "--spp", 4, "--res", 32, "--seed", 5)
     assert r.returncode == 0, r.stderr
     stats = json.loads(r.stdout.strip().splitlines()[-1])
-    assert stats["seed"] == 5 and (out / "albedo.exr").is_file()
+    assert stats["seed"] == stats["cycles"]["seed"] == 5 and (out / "albedo.exr").is_file()  # the seed used
     # compare: the reference (B) has alpha -> masked
     r = cli("compare", out / "indirect.exr", ref32[0] / "indirect.exr")
     assert r.returncode == 0, r.stderr
@@ -271,6 +271,7 @@ def test_cli_compare_rgb_and_size_mismatch(tmp_path):
     (("--bounces", 0), "--bounces"),
     (("--res", 4), "--res"),
     (("--res", 9000), "--res"),
+    (("--seed", -1), "--seed -1"),  # Cycles would clamp it to 0 and the stats would name -1
 ])
 def test_cli_reference_bad_values(scene_4x3, tmp_path, extra, message):
     r = cli("reference", scene_4x3[0], "--out", tmp_path / "o", *extra)
