@@ -41,7 +41,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as exc:  # a bad flag (one line printed by _Parser) or --help: the status, as for a run
+        return int(exc.code or 0)
     with removed_on_failure(getattr(args, "out", None)) as report_status:
         try:
             code = int(args._run(args) or 0)

@@ -12,10 +12,7 @@ from addon.commands._args import removed_on_failure
 
 
 def run_cli(capsys, *args) -> tuple[int, list[str]]:
-    try:
-        code = main([str(a) for a in args])
-    except SystemExit as exc:  # argparse's errors
-        code = exc.code
+    code = main([str(a) for a in args])
     return code, capsys.readouterr().err.strip().splitlines()
 
 
