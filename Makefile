@@ -1,10 +1,11 @@
 # The two commands of the README: `make demo` and `make test`. Both create .venv on first use.
+# `make test-blender`: the real-Blender tier (Debian's Blender 4.3 in a chroot under .cache/; root).
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint extension clean
+.PHONY: demo test test-blender lint extension clean
 
 $(STAMP): requirements.txt
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -17,6 +18,10 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(PY) -m pytest -q
+
+test-blender: $(STAMP)
+	$(PY) tools/real_blender.py setup
+	BOUNCE_REAL_BLENDER=1 $(PY) -m pytest -q tests/real_blender
 
 lint: $(STAMP)
 	$(PY) -m ruff check .

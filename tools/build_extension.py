@@ -142,15 +142,19 @@ def build(out_dir: Path) -> list[Path]:
     return sorted(out_dir.glob("bounce-*.zip"))
 
 
+def build_all(out_dir: Path) -> list[Path]:
+    """Wheels, manifest, zips: what `make extension` does; the zips' paths."""
+    if write_manifest_wheels(download_wheels()):
+        print(f"updated the wheels of {MANIFEST.name}: commit it", file=sys.stderr)
+    return build(out_dir)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=ROOT / "dist", help="output folder for the zips")
     args = parser.parse_args(argv)
     try:
-        wheels = download_wheels()
-        if write_manifest_wheels(wheels):
-            print(f"updated the wheels of {MANIFEST.name}: commit it", file=sys.stderr)
-        for zip_path in build(args.out):
+        for zip_path in build_all(args.out):
             print(zip_path)
     except BuildError as exc:
         print(f"error: {exc}", file=sys.stderr)

@@ -1,0 +1,105 @@
+"""In a real window: the overlay of each method drawing in the 3D view, screenshots, a light moved.
+-- SHOT_DIR RESULT.json   (run with the Cornell .blend opened, DISPLAY set, the extension enabled)
+
+Blender's event loop must run for a 3D view to draw, so the steps are a timer's: each returns the delay
+to the next. Screenshots are the X screen (`xwd`, converted by ImageMagick): what a user sees. The
+result records the 3D view's rectangle, so the test can crop it."""
+
+import os
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(__file__))
+import _common  # noqa: E402
+import bpy  # noqa: E402
+
+METHODS = ("direct", "rsm", "lpv", "vct")
+WAIT_S = 120.0  # llvmpipe: vct's first update in a window takes seconds; a GPU takes milliseconds
+
+shot_dir, result_path = _common.args()[:2]
+result = {"blender": bpy.app.version_string, "methods": {}}
+
+
+def shot(name):
+    path = os.path.join(shot_dir, f"{name}.png")
+    subprocess.run(f"xwd -root -silent -display {os.environ['BOUNCE_DISPLAY']} | convert xwd:- {path}",
+                   shell=True, check=True)
+    return path
+
+
+def view3d():
+    screen = bpy.context.window_manager.windows[0].screen
+    return next(a for a in screen.areas if a.type == "VIEW_3D")
+
+
+def redraw():
+    view3d().tag_redraw()
+
+
+def finish(error=None):
+    import traceback
+
+    if error is not None:
+        result.update(ok=False, error=f"{type(error).__name__}: {error}", traceback=traceback.format_exc())
+    else:
+        result["ok"] = True
+    _common.write(result_path, result)
+    os._exit(0 if error is None else 1)
+
+
+def steps():
+    """A generator of delays: the timer below advances it once per call."""
+    live, viewport = _common.bounce("addon.bridge.live"), _common.bounce("addon.bridge.viewport")
+    area = view3d()
+    space = area.spaces.active
+    space.region_3d.view_perspective = "CAMERA"
+    space.shading.type = "SOLID"
+    space.overlay.show_overlays = False  # gizmos and grid off: only the scene and Bounce's light
+    window = bpy.context.window_manager.windows[0]
+    result["window"] = [window.width, window.height]
+    result["area"] = [area.x, area.y, area.width, area.height]
+    redraw()
+    yield 2.0
+    result["off"] = shot("off")
+    settings = bpy.context.scene.bounce
+    settings.lpv.grid_cells, settings.vct.voxel_cells, settings.vct.diffuse_cones = 16, 32, 6
+    spot = bpy.data.objects["Spot"]
+    for method in METHODS:
+        entry = result["methods"].setdefault(method, {})
+        for phase in ("on", "moved"):
+            runs = viewport.gpu_runs
+            if phase == "on":
+                settings.gi.method = method
+                settings.enabled = True
+            else:
+                spot.location.x += 0.25  # the light moves: the overlay must follow
+            t0 = time.perf_counter()
+            while viewport.gpu_runs == runs or live.STATE.quality != "full" or bpy.app.timers.is_registered(live.tick):
+                if live.STATE.error or time.perf_counter() - t0 > WAIT_S:
+                    break
+                redraw()
+                yield 0.25
+            redraw()
+            yield 1.0  # the updated frame reaches the screen
+            entry[phase] = {"shot": shot(f"{method}_{phase}"), "status": live.status(), "error": live.STATE.error,
+                            "gpu_runs": viewport.gpu_runs - runs, "wait_s": round(time.perf_counter() - t0, 2)}
+        spot.location.x -= 0.25
+        settings.enabled = False
+        redraw()
+        yield 0.5
+
+
+_steps = steps()
+
+
+def tick():
+    try:
+        return next(_steps)
+    except StopIteration:
+        finish()
+    except Exception as exc:  # noqa: BLE001 - everything is reported to the host
+        finish(exc)
+
+
+bpy.app.timers.register(tick, first_interval=2.0)
