@@ -37,6 +37,15 @@ def test_render_writes_products_and_stats(scenes_dir, tmp_path):
     assert (tmp_path / "direct.exr").is_file()
 
 
+def test_progress_on_stderr_unless_quiet(scenes_dir, tmp_path):
+    args = ("render", str(scenes_dir / "cornell.blend"), "--out", str(tmp_path), "--res", "32", "--repeat", "1")
+    loud, quiet = cli(*args), cli(*args, "--quiet")
+    assert loud.returncode == quiet.returncode == 0, loud.stderr
+    assert "bounce: timed run 1/1" in loud.stderr and "bounce:" not in quiet.stderr
+    for r in (loud, quiet):  # stdout's last line stays the JSON result
+        assert json.loads(r.stdout.strip().splitlines()[-1])["out"] == str(tmp_path)
+
+
 @pytest.mark.parametrize(
     ("args", "needle"),
     [
