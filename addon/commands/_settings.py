@@ -11,6 +11,7 @@ with one line naming the flag as it was typed (`error: --grid 3: out of range [8
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import re
 from dataclasses import dataclass
 from typing import Any
@@ -131,6 +132,8 @@ class _Checked(argparse.Action):
 
 
 class _CheckedBool(argparse.BooleanOptionalAction):
+    """--flag / --no-flag; records that the user gave it."""
+
     def __call__(self, parser, namespace, values, option_string=None):
         super().__call__(parser, namespace, values, option_string)
         _mark_given(namespace, self.dest)
@@ -145,13 +148,13 @@ def given(args, dest: str) -> bool:
     return dest in getattr(args, _GIVEN, frozenset())
 
 
-def _add(parser, setting: Setting, flags: tuple[str, ...], default, help_text: str) -> None:
+def _add(parser, setting: Setting) -> None:
+    common = {"dest": setting.dest, "default": setting.default, "help": setting.help()}
     if setting.kind is bool:
-        parser.add_argument(*flags, dest=setting.dest, action=_CheckedBool, default=default, help=help_text)
+        parser.add_argument(*setting.flags, action=_CheckedBool, **common)
         return
     metavar = "{" + ",".join(setting.choices) + "}" if setting.choices else setting.kind.__name__.upper()
-    parser.add_argument(*flags, dest=setting.dest, action=_Checked, setting=setting, default=default,
-                        metavar=metavar, help=help_text)
+    parser.add_argument(*setting.flags, action=_Checked, setting=setting, metavar=metavar, **common)
 
 
 def add_config_flags(parser) -> None:
@@ -161,16 +164,15 @@ def add_config_flags(parser) -> None:
                                           (cls.__doc__ or "").strip().splitlines()[0])
         for setting in SETTINGS:
             if setting.fields[0][0] is cls:
-                _add(group, setting, setting.flags, setting.default, setting.help())
+                _add(group, setting)
 
 
 def add_field_flag(parser, cls: type, name: str, *flags: str, default=None, doc: str | None = None) -> None:
     """One flag checked against a config field's limits, for commands that do not build that config
     (reference's --res, screenshot's --method): the flag, default and help may be the command's own."""
     setting = _find(cls, name)
-    own = Setting(flags or setting.flags, setting.fields, setting.default if default is None else default,
-                  doc or setting.doc, setting.lo, setting.hi, setting.choices)
-    _add(parser, own, own.flags, own.default, own.help())
+    _add(parser, dataclasses.replace(setting, flags=flags or setting.flags, doc=doc or setting.doc,
+                                     default=setting.default if default is None else default))
 
 
 def flag_name(cls: type, name: str) -> str:
