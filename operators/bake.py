@@ -92,6 +92,10 @@ class BOUNCE_OT_bake(bpy.types.Operator):
         except BounceError as exc:
             self.report({"ERROR"}, str(exc))
             return False
+        # A scene without light bakes black images: say so once (the bake still runs, as asked).
+        self._unlit = bake.empty_light_warning(self._baker.scene)
+        if self._unlit:
+            self.report({"WARNING"}, self._unlit)
         return True
 
     def _bake(self, obj) -> None:
@@ -100,11 +104,13 @@ class BOUNCE_OT_bake(bpy.types.Operator):
 
         try:
             if self.target == "image":
-                rgba, notes = self._baker.bake_image(obj, self.size, self.pass_name, self.margin)
-                bake.store_image(bake.image_name(obj.name, self.pass_name), rgba)
+                values, notes = self._baker.bake_image(obj, self.size, self.pass_name, self.margin)
+                bake.store_image(bake.image_name(obj.name, self.pass_name), values)
             else:
-                colors, notes = self._baker.bake_vertex_colors(obj, self.pass_name)
-                bake.store_vertex_colors(obj.data, bake.attribute_name(self.pass_name), colors)
+                values, notes = self._baker.bake_vertex_colors(obj, self.pass_name)
+                bake.store_vertex_colors(obj.data, bake.attribute_name(self.pass_name), values)
+            dark = None if self._unlit else bake.zero_light_warning(values)  # the scene's warning says it
+            notes = notes + [dark] if dark else notes
             self._done += 1
             for note in notes:
                 self.report({"WARNING"}, f"{obj.name}: {note}")

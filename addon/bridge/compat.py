@@ -47,7 +47,8 @@ def clear_light_exposure(light_data) -> None:
 # on): the documented dict raises "'GPUTexture' object cannot be interpreted as an integer", while
 # {"layer": t, "texture": k} attaches texture t's layer k. The documented form is tried first; it
 # raises on a build with the inversion, and the swapped form raises on every build without it, so
-# the probe cannot pick the wrong one (tests/real_blender checks the layer written on both).
+# the probe cannot pick the wrong one. The real-Blender tier's lpv and vct overlays (which splat into
+# 3D-texture layers) draw on 4.3; tests/blender checks those passes equal moderngl's on 5.0.
 _layer_keys: tuple[str, str] | None = None
 
 

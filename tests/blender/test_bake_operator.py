@@ -107,3 +107,26 @@ def test_modal_bake_steps_per_timer_and_cancels_on_escape(bounce):
     assert BOUNCE_OT_bake.modal(op, context, timer) == {"RUNNING_MODAL"}
     assert BOUNCE_OT_bake.modal(op, context, timer) == {"FINISHED"}
     assert op.baked == ["obj0", "obj1"] and op.stopped == 1
+
+
+def test_bake_is_kept_by_the_file(cornell, tmp_path):
+    # A new image has no users; Blender drops such datablocks when it saves. The bake's fake user keeps
+    # it (the real-Blender tier saves and reloads in 4.3; this is the same under 5.0).
+    select(cornell, "Floor")
+    assert bpy.ops.bounce.bake(size=8, pass_name="indirect", target="image") == {"FINISHED"}
+    assert bpy.data.images["Floor_bounce_indirect"].use_fake_user
+    path = tmp_path / "kept.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    img = bpy.data.images["Floor_bounce_indirect"]
+    assert img.packed_file is not None and tuple(img.size) == (8, 8)
+
+
+def test_unlit_scene_bakes_with_a_warning(cornell, capfd):
+    # Black images reported as a success would look like a broken bake: the operator says why.
+    bpy.data.objects.remove(bpy.data.objects["Spot"])
+    select(cornell, "Floor")
+    capfd.readouterr()
+    assert bpy.ops.bounce.bake(size=8, pass_name="indirect", target="image") == {"FINISHED"}
+    out = capfd.readouterr().out
+    assert "no light sources" in out, out  # background Blender prints reports as "Warning: <message>"
