@@ -170,16 +170,20 @@ def test_settings_survive_save_and_reload(registered, tmp_path):
 
 
 class _RecordingLayout:
-    """Stands in for UILayout (there is no UI in background mode): records what a panel draws."""
+    """Stands in for UILayout (there is no UI in background mode): records what a panel draws, and
+    which operators it draws greyed out (`active` False on the layout or one it was made from)."""
 
-    def __init__(self, drawn):
-        self.drawn = drawn
+    def __init__(self, drawn, greyed=None, parent=None):
+        self.drawn, self.greyed, self.parent = drawn, greyed if greyed is not None else [], parent
+        self.active = True
+
+    def _greyed(self) -> bool:
+        return not self.active or (self.parent is not None and self.parent._greyed())
 
     def column(self, **_kwargs):
-        return self
+        return _RecordingLayout(self.drawn, self.greyed, self)
 
-    def box(self, **_kwargs):
-        return self
+    box = column
 
     def label(self, **_kwargs):
         pass
@@ -190,6 +194,8 @@ class _RecordingLayout:
 
     def operator(self, idname, **_kwargs):
         self.drawn.append(idname)
+        if self._greyed():
+            self.greyed.append(idname)
 
 
 def test_panel_draws_every_setting(registered):
@@ -204,8 +210,18 @@ def test_panel_draws_every_setting(registered):
         return drawn
 
     fields = [*config.limits(config.GIConfig), *config.limits(config.RsmConfig)]
-    # The LPV group only while method lpv is selected (the default method is direct).
+    # The LPV group only while method lpv is selected (the default method is rsm).
     assert drawn_settings() == ["enabled", *fields, "bounce.report_renderer", "bounce.bake"]
     bpy.context.scene.bounce.gi.method = "lpv"
     lpv_fields = list(config.limits(config.LpvConfig))
     assert drawn_settings() == ["enabled", *fields, *lpv_fields, "bounce.report_renderer", "bounce.bake"]
+
+
+def test_bake_button_is_not_greyed_while_the_overlay_is_off(registered):
+    # A bake does not need the overlay: only the settings are drawn greyed (still editable) when it is off.
+    from bounce.panels.main import BOUNCE_PT_main
+
+    layout = _RecordingLayout([])
+    bpy.context.scene.bounce.enabled = False
+    BOUNCE_PT_main.draw(type("Panel", (), {"layout": layout})(), bpy.context)
+    assert "bounce.bake" in layout.drawn and layout.greyed == []
