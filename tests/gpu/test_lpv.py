@@ -7,11 +7,10 @@ linear in the coefficients, so it is conserved (or not) exactly, not up to the L
 Volumes read back as (z, y, x, 4) arrays.
 """
 
-import functools
-
 import numpy as np
 import pytest
 
+from addon.engine import lpv_reference as ref
 from addon.engine import sh
 from addon.engine.config import GIConfig, LpvConfig, RsmConfig
 from addon.engine.grid import Grid
@@ -23,89 +22,17 @@ from addon.engine.transforms import look_along, perspective
 
 pytestmark = pytest.mark.gpu
 
-FRONT, SIDE = 0.4006696846, 0.4234313544
-AXES = [np.array(v, float) for v in ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1))]
-FLUX_PER_C0 = 2.0 * np.sqrt(np.pi)
 
-
-# -- numpy reference of one propagation step ----------------------------------------------------------
-@functools.cache
-def transfer_matrices(variant):
-    """M_d (4x4, acting on (1, y, z, x) coefficients) for the six travel directions d, as in
-    propagate.comp.glsl, built independently: classic from the five faces, improved by quadrature
-    (full 4x4 matrices, so the shader's symmetric form is checked)."""
-    mats = []
-    if variant == "classic":
-        for d in AXES:
-            m = np.zeros((4, 4))
-            for f in AXES:
-                if f @ d < -0.5:
-                    continue
-                w = d if f @ d > 0.5 else (d + 0.5 * f) / np.linalg.norm(d + 0.5 * f)
-                omega = FRONT if f @ d > 0.5 else SIDE
-                m += omega * np.outer(sh.cosine_lobe_l1(f) / np.pi, sh.basis_l1(w))
-            mats.append(m)
-        return mats
-    # M_+x by quadrature (full 4x4), rotated to the other axes exactly: a (theta, phi) rule is not
-    # symmetric between x and z, so quadrature per axis would differ by its own ~1e-5 error.
-    dirs, wts = sh.sphere_quadrature(1024, 2048)
-    y = sh.basis_l1(dirs)
-    wx = wts * np.maximum(dirs[:, 0], 0.0) / np.abs(dirs).sum(axis=1)
-    m_x = np.einsum("k,ki,kj->ij", wx, y, y)
-    slot = {0: 3, 1: 1, 2: 2}  # axis -> coefficient index in (1, y, z, x)
-    for d in AXES:
-        a = int(np.argmax(np.abs(d)))
-        rot = np.eye(3)
-        rot[:, [0, a]] = rot[:, [a, 0]]  # swap x and axis a: maps e_x to e_a ...
-        rot[:, 0] *= d[a]  # ... with d's sign (a signed permutation keeps |w|_1)
-        p = np.zeros((4, 4))
-        p[0, 0] = 1.0
-        for i in range(3):
-            for j in range(3):
-                p[slot[i], slot[j]] = rot[i, j]
-        mats.append(p @ m_x @ p.T)
-    return mats
-
-
-def shifted(v, d):
-    """out[B] = v[B - d], zero where B - d is outside; v is (z, y, x, ...)."""
-    out = np.zeros_like(v)
-    src, dst = [slice(None)] * 3, [slice(None)] * 3
-    for axis, step in zip((2, 1, 0), d.astype(int), strict=True):  # x, y, z -> array axes
-        if step == 1:
-            src[axis], dst[axis] = slice(0, -1), slice(1, None)
-        elif step == -1:
-            src[axis], dst[axis] = slice(1, None), slice(0, -1)
-    out[tuple(dst)] = v[tuple(src)]
-    return out
-
-
-def pass_through(geometry, d, surface_offsets):
-    """(z, y, x) share of the light of cell B - d that enters B, B on the grid: 1 - b_A s_A - b_B (1 - s_B),
-    b = min(1, projected area along d's axis), s = the share of b on the transfer leaving along d:
-    0.5 + the surfaces' offset along d (clamped to 0..1) with surface offsets, else 0.5."""
-    axis = int(np.flatnonzero(d)[0])
-    b = np.minimum(1.0, geometry["vox_projected"][..., axis].astype(np.float64))
-    if surface_offsets:
-        s = np.clip(0.5 + d[axis] * geometry["vox_offset"][..., axis].astype(np.float64), 0.0, 1.0)
-    else:
-        s = np.full(b.shape, 0.5)
-    return np.maximum(0.0, 1.0 - shifted(b * s, d) - b * (1.0 - s))
-
-
+# -- numpy reference of one propagation step (addon/engine/lpv_reference.py) ----------------------------
 def reference_step(channels, variant, geometry=None, surface_offsets=True):
-    """channels: list of (z, y, x, 4) arrays -> the next snapshot of each (float64)."""
-    mats = transfer_matrices(variant)
-    out = [np.zeros(c.shape) for c in channels]
-    for d, m in zip(AXES, mats, strict=True):
-        if geometry is None:
-            through = 1.0
-        else:
-            # Classic (the published baseline) splits every cell's blocking half and half.
-            through = pass_through(geometry, d, surface_offsets and variant == "improved")[..., None]
-        for o, c in zip(out, channels, strict=True):
-            o += through * (shifted(c.astype(np.float64), d) @ m.T)
-    return out
+    """channels: list of (z, y, x, 4) arrays -> the next snapshot of each (float64). `geometry`:
+    {"vox_projected", "vox_offset"} (z, y, x, 4); classic (the published baseline) splits every cell's
+    blocking half and half, as LpvVolume does."""
+    through = None
+    if geometry is not None:
+        offsets = geometry["vox_offset"] if surface_offsets and variant == "improved" else None
+        through = ref.pass_through(*ref.blocking(geometry["vox_projected"], offsets))
+    return [ref.step(c, ref.transfer_matrices(variant), through) for c in channels]
 
 
 # -- GPU helpers --------------------------------------------------------------------------------------
@@ -145,7 +72,7 @@ def random_field(rng, dims, cells=6):
 
 
 def flux(channels):
-    return np.array([FLUX_PER_C0 * np.sum(c[..., 0], dtype=np.float64) for c in channels])
+    return np.array([ref.flux_w(c) for c in channels])
 
 
 # -- injection ----------------------------------------------------------------------------------------
@@ -173,13 +100,10 @@ def test_injection_of_one_vpl_gives_its_lobe(gl):
     lpv_inject.unpack(gl, atlas_tex, vols, grid, atlas)
     got = [gl.read(vols[f"sh_{c}"]) for c in "rgb"]
 
-    expected = [np.zeros_like(got[0]) for _ in range(3)]
-    for p, n, f in ((p1, n1, f1), (p2, n2, f2)):
-        x, y, z = np.floor((p + 0.25 * n) / 0.5).astype(int)  # half a cell (0.25 m) along n
-        for ch in range(3):
-            expected[ch][z, y, x] += f[ch] / np.pi * sh.cosine_lobe_l1(n)
+    vpl_pos, vpl_nrm, vpl_flux = np.array([p1, p2]), np.array([n1, n2]), np.array([f1, f2])
+    expected = [ref.inject(grid, vpl_pos, vpl_nrm, vpl_flux[:, ch]) for ch in range(3)]
     # The two VPLs land in different layers (tiles), and every other cell's stale content is overwritten.
-    assert np.floor((p1 + 0.25 * n1) / 0.5)[2] != np.floor((p2 + 0.25 * n2) / 0.5)[2]
+    assert len(set(ref.injection_cells(grid, vpl_pos, vpl_nrm)[:, 2])) == 2
     for ch in range(3):
         # fp32 arithmetic of a few products: 1e-6 relative to the largest coefficient.
         np.testing.assert_allclose(got[ch], expected[ch], atol=1e-6 * np.abs(expected[ch]).max())
@@ -227,16 +151,12 @@ def test_injection_with_emitter_classes_puts_each_vpl_in_its_class_block(gl):
     plain, blocks = blocks[-1], blocks[:-1]
     cls = lpv_inject.emitter_class(n)
     assert set(cls) == set(range(6))  # every block is exercised
-    cells = np.floor((p + 0.3 * n) / 0.5).astype(int)
+    cells = ref.injection_cells(grid, p, n)
     inside = np.all((cells >= 0) & (cells < grid.dims), axis=1)
     assert inside.sum() >= 30
     np.testing.assert_allclose(flux(plain), f[inside].sum(axis=0), rtol=1e-5)
     for k, got in enumerate(blocks):
-        want = [np.zeros_like(got[0]) for _ in range(3)]
-        for i in np.flatnonzero((cls == k) & inside):
-            x, y, z = cells[i]  # the cell 0.6 cells along n
-            for ch in range(3):
-                want[ch][z, y, x] += f[i, ch] / np.pi * sh.cosine_lobe_l1(n[i])
+        want = [ref.inject(grid, p[cls == k], n[cls == k], f[cls == k, ch]) for ch in range(3)]
         for ch in range(3):
             # fp32 sums of a few products: 1e-6 of the largest coefficient.
             np.testing.assert_allclose(got[ch], want[ch], atol=1e-6 * np.abs(plain[ch]).max())
@@ -322,7 +242,7 @@ def point_source_profile(gl, variant, iterations, length=36, side=31):
     grid = Grid(np.zeros(3), 1.0, (length + 6, side, side))
     src = (4, side // 2, side // 2)  # x, y, z
     field = [np.zeros((side, side, length + 6, 4), np.float32) for _ in range(3)]
-    field[0][src[2], src[1], src[0], 0] = 1.0 / FLUX_PER_C0  # P = 1 W in the red channel
+    field[0][src[2], src[1], src[0], 0] = 1.0 / ref.FLUX_PER_C0  # P = 1 W in the red channel
     sets = [volumes(gl, grid.dims, field), volumes(gl, grid.dims)]
     acc = {f"acc_{c}": gl.texture(grid.dims) for c in "rgb"}
     for i in range(iterations):
@@ -467,7 +387,7 @@ def far_field_point_source_profile(gl, near, length=36, side=31):
     coarse = lpv_far_field.grid_for(grid)
     src = (4, side // 2, side // 2)
     field = [np.zeros((side, side, length + 6, 4), np.float32) for _ in range(3)]
-    field[0][src[2], src[1], src[0], 0] = 1.0 / FLUX_PER_C0
+    field[0][src[2], src[1], src[0], 0] = 1.0 / ref.FLUX_PER_C0
     fine_sets = [volumes(gl, grid.dims, field), volumes(gl, grid.dims)]
     coarse_sets = [volumes(gl, coarse.dims), volumes(gl, coarse.dims)]
     lpv_far_field.source(gl, fine_sets[0], grid, coarse_sets[0], coarse)
@@ -498,30 +418,10 @@ def test_far_field_point_source_irradiance_along_an_axis(gl):
 
 
 # -- lookup -------------------------------------------------------------------------------------------
-def reference_lookup(acc, vox_normal, grid, pos, nrm, offset_cells=0.5):
-    """numpy twin of lookup.comp.glsl with the geometry volume: E / pi per pixel, the trilinear corners of
-    p = pos + offset h n weighted by 1 - min(1, w |n_cell . n|) and renormalised (plain trilinear when
-    every corner is blocked). acc: per channel (z, y, x, 4); pos, nrm: (k, 3)."""
-    out = np.zeros((len(pos), 3))
-    for k, (p, n) in enumerate(zip(pos, nrm, strict=True)):
-        n = n / np.linalg.norm(n)
-        t = (p + offset_cells * grid.cell_size_m * n - grid.origin_m) / grid.cell_size_m - 0.5  # x, y, z
-        i0 = np.floor(t).astype(int)
-        f = t - i0
-        lobe = sh.cosine_lobe_l1(-n)
-        aware, plain, w_sum = np.zeros(3), np.zeros(3), 0.0
-        for corner in np.ndindex(2, 2, 2):  # x, y, z offsets
-            c = np.clip(i0 + corner, 0, np.array(grid.dims) - 1)
-            w = np.prod([f[a] if corner[a] else 1.0 - f[a] for a in range(3)])
-            nv = vox_normal[c[2], c[1], c[0]]
-            through = 1.0 - min(1.0, nv[3] * abs(nv[:3] @ n))
-            v = np.array([a[c[2], c[1], c[0]] @ lobe for a in acc])
-            plain += w * v
-            aware += w * through * v
-            w_sum += w * through
-        e = aware / w_sum if w_sum > 1e-4 else plain
-        out[k] = np.maximum(e, 0.0) / (grid.cell_size_m**2 * np.pi)
-    return out
+def reference_lookup(acc, vox_normal, grid, pos, nrm):
+    """The numpy twin of lookup.comp.glsl with the geometry volume per colour: E / pi (k, 3); acc: per
+    channel (z, y, x, 4); pos, nrm: (k, 3)."""
+    return np.stack([ref.lookup(a, grid, pos, nrm, vox_normal) for a in acc], axis=-1)
 
 
 def test_lookup_skips_the_cells_a_surface_blocks(gl):
@@ -584,7 +484,7 @@ def test_lookup_with_emitter_classes_reads_every_class_but_its_own(gl):
     k = 24
     pos = rng.uniform([-0.9, 0.1, 0.1], [1.9, 2.4, 1.9], size=(k, 3))
     nrm = rng.normal(size=(k, 3))
-    nrm[:6] = AXES
+    nrm[:6] = ref.DIRECTIONS
     nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
     gbuf = {"position": gl.texture((k, 1), "RGBA32F", np.c_[pos, np.ones(k)].reshape(1, k, 4).astype(np.float32)),
             "normal": gl.texture((k, 1), "RGBA32F", np.c_[nrm, np.zeros(k)].reshape(1, k, 4).astype(np.float32))}
@@ -608,19 +508,6 @@ def test_lookup_with_emitter_classes_reads_every_class_but_its_own(gl):
 
 
 # -- re-injection (bounces 2..) ----------------------------------------------------------------------
-def trilinear(v, g):
-    """v (z, y, x, 4) sampled at grid coordinates g = (x, y, z) in cells (centres at i + 0.5), clamped
-    to the edge texels as the backend's samplers are."""
-    t = np.asarray(g, float)[::-1] - 0.5  # z, y, x
-    i0 = np.floor(t).astype(int)
-    f = t - i0
-    out = np.zeros(4)
-    for corner in np.ndindex(2, 2, 2):
-        idx = tuple(int(np.clip(i0[k] + corner[k], 0, v.shape[k] - 1)) for k in range(3))
-        out += np.prod([f[k] if corner[k] else 1.0 - f[k] for k in range(3)]) * v[idx]
-    return out
-
-
 def reference_reinject(acc, vox_normal, vox_albedo, vox_projected, side_acc=None):
     """numpy twin of reinject.comp.glsl: per cell A with a surface, phi = albedo * w * max(0, c . lobe(-m))
     on the better lit side m, c trilinear at A's centre + m / 2 over the corners q weighted by their
@@ -655,7 +542,7 @@ def reference_reinject(acc, vox_normal, vox_albedo, vox_projected, side_acc=None
         m = side * n
         phi = vox_albedo[z, y, x, :3] * vox_normal[z, y, x, 3] * e[side]
         phi_cells[z, y, x] = phi
-        for d in AXES:
+        for d in ref.DIRECTIONS:
             share = max(m @ d, 0.0) / np.abs(m).sum()
             bx, by, bz = np.array([x, y, z]) + d.astype(int)
             if share > 0 and 0 <= bx < shape[2] and 0 <= by < shape[1] and 0 <= bz < shape[0]:
