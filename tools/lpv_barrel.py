@@ -28,14 +28,13 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from addon.engine import sh  # noqa: E402
-from addon.engine.passes.lpv_propagate import improved_constants  # noqa: E402
+from addon.engine import lpv_reference as ref  # noqa: E402
+from addon.engine.grid import Grid  # noqa: E402
 
 GRID_YZ = 48  # cells across the vault's plane: room for the largest radius and its light's spread
 GRID_X = 8  # periodic along the axis: an infinite vault
+GRID = Grid(np.zeros(3), 1.0, (GRID_X, GRID_YZ, GRID_YZ))  # cell units: h = 1
 ARC_SAMPLES = 2000
-INJECT_OFFSET = 0.6  # cells along n, as lpv_inject
-LOOKUP_OFFSET = 0.5  # cells along n, as lpv_lookup
 
 
 def arc(radius: float, centre: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
@@ -57,49 +56,24 @@ def class_of(normal_yz: np.ndarray, classes: str) -> int:
     return int(angle // (2.0 * np.pi / k)) % k
 
 
-def transfer_matrices() -> list[tuple[int, int, np.ndarray]]:
-    """(array axis, step sign, M_d) for the six directions of the improved transport."""
-    c = improved_constants()
-    out = []
-    for array_axis, sh_index in ((1, 3), (2, 1), (3, 2)):  # volume axes x, y, z; SH order (1, y, z, x)
-        for sign in (1, -1):
-            m = np.diag([1.0 / 6.0, c["m_side"], c["m_side"], c["m_side"]])
-            m[sh_index, sh_index] = c["m_along"]
-            m[0, sh_index] = m[sh_index, 0] = sign * c["m_cross"]
-            out.append((array_axis, sign, m))
-    return out
+def propagate(injected: np.ndarray) -> np.ndarray:
+    """Accumulated coefficients (z, y, x, 4): the improved transport on the empty grid, periodic in x,
+    long enough for the light to cross the grid's plane."""
+    matrices, path = ref.gpu_improved_transfer()
+    return ref.accumulate(injected, matrices, path, 3 * GRID_YZ, periodic_axes=(0,))
 
 
-def propagate(injected: np.ndarray, steps: int) -> np.ndarray:
-    """Accumulated coefficients (4, X, Y, Z): the improved transport, S0 not accumulated, periodic in x."""
-    path_weight = improved_constants()["path_weight"]
-    transfers = transfer_matrices()
-    current, accumulated = injected, np.zeros_like(injected)
-    for _ in range(steps):
-        moved = np.zeros_like(current)
-        for array_axis, sign, m in transfers:
-            shifted = np.roll(np.einsum("ij,j...->i...", m, current), sign, axis=array_axis)
-            if array_axis != 1:  # y and z have borders: what rolled over leaves the grid
-                border = [slice(None)] * 4
-                border[array_axis] = 0 if sign > 0 else -1
-                shifted[tuple(border)] = 0.0
-            moved += shifted
-        current = moved
-        accumulated += path_weight * current
-    return accumulated
+def in_3d(yz: np.ndarray) -> np.ndarray:
+    """(n, 2) points or normals in the vault's plane -> (n, 3) with x = 0."""
+    return np.c_[np.zeros(len(yz)), yz]
 
 
-def trilinear(volume: np.ndarray, point_xyz: np.ndarray) -> np.ndarray:
-    """Coefficients (4,) at a point in cell units (cell centres at i + 0.5), periodic in x."""
-    p = point_xyz - 0.5
-    base = np.floor(p).astype(int)
-    frac = p - base
-    out = np.zeros(4)
-    for corner in np.ndindex(2, 2, 2):
-        w = np.prod([f if c else 1.0 - f for f, c in zip(frac, corner, strict=True)])
-        i = base + np.array(corner)
-        out += w * volume[:, i[0] % volume.shape[1], i[1], i[2]]
-    return out
+def inject(points: np.ndarray, normals: np.ndarray, ds: float) -> np.ndarray:
+    """The snapshot (z, y, x, 4) of arc samples of exitance 1, injected as the method injects VPLs: a VPL
+    of flux ds per sample and cell along the axis."""
+    x_m = np.repeat(np.arange(GRID_X) + 0.5, len(points))  # the arc's copy through each cell centre
+    pos = np.c_[x_m, np.tile(points, (GRID_X, 1))]
+    return ref.inject(GRID, pos, np.tile(in_3d(normals), (GRID_X, 1)), np.full(len(pos), ds))
 
 
 def exact_irradiance(
@@ -122,26 +96,20 @@ def vault_readings(radius: float, classes: str, receiver_angles_deg: list[float]
     centre = np.array([GRID_YZ / 2 + 0.3, GRID_YZ / 2 + 0.1])  # off the cell lattice: no alignment luck
     points, normals, ds = arc(radius, centre)
     n_classes = 1 if classes == "none" else (6 if classes == "axes" else int(classes))
-    injected = np.zeros((n_classes, 4, GRID_X, GRID_YZ, GRID_YZ))
-    for point, normal in zip(points, normals, strict=True):
-        cell = np.floor(point + INJECT_OFFSET * normal).astype(int)
-        flux = ds * 1.0  # exitance 1 over ds x one cell along x
-        lobe = flux / np.pi * sh.cosine_lobe_l1(np.array([0.0, normal[0], normal[1]]))
-        injected[class_of(normal, classes), :, :, cell[0], cell[1]] += lobe[:, None]
-    volumes = [propagate(v, 3 * GRID_YZ) if v.any() else np.zeros_like(v) for v in injected]
+    of_class = np.array([class_of(n, classes) for n in normals])
+    injected = [inject(points[of_class == c], normals[of_class == c], ds) for c in range(n_classes)]
+    volumes = [propagate(v) if v.any() else v for v in injected]
     total = sum(volumes)
     rows = []
     for angle in receiver_angles_deg:
         k = int(round(np.radians(angle) / np.pi * ARC_SAMPLES - 0.5))
         point, normal = points[k], normals[k]
-        lookup = np.array([GRID_X / 2, *(point + LOOKUP_OFFSET * normal)])
-        coeffs = trilinear(total, lookup)
-        if classes != "none":
-            coeffs = coeffs - trilinear(volumes[class_of(normal, classes)], lookup)
-        # the light arriving at the surface travels along -n (grids store direction of travel)
-        lpv = float(sh.irradiance(coeffs, -np.array([0.0, normal[0], normal[1]])))
+        # A receiver reads every class but its own (the reading is linear before its clamp).
+        seen = total if classes == "none" else total - volumes[of_class[k]]
+        receiver = np.array([[GRID_X / 2, *point]])
+        lpv = np.pi * float(ref.lookup(seen, GRID, receiver, in_3d(normal[None]))[0])  # E (h = 1), not E / pi
         if own_exact and classes != "none":
-            own = np.array([class_of(n, classes) == class_of(normal, classes) for n in normals])
+            own = of_class == of_class[k]
             lpv += exact_irradiance(point, normal, points[own], normals[own], ds)
         rows.append((angle, exact_irradiance(point, normal, points, normals, ds), lpv))
     return rows
