@@ -14,21 +14,24 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, Po
 
 from .engine import config
 
-# Group attribute on scene.bounce -> the config it mirrors.
-CONFIGS = {"gi": config.GIConfig, "rsm": config.RsmConfig, "lpv": config.LpvConfig, "vct": config.VctConfig}
-# Groups only one method reads -> that method: the panel shows them only while it is selected.
-GROUP_METHOD = {"lpv": "lpv", "vct": "vct"}
+# Group attribute on scene.bounce -> the config it mirrors (the panels show, per method, the fields the
+# registry says it reads).
+CONFIGS = config.GROUPS
 
 
 _ACRONYMS = {"vpl", "rsm", "lpv", "vct", "sh"}
-_UNITS = {"m": "m", "mb": "MB", "ms": "ms"}
+_UNITS = {"mb": "MB", "ms": "ms"}  # shown in the label; lengths and angles get Blender's own units
+# Config names carry their unit as a suffix: a length (`cell_size_m`) or an angle (`_rad`) becomes a
+# property with Blender's unit, so it displays and edits in the scene's units (1 m, 90°).
+_BLENDER_UNITS = {"m": {"subtype": "DISTANCE", "unit": "LENGTH"}, "rad": {"subtype": "ANGLE", "unit": "ROTATION"}}
 
 
 def _label(name: str) -> str:
-    # Config names carry their unit as a suffix (`cell_size_m`); the UI shows "Cell Size (m)".
+    # `cell_size_m` -> "Cell Size" (a length property), `budget_mb` -> "Budget (MB)".
     words = name.split("_")
-    unit = _UNITS.get(words[-1]) if len(words) > 1 else None
-    if unit:
+    suffix = words[-1] if len(words) > 1 else None
+    unit = _UNITS.get(suffix)
+    if unit or suffix in _BLENDER_UNITS:
         words = words[:-1]
     label = " ".join(w.upper() if w in _ACRONYMS else w.title() for w in words)
     return f"{label} ({unit})" if unit else label
@@ -37,6 +40,7 @@ def _label(name: str) -> str:
 def _property(name: str, spec: dict):
     label = _label(name)
     doc = spec.get("doc", "")
+    units = _BLENDER_UNITS.get(name.rsplit("_", 1)[-1], {}) if "_" in name else {}
     if "choices" in spec:
         items = [(c, c.replace("-", " ").title(), "") for c in spec["choices"]]
         return EnumProperty(name=label, description=doc, items=items, default=spec["default"])
@@ -47,7 +51,7 @@ def _property(name: str, spec: dict):
         return IntProperty(name=label, description=doc, default=default, min=spec["min"], max=spec["max"])
     if isinstance(default, float):
         return FloatProperty(
-            name=label, description=doc, default=default, min=spec["min"], max=spec["max"], precision=4
+            name=label, description=doc, default=default, min=spec["min"], max=spec["max"], precision=4, **units
         )
     raise TypeError(f"no Blender property for config field {name!r} (default {default!r}): add one here")
 

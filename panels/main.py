@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import bpy
 
-from ..addon.properties import CONFIGS, GROUP_METHOD
+from ..addon.engine import registry
+from ..addon.properties import CONFIGS
 
 
 class BOUNCE_PT_main(bpy.types.Panel):
@@ -25,15 +26,16 @@ class BOUNCE_PT_main(bpy.types.Panel):
         # does not need the overlay.
         settings_column = layout.column()
         settings_column.active = settings.enabled
-        # Every field of each group, in the config's order: a new config field appears without edits here.
-        # A method's own group (LPV) only while that method is selected.
+        # The fields the chosen method reads (the registry's `reads`), in each config's order: a new
+        # config field appears without edits here, under the methods that read it.
+        method = registry.get(settings.gi.method)
         for attr in CONFIGS:
-            if GROUP_METHOD.get(attr, settings.gi.method) != settings.gi.method:
-                continue
             group = getattr(settings, attr)
-            column = settings_column.column(heading=attr.upper())
-            for name in group.bl_rna.properties.keys():
-                if name not in {"rna_type", "name"}:
+            names = [n for n in group.bl_rna.properties.keys()
+                     if n not in {"rna_type", "name"} and method.reads_setting(attr, n)]
+            if names:
+                column = settings_column.column(heading=attr.upper())
+                for name in names:
                     column.prop(group, name)
         layout.operator("bounce.report_renderer", icon="INFO")
         box = layout.box()

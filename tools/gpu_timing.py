@@ -306,12 +306,12 @@ def time_method(be, method, scene, warmup: int, repeat: int, stamps: GpuTimestam
     # 1. what an update costs: no per-pass waits, one finish at the end
     method.profile = False
     for _ in range(warmup):
-        method.compute()
+        method.compute(solve=True)
     be.finish()
     totals = []
     for _ in range(repeat):
         t0 = time.perf_counter()
-        method.compute()
+        method.compute(solve=True)
         be.finish()
         totals.append((time.perf_counter() - t0) * 1e3)
     res["wall_total"] = summary(totals)
@@ -324,7 +324,7 @@ def time_method(be, method, scene, warmup: int, repeat: int, stamps: GpuTimestam
             runs = []
             for i in range(warmup + repeat):
                 stamps.begin_update()
-                method.compute()
+                method.compute(solve=True)
                 be.finish()
                 r = stamps.end_update()
                 if i >= warmup:
@@ -336,8 +336,8 @@ def time_method(be, method, scene, warmup: int, repeat: int, stamps: GpuTimestam
     # 3. method.profile: glFinish around every pass
     method.profile = True
     for _ in range(warmup):
-        method.compute()
-    res["wall_profiled"] = per_pass([method.compute() for _ in range(repeat)])
+        method.compute(solve=True)
+    res["wall_profiled"] = per_pass([method.compute(solve=True) for _ in range(repeat)])
 
     # 4. a full re-voxelization alone (every layer redrawn, as after set_scene; a change in part of the scene
     # redraws only the layers it reaches)
@@ -373,7 +373,7 @@ def time_method(be, method, scene, warmup: int, repeat: int, stamps: GpuTimestam
 
 
 def fed_gpu_ms(be, stamps: GpuTimestamps, method, fn, warmup: int, repeat: int) -> dict:
-    """GPU time of fn() with a whole update's GPU work queued ahead of it (method.compute(), not waited
+    """GPU time of fn() with a whole update's GPU work queued ahead of it (method.compute(solve=True), not waited
     for), so that fn's commands are all submitted before the GPU reaches them: the timestamps then measure
     fn's GPU work, not how fast this host's Python submits many small dispatches or draws. Also returned:
     `submit_ms`, fn's submission (wall, no finish), and `ahead_gpu_ms`, the queued update's GPU time: the
@@ -383,7 +383,7 @@ def fed_gpu_ms(be, stamps: GpuTimestamps, method, fn, warmup: int, repeat: int) 
     for i in range(warmup + repeat):
         stamps.begin_update()
         with stamps.timed({}, "ahead"):
-            method.compute()
+            method.compute(solve=True)
         t0 = time.perf_counter()
         with stamps.timed({}, "fn"):
             fn()

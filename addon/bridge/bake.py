@@ -18,7 +18,7 @@ import json
 import os
 import sys
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import bpy
@@ -46,10 +46,13 @@ class ObjectResult:
     file: str | None = None
     size: list[int] | None = None
     time_ms: float = 0.0
+    solve_ms: float = 0.0   # of the light field: only the object whose bake solved it
+    gather_ms: float = 0.0  # its texels' gather from the light field
     notes: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
-        return {"file": self.file, "size": self.size, "time_ms": round(self.time_ms, 2), "status": self.status,
+        return {"file": self.file, "size": self.size, "time_ms": round(self.time_ms, 2),
+                "solve_ms": round(self.solve_ms, 2), "gather_ms": round(self.gather_ms, 2), "status": self.status,
                 "message": self.message, "warnings": list(self.notes)}
 
     def line(self) -> str:
@@ -356,7 +359,7 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
         "blend": str(blend), "method": gi.method, "pass": pass_name, "target": target, "size": size,
         "config": {"gi": gi.to_dict(), "rsm": rsm.to_dict()}, "renderer": be.renderer,
         "setup_ms": round(baker.setup_ms, 2), "total_ms": round((time.perf_counter() - t0) * 1e3, 2),
-        "shard": [shard_index, shard_count], "saved_blend": saved,
+        "shard": [shard_index, shard_count], "saved_blend": saved, "solves": baker.method.solves,
         "scene_warnings": list(baker.scene.warnings), "warnings": warnings,
         "objects": {r.name: r.to_dict() for r in results},
     }
@@ -419,6 +422,8 @@ def _bake_one(baker: Baker, name: str, out_dir: Path, size: int, pass_name: str,
             store_vertex_colors(obj.data, attribute_name(pass_name), values)
             res.file = f"{obj.data.name}:{attribute_name(pass_name)}"
             res.size = [len(values), 1]
+        res.solve_ms = baker.texels.last_timings.get("solve", 0.0)
+        res.gather_ms = baker.texels.last_timings.get("gather", 0.0)
         res.notes = notes + [w for w in [zero_light_warning(values)] if w]
         if res.notes:
             res.status, res.message = "warning", "; ".join(res.notes)
@@ -462,13 +467,12 @@ def bake_volume(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, lpv, o
     define_light_switch()
     t0 = time.perf_counter()
     say("bake: capturing the scene, propagating the LPV")
-    scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 64, 64)
-    if scene.camera is None:
-        scene.camera = _default_camera(64)  # the volume does not depend on a view
+    # The light field is solved without a camera: the volume depends on no view.
+    scene = replace(SceneCache().update(bpy.context.evaluated_depsgraph_get(), 1, 1), camera=None)
     be = backend or default_backend()
     method = LpvMethod(be, gi, rsm, lpv)
     method.set_scene(scene)
-    method.compute()
+    timings = method.solve_volume()
     sh = {f"sh_{c}": be.read(method.accumulated[f"acc_{c}"]) for c in "rgb"}
     grid = method.grid
     extra = {} if method.vox_normal is None else {"vox_normal": be.read(method.vox_normal)}
@@ -479,6 +483,6 @@ def bake_volume(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, lpv, o
         print(f"warning: {Path(blend).name}: {warning}", file=sys.stderr)
     summary = {"blend": str(blend), "file": str(path), "dims": list(grid.dims), "cell_size_m": grid.cell_size_m,
                "time_ms": round((time.perf_counter() - t0) * 1e3, 2), "config": {"lpv": method.lpv_config.to_dict()},
-               "warnings": warnings}
+               "solves": method.solves, "solve_ms": round(timings["solve"], 2), "warnings": warnings}
     print(f"{Path(blend).name}: volume {grid.dims[0]}x{grid.dims[1]}x{grid.dims[2]} -> {path}")
     return summary

@@ -2,7 +2,8 @@
 
 `TexelBaker(method)` takes a method whose `set_scene` has run (the whole scene: RSMs, voxels) and, per
 object, fills `method.gbuf` with the object's texels (passes/bake_gbuffer.py), runs
-`method.compute(run_gbuffer=False)` and reads the products back. The camera only sets the G-buffer size.
+`method.compute(run_gbuffer=False)` and reads the products back: the first object's update solves the
+light field, the others only gather from it. The camera only sets the G-buffer size.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ class TexelBaker:
         self._target = None
         self._target_key = None
         self._count_tex = None
+        self.last_timings: dict[str, float] = {}  # the last shade's, per pass and half (solve, gather)
 
     def _resize(self, size: tuple[int, int]):
         m = self.method
@@ -70,7 +72,8 @@ class TexelBaker:
     def shade(self) -> dict[str, np.ndarray]:
         """Run the light passes on the current G-buffer: images row 0 = top (V = 1), alpha = coverage;
         'direct', 'albedo' and, for indirect methods, 'indirect'."""
-        self.method.compute(run_gbuffer=False)
+        # The light field is solved once per scene: later objects only gather (method.compute decides).
+        self.last_timings = self.method.compute(run_gbuffer=False)
         return self.method.read()
 
     def bake_triangles(self, uv, positions, normals, albedo, size: tuple[int, int]) -> dict[str, np.ndarray]:

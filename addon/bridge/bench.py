@@ -28,31 +28,12 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..engine import registry
 from ..engine.errors import ConfigError
 
-# Method -> the settings it is benchmarked at: each a dict of "gi.<field>" / "rsm.<field>" -> value.
-# Small on purpose: every setting costs a run per scene. A method that is not here cannot be benched.
-SETTINGS: dict[str, tuple[dict, ...]] = {
-    "direct": ({"rsm.resolution": 256}, {"rsm.resolution": 512}),
-    # Voxel visibility marches every VPL (x6 faces for point lights): on llvmpipe 256 VPLs at 64 cells
-    # is what fits a benchmark run; 1024 VPLs at 128 cells (rel_rmse_8 0.055 on cornell) takes minutes.
-    "rsm": ({"rsm.vpl_samples": 64}, {"rsm.vpl_samples": 256}, {"rsm.vpl_samples": 1024},
-            {"rsm.vpl_samples": 256, "rsm.visibility": "voxel"}),
-    # The published scheme as the baseline row, the improved transport at the issue's three grids, and
-    # at 32 without surface offsets (each cell's blocking split half and half), on one grid (no far
-    # field) and with emitter classes, docs/LPV.md.
-    "lpv": ({"lpv.variant": "classic", "lpv.geometry_volume": True},
-            {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.grid_cells": 16},
-            {"lpv.variant": "improved", "lpv.geometry_volume": True},
-            {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.surface_offsets": False},
-            {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.far_field": False},
-            {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.emitter_classes": True},
-            {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.grid_cells": 64}),
-    # The issue's two grid sizes at the defaults (16 cones, docs/VCT.md), the half-resolution gather, and
-    # the filtered injection (four points per VPL: no flicker as lights move, slower).
-    "vct": ({"vct.voxel_cells": 64}, {"vct.voxel_cells": 64, "vct.gather_scale": 2}, {"vct.voxel_cells": 128},
-            {"vct.voxel_cells": 64, "vct.filtered_injection": True}),
-}
+# Method -> the settings it is benchmarked at (the registry's `bench` rows): each a dict of
+# "gi.<field>" / "rsm.<field>" / ... -> value. Small on purpose: every setting costs a run per scene.
+SETTINGS: dict[str, tuple[dict, ...]] = {m.name: m.bench for m in registry.METHODS}
 REAL_SCENES = ("sponza", "sibenik", "conference")  # /work/shared/scenes/<name>/<name>.blend
 CURVE_SPP = (1, 4, 16, 64, 256)
 QUICK_CURVE_SPP = (1, 4, 16)
@@ -78,17 +59,17 @@ def setting_label(setting: dict) -> str:
 def make_configs(method: str, setting: dict, res: int, bounces: int):
     """(GIConfig, RsmConfig, LpvConfig, VctConfig) for one setting; the dataclasses validate every value
     (ConfigError)."""
-    from ..engine.config import GIConfig, LpvConfig, RsmConfig, VctConfig
+    from ..engine.config import GROUPS
 
-    groups = {"gi": {"method": method, "resolution": res, "bounces": bounces}, "rsm": {}, "lpv": {}, "vct": {}}
+    groups = {group: {} for group in GROUPS}
+    groups["gi"].update(method=method, resolution=res, bounces=bounces)
     for key, value in setting.items():
         group, _, name = key.partition(".")
         if group not in groups or not name:
-            raise ConfigError(f"bench setting {key!r}: must be 'gi.<field>', 'rsm.<field>', 'lpv.<field>' or "
-                              "'vct.<field>'")
+            raise ConfigError(f"bench setting {key!r}: must be '<group>.<field>' with a group of "
+                              f"{', '.join(GROUPS)}")
         groups[group][name] = value
-    return (GIConfig.from_dict(groups["gi"]), RsmConfig.from_dict(groups["rsm"]),
-            LpvConfig.from_dict(groups["lpv"]), VctConfig.from_dict(groups["vct"]))
+    return tuple(cls.from_dict(groups[group]) for group, cls in GROUPS.items())
 
 
 def curve_spp(ref_spp: int, quick: bool) -> list[int]:
@@ -251,7 +232,7 @@ def plot_scene(sc: dict, path: Path) -> None:
 @dataclass
 class Options:
     scenes: list[str] | None = None  # None: every procedural scene and the real scenes found
-    methods: list[str] | None = None  # None: every method of SETTINGS that methods.get knows
+    methods: list[str] | None = None  # None: every method of the registry
     quick: bool = False
     res: int = 128
     ref_spp: int | None = None  # None: REF_SPP, or QUICK_REF_SPP with quick
@@ -263,23 +244,12 @@ class Options:
 
 
 def resolve_methods(names: list[str] | None) -> list[str]:
-    """Named methods must have settings here and exist in engine.methods (else ConfigError). Without
-    names: every method in SETTINGS that is implemented (the others are skipped silently)."""
-    from ..engine import methods
-
+    """Named methods must be in the registry (else ConfigError); without names: every method."""
     if names:
         for n in names:
             settings_for(n)
-            methods.get(n)
         return list(names)
-    found = []
-    for n in SETTINGS:
-        try:
-            methods.get(n)
-            found.append(n)
-        except ConfigError:
-            pass
-    return found
+    return list(registry.NAMES)
 
 
 def resolve_scenes(names: list[str] | None, shared: Path) -> tuple[list[tuple[str, Path | None]], dict]:

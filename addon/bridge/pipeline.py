@@ -8,10 +8,13 @@ from __future__ import annotations
 
 import json
 import statistics
+import time
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 import bpy
+import numpy as np
 
 from ..engine import methods
 from ..engine.backends.moderngl_backend import ModernGLBackend
@@ -38,13 +41,59 @@ def open_blend(path: Path) -> None:
         raise SceneError(f"cannot open {path}: {str(exc).strip().splitlines()[-1]}") from None
 
 
+UPDATE_STEP_M = 0.01  # how far update_costs moves the lights or the camera per update
+
+
+def update_costs(method, repeat: int) -> dict[str, float]:
+    """Median wall time in ms (GPU work finished, no read-back) of the three kinds of update a user
+    makes, each right after its change, alternately moving by UPDATE_STEP_M and back:
+    - full: everything (the G-buffer, the light views, the solve, the gathers);
+    - lights: every light moved UPDATE_STEP_M along z: the light views, the solve and the gathers
+      (the G-buffer is still valid);
+    - camera: the camera moved UPDATE_STEP_M along its right axis: the G-buffer and the gathers
+      (the solve too where the method cannot keep its light field: `keeps_light_field`).
+    Per-pass waits are off, as in the viewport; the method is left as it was found."""
+    be, source, profile = method.backend, method.source, method.profile
+    lights, camera = list(source.lights), source.camera
+    moved_lights = [replace(light, position_m=light.position_m + np.array([0.0, 0.0, UPDATE_STEP_M]))
+                    for light in lights]
+    view = camera.view.copy()
+    view[0, 3] -= UPDATE_STEP_M  # x in camera space: its right axis
+    moved_camera = replace(camera, view=view)
+
+    def timed(update) -> float:
+        be.finish()
+        t0 = time.perf_counter()
+        update()
+        be.finish()
+        return (time.perf_counter() - t0) * 1e3
+
+    method.profile = False
+    samples = {"full": [], "lights": [], "camera": []}
+    try:
+        for i in range(repeat):
+            away = i % 2 == 0
+            samples["full"].append(timed(lambda: method.compute(solve=True)))
+            method.set_lights(moved_lights if away else lights)
+            samples["lights"].append(timed(lambda: method.compute(run_gbuffer=False)))
+            method.set_camera(moved_camera if away else camera)
+            samples["camera"].append(timed(method.compute))
+        method.set_lights(lights)
+        method.set_camera(camera)
+        method.compute()  # the products of the state the caller set
+    finally:
+        method.profile = profile
+    return {kind: statistics.median(ms) for kind, ms in samples.items()}
+
+
 def render_file(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, repeat: int = 3,
                 lpv: LpvConfig | None = None, vct: VctConfig | None = None,
-                progress: Callable[[str], None] = lambda step: None) -> dict:
+                progress: Callable[[str], None] = lambda step: None, profile_updates: bool = False) -> dict:
     """Render `blend` with gi.method; write <product>.exr for each product and stats.json; return stats.
 
     The timing is the median of `repeat` full updates after one warm-up (programs compiled, geometry
-    uploaded): what a user waits for when a light moves. `progress(step)` is told each step.
+    uploaded): what a user waits for when a light moves. `progress(step)` is told each step. With
+    profile_updates, stats["update_ms"] holds `update_costs` (full, lights, camera) over `repeat` runs.
     """
     progress(f"opening {blend}")
     open_blend(blend)
@@ -64,6 +113,10 @@ def render_file(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, repeat
         progress(f"timed run {i + 1}/{repeat}")
         runs.append(method.run())
     result = runs[-1]
+    update_ms = None
+    if profile_updates:
+        progress(f"timing the three kinds of update ({repeat} of each)")
+        update_ms = update_costs(method, max(repeat, 1))
     progress(f"writing {out_dir}")
     for name, pixels in result.images.items():
         images.write_exr(out_dir / f"{name}.exr", pixels)
@@ -83,6 +136,7 @@ def render_file(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, repeat
         "timings_ms": {k: statistics.median(r.timings_ms[k] for r in runs) for k in result.timings_ms},
         "total_ms": statistics.median(r.timings_ms["total"] for r in runs),
         "runs": repeat,
+        **({"update_ms": update_ms} if update_ms is not None else {}),
         "renderer": be.renderer,
         "blender_version": bpy.app.version_string,
         "notes": notes,

@@ -11,9 +11,10 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
+from . import registry
 from .errors import ConfigError
 
-METHODS = ("direct", "rsm", "lpv", "vct")
+METHODS = registry.NAMES
 
 
 def _num(default, lo, hi, doc):
@@ -144,6 +145,11 @@ class GIConfig(_Validated):
     bounces: int = _num(1, 1, 8, "indirect diffuse bounces (Cycles diffuse_bounces)")
     resolution: int = _num(256, 8, 8192, "long side of the output image in pixels")
     seed: int = _num(0, 0, 2**31 - 1, "seed of every stochastic choice")
+
+
+# Settings group -> its config class: the Blender property groups (scene.bounce.<group>), the command
+# line's flags and the registry's `reads` use these names.
+GROUPS: dict[str, type] = {"gi": GIConfig, "rsm": RsmConfig, "lpv": LpvConfig, "vct": VctConfig}
 
 
 def limits(cls) -> dict[str, dict[str, Any]]:

@@ -147,3 +147,19 @@ def test_a_lit_bake_has_no_warnings(blend, tmp_path):
     assert r.returncode == 0, r.stderr
     summary = json.loads((tmp_path / "bake.json").read_text())
     assert summary["warnings"] == [] and summary["objects"]["Floor"]["warnings"] == []
+
+
+@pytest.mark.parametrize("method_args", [["--method", "rsm"], ["--method", "lpv", "--grid", "16"],
+                                         ["--method", "vct", "--voxel-cells", "16", "--cones", "6"]])
+def test_a_bake_solves_once_and_gathers_per_object(tmp_path, method_args):
+    # The light field depends on the scene and its lights, not on the texels: the Cornell box's seven
+    # objects take one solve, and each object only its gather.
+    blend = tmp_path / "cornell.blend"
+    assert cli("scene", "cornell", "--out", str(blend)).returncode == 0
+    r = cli("bake", str(blend), "--out", str(tmp_path / "out"), *FAST, *method_args)
+    assert r.returncode == 0, r.stderr
+    summary = json.loads((tmp_path / "out" / "bake.json").read_text())
+    objects = summary["objects"].values()
+    assert len(objects) == 7 and summary["solves"] == 1
+    assert sum(o["solve_ms"] > 0 for o in objects) == 1  # the first object's update solved
+    assert all(o["gather_ms"] > 0 for o in objects)

@@ -198,8 +198,8 @@ class _RecordingLayout:
             self.greyed.append(idname)
 
 
-def test_panel_draws_every_setting(registered):
-    from bounce.addon.engine import config
+def test_panel_draws_what_the_method_reads(registered):
+    from bounce.addon.engine import config, registry
     from bounce.panels.main import BOUNCE_PT_main
 
     def drawn_settings():
@@ -209,12 +209,22 @@ def test_panel_draws_every_setting(registered):
         BOUNCE_PT_main.draw(panel, bpy.context)
         return drawn
 
-    fields = [*config.limits(config.GIConfig), *config.limits(config.RsmConfig)]
-    # The LPV group only while method lpv is selected (the default method is rsm).
-    assert drawn_settings() == ["enabled", *fields, "bounce.report_renderer", "bounce.bake"]
-    bpy.context.scene.bounce.gi.method = "lpv"
-    lpv_fields = list(config.limits(config.LpvConfig))
-    assert drawn_settings() == ["enabled", *fields, *lpv_fields, "bounce.report_renderer", "bounce.bake"]
+    shown = set()
+    for spec in registry.METHODS:
+        bpy.context.scene.bounce.gi.method = spec.name
+        expected = [name for group, cls in config.GROUPS.items() for name in config.limits(cls)
+                    if spec.reads_setting(group, name)]
+        assert drawn_settings() == ["enabled", *expected, "bounce.report_renderer", "bounce.bake"], spec.name
+        shown |= {(group, name) for group, cls in config.GROUPS.items() for name in config.limits(cls)
+                  if spec.reads_setting(group, name)}
+    # Written out for one case: `direct` has no VPL gather, so no VPL samples and no LPV or VCT group.
+    bpy.context.scene.bounce.gi.method = "direct"
+    assert drawn_settings() == ["enabled", "method", "resolution", "resolution", "shadow_bias_texels",
+                                "bounce.report_renderer", "bounce.bake"]
+    # Every setting is shown under some method: none is unreachable from the UI (the command line's
+    # flags: tests/unit/test_cli_flags.py; the defaults: test_properties_mirror_every_config_field).
+    every = {(group, name) for group, cls in config.GROUPS.items() for name in config.limits(cls)}
+    assert every - shown == set()
 
 
 def test_bake_button_is_not_greyed_while_the_overlay_is_off(registered):

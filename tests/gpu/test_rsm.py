@@ -118,13 +118,13 @@ def test_rsm_flux_behind_an_emitter_loses_what_goes_back_at_it(gl):
         light = Light("AREA", [0, 0, 1.98], [0, 0, 1], [1, 1, 1], power_w=50.0, occluder_radius_m=radius)
         method = RsmMethod(gl, GIConfig(method="rsm"), RsmConfig(resolution=128))
         method.set_scene(scene_of(rects, [[0.8] * 3, [0.5] * 3], light, cam))
-        read, per_face = [], method.per_light_view
+        read, per_face = [], method.solve_view
 
         def keep_face(view, timings, method=method, read=read, per_face=per_face):
             per_face(view, timings)
             read.append([gl.read(method.rsm[k]).astype(np.float64) for k in ("position", "normal", "flux")])
 
-        method.per_light_view = keep_face
+        method.solve_view = keep_face
         method.run()
         faces[radius] = [np.concatenate([f[i].reshape(-1, 4) for f in read]) for i in range(3)]
     pos, nrm, _ = faces[0.28]

@@ -3,21 +3,44 @@ Diffuse Direct pass, and the base every indirect method adds to.
 
 Passes: gbuffer -> for each light face: rsm -> direct_light. Geometry is uploaded once per scene
 (`set_scene`); `run()` is one full update with lights and camera as they are now.
+
+Every method's update has two halves (docs/ARCHITECTURE.md, "Light field and gathers"):
+- the *solve*: geometry + lights -> a view-independent light field (the RSM of every light face, and
+  what a method builds from them: the LPV's SH grid, the VCT's radiance pyramid);
+- the *gather*: light field + a G-buffer (camera pixels or lightmap texels) -> direct, indirect, glossy.
+`compute()` solves only when the lights or the geometry changed since the last solve (or the method
+cannot keep its light field for this configuration, `keeps_light_field`); otherwise a camera move, or
+the next object of a bake, only gathers. Hooks for subclasses: `begin_solve`, `solve_view` (per RSM
+face, its RSM bound as `self.rsm`), `finish_solve`, `gather_view` (per face), `gather_pixels`.
 """
 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .. import registry
 from ..backends.base import Backend
 from ..config import GIConfig, RsmConfig
 from ..errors import ConfigError
 from ..passes import direct_light, gbuffer, rsm, zero
 from ..passes.light_views import LightView, emissive_lights, views_for
 from ..scene import Camera, Scene
+
+# Each light face's RSM is kept between updates while all of them fit in this budget, so a gather after
+# a camera move reads them instead of redrawing them; a scene with more faces shares one RSM and solves
+# at every update. 256 MB holds 75 faces at 256^2 texels (3 RGBA32F + depth: 52 bytes a texel).
+RSM_KEEP_BYTES = 256 * 2**20
+RSM_BYTES_PER_TEXEL = 3 * 16 + 4
+
+
+def lights_key(lights) -> tuple:
+    """Equal for equal light lists: what a light field was solved for (lights may be changed in place)."""
+    return tuple(tuple(v.tobytes() if isinstance(v, np.ndarray) else v for v in dataclasses.astuple(light))
+                 for light in lights)
 
 
 @dataclass
@@ -44,8 +67,14 @@ def triangle_attributes(scene: Scene, select: np.ndarray | None = None) -> dict[
 
 
 class DirectMethod:
-    name = "direct"
-    products = ("direct", "albedo")
+    spec = registry.get("direct")
+    name, products, max_bounces = spec.name, spec.products, spec.max_bounces
+
+    def __init_subclass__(cls, **kwargs):
+        # A method's name, products and bounce limit are its registry entry's: declared once.
+        super().__init_subclass__(**kwargs)
+        if "spec" in cls.__dict__:
+            cls.name, cls.products, cls.max_bounces = cls.spec.name, cls.spec.products, cls.spec.max_bounces
 
     def __init__(self, backend: Backend, gi: GIConfig, rsm_config: RsmConfig):
         self.backend, self.gi, self.rsm_config = backend, gi, rsm_config
@@ -64,8 +93,6 @@ class DirectMethod:
     def set_scene(self, scene: Scene) -> None:
         """Upload geometry once; call again only when geometry changes. Camera and lights may change
         between updates without it: set_camera / set_lights, or by changing `scene`'s own fields."""
-        if scene.camera is None:
-            raise ValueError("DirectMethod needs a scene with a camera")
         be = self.backend
         self.source = scene
         self.scene, self.origin_m = scene.prepared()
@@ -83,11 +110,22 @@ class DirectMethod:
             attrs = triangle_attributes(self.scene, select)
             self._meshes[spec.name] = be.mesh(be.program(spec), attrs, "triangles") if attrs is not None else None
         n = self.rsm_config.resolution
-        self.rsm = {k: be.texture((n, n)) for k in ("position", "normal", "flux")}
-        self.rsm_target = be.target([self.rsm["position"], self.rsm["normal"], self.rsm["flux"]],
-                                    be.depth_texture((n, n)))
+        self._rsm_slots: list[tuple[dict, object]] = []  # (textures, target) per kept face, made on use
+        self._kept_faces = max(1, RSM_KEEP_BYTES // (RSM_BYTES_PER_TEXEL * n * n))
+        self.rsm, self.rsm_target = self._rsm_slot(0)  # the face being drawn or read (hooks use it)
+        self._solved_for = None  # lights_key of the light field on the GPU; None: none is
+        self.solves = 0          # how many updates solved (bakes report it)
         self._size = None
         self._allocate_images()
+
+    def _rsm_slot(self, index: int) -> tuple[dict, object]:
+        """The RSM textures and target of kept face `index`, allocated on first use."""
+        be, n = self.backend, self.rsm_config.resolution
+        while len(self._rsm_slots) <= index:
+            textures = {k: be.texture((n, n)) for k in ("position", "normal", "flux")}
+            target = be.target([textures["position"], textures["normal"], textures["flux"]], be.depth_texture((n, n)))
+            self._rsm_slots.append((textures, target))
+        return self._rsm_slots[index]
 
     def set_camera(self, camera: Camera) -> None:
         self.source = replace(self.source, camera=camera)
@@ -97,7 +135,10 @@ class DirectMethod:
         self.source = replace(self.source, lights=list(lights))
 
     def _allocate_images(self) -> None:
-        """Camera-sized targets, (re)made only when the camera's size changes."""
+        """Camera-sized targets, (re)made only when the camera's size changes; none without a camera
+        (a solve alone needs none)."""
+        if self.source.camera is None:
+            return
         size = (self.source.camera.width, self.source.camera.height)
         if size == self._size:
             return
@@ -123,25 +164,87 @@ class DirectMethod:
         lights += self.emissive
         return [v for i, light in enumerate(lights) for v in views_for(light, i, bounds, self.rsm_config.resolution)]
 
-    def compute(self, run_gbuffer: bool = True) -> dict[str, float]:
+    def keeps_light_field(self) -> bool:
+        """Whether the light field stays valid when only the camera or the G-buffer changes (methods
+        whose solve depends on the camera, or whose gather consumes its light field, say no)."""
+        return True
+
+    def compute(self, run_gbuffer: bool = True, solve: bool | None = None) -> dict[str, float]:
         """Every pass of one update, no read-back (the viewport samples the textures); the G-buffer may
-        be skipped when only lights changed. Returns timings in ms per pass."""
-        be = self.backend
+        be skipped when it is still valid (only lights changed, or a bake filled it). `solve`: None
+        solves only when the lights or the geometry changed since the last solve; True always.
+        Returns timings in ms per pass, and per half ("solve", "gather")."""
+        if self.source.camera is None:
+            raise ValueError(f"method {self.name}: an update needs a camera (set_camera); solve_light_field "
+                             "needs none")
         self._allocate_images()
+        views = self.light_views()
+        keep = len(views) <= self._kept_faces
+        key = lights_key(self.source.lights)
+        if solve is None:
+            solve = not (keep and self.keeps_light_field() and self._solved_for == key)
         timings: dict[str, float] = {}
         with self.timed(timings, "total"):
             if run_gbuffer:
                 with self.timed(timings, "gbuffer"):
-                    gbuffer.run(be, self.gbuf_target, self.gbuf, self._meshes[gbuffer.SPEC.name], self.camera())
-            self.clear_products()
-            for view in self.light_views():
-                with self.timed(timings, "rsm"):
-                    rsm.run(be, self.rsm_target, self._meshes[rsm.SPEC.name], view)
-                with self.timed(timings, "direct_light"):
-                    direct_light.run(be, self.gbuf["position"], self.gbuf["normal"], self.rsm["position"],
-                                     self.direct, view, self.rsm_config.shadow_bias_texels)
-                self.per_light_view(view, timings)
+                    gbuffer.run(self.backend, self.gbuf_target, self.gbuf, self._meshes[gbuffer.SPEC.name],
+                                self.camera())
+            if keep:
+                if solve:
+                    with self.timed(timings, "solve"):
+                        self._solve(views, timings, range(len(views)))
+                with self.timed(timings, "gather"):
+                    self._gather(views, timings, range(len(views)))
+            else:  # one RSM for every face: each is drawn, solved and gathered in turn
+                with self.timed(timings, "solve"):
+                    self.begin_solve(timings)
+                    self.clear_products()
+                    for view in views:
+                        self._draw_rsm(view, 0, timings)
+                        self.solve_view(view, timings)
+                        self._gather_view(view, timings)
+                    self.finish_solve(timings)
+                with self.timed(timings, "gather"):
+                    self.gather_pixels(timings)
+            self._solved_for = key if keep else None
+            self.solves += 1 if solve or not keep else 0
         return timings
+
+    def solve_light_field(self) -> dict[str, float]:
+        """The solve alone, with no camera and no pixels (a volume bake); timings per pass."""
+        views = self.light_views()
+        keep = len(views) <= self._kept_faces
+        timings: dict[str, float] = {}
+        with self.timed(timings, "total"), self.timed(timings, "solve"):
+            self._solve(views, timings, range(len(views)) if keep else [0] * len(views))
+        self._solved_for = lights_key(self.source.lights) if keep else None
+        self.solves += 1
+        return timings
+
+    def _draw_rsm(self, view: LightView, slot: int, timings: dict[str, float]) -> None:
+        self.rsm, self.rsm_target = self._rsm_slot(slot)
+        with self.timed(timings, "rsm"):
+            rsm.run(self.backend, self.rsm_target, self._meshes[rsm.SPEC.name], view)
+
+    def _solve(self, views: list[LightView], timings: dict[str, float], slots) -> None:
+        self.begin_solve(timings)
+        for view, slot in zip(views, slots, strict=True):
+            self._draw_rsm(view, slot, timings)
+            self.solve_view(view, timings)
+        self.finish_solve(timings)
+
+    def _gather(self, views: list[LightView], timings: dict[str, float], slots) -> None:
+        self.clear_products()
+        for view, slot in zip(views, slots, strict=True):
+            self.rsm, self.rsm_target = self._rsm_slot(slot)
+            self._gather_view(view, timings)
+        self.gather_pixels(timings)
+
+    def _gather_view(self, view: LightView, timings: dict[str, float]) -> None:
+        with self.timed(timings, "direct_light"):
+            direct_light.run(self.backend, self.gbuf["position"], self.gbuf["normal"], self.rsm["position"],
+                             self.direct, view, self.rsm_config.shadow_bias_texels)
+        self.gather_view(view, timings)
 
     def read(self) -> dict[str, np.ndarray]:
         """The products in image order (row 0 = top), alpha = geometry coverage."""
@@ -156,7 +259,7 @@ class DirectMethod:
         """One full update (G-buffer, every light, read-back), timed: what a benchmark measures."""
         timings: dict[str, float] = {}
         with self.timed(timings, "total"):
-            timings.update({k: v for k, v in self.compute().items() if k != "total"})
+            timings.update({k: v for k, v in self.compute(solve=True).items() if k != "total"})
             with self.timed(timings, "readback"):
                 images = self.read()
         return Result(images, timings)
@@ -164,8 +267,21 @@ class DirectMethod:
     def clear_products(self) -> None:
         zero.images(self.backend, [self.direct])  # a compute pass: framebuffer clears are slow raster work
 
-    def per_light_view(self, view: LightView, timings: dict[str, float]) -> None:
-        """Hook for methods that add work per RSM face while it is bound (the indirect gathers)."""
+    # Hooks of the two halves (module docstring); `direct` has nothing beyond its RSMs and direct light.
+    def begin_solve(self, timings: dict[str, float]) -> None:
+        """Before the first face's RSM: clear what the solve accumulates into."""
+
+    def solve_view(self, view: LightView, timings: dict[str, float]) -> None:
+        """Per RSM face (`self.rsm`), view-independent work: injection into the light field."""
+
+    def finish_solve(self, timings: dict[str, float]) -> None:
+        """After every face: complete the light field (propagation, pyramids, bounces)."""
+
+    def gather_view(self, view: LightView, timings: dict[str, float]) -> None:
+        """Per RSM face (`self.rsm`), after its direct light: per-pixel work that reads the face."""
+
+    def gather_pixels(self, timings: dict[str, float]) -> None:
+        """After every face's gather: per-pixel reads of the light field (lookups, cones)."""
 
     def product_textures(self) -> dict:
         return {"direct": self.direct}
@@ -175,9 +291,6 @@ class OneBounceMethod(DirectMethod):
     """Base of the indirect methods: the `indirect` product (Cycles' Diffuse Indirect units) beside
     direct light, allocated, cleared and read like `direct`. A method computes up to `max_bounces`
     diffuse bounces (GIConfig.bounces); more are refused."""
-
-    products = ("direct", "indirect", "albedo")
-    max_bounces = 1
 
     def __init__(self, backend: Backend, gi: GIConfig, rsm_config: RsmConfig):
         if gi.bounces > self.max_bounces:

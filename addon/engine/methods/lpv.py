@@ -35,7 +35,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import registry
 from ..config import LpvConfig
+from ..errors import ConfigError
 from ..grid import Grid
 from ..passes import (
     atlas,
@@ -141,8 +143,7 @@ class LpvVolume:
 
 
 class LpvMethod(OneBounceMethod):
-    name = "lpv"
-    max_bounces = 8  # GIConfig's limit: each bounce is one more re-injection and propagation
+    spec = registry.get("lpv")
 
     def __init__(self, backend, gi, rsm_config, lpv_config: LpvConfig | None = None):
         super().__init__(backend, gi, rsm_config)
@@ -161,7 +162,14 @@ class LpvMethod(OneBounceMethod):
     vox_normal = property(lambda self: self.levels[0].vox_normal)
 
     def camera_m(self) -> np.ndarray:
-        """The camera's position in the uploaded geometry's (re-centred) frame."""
+        """The camera's position in the uploaded geometry's (re-centred) frame: where the cascades go.
+        One grid fits the scene wherever the camera is, so a solve alone (no camera) needs one only
+        with cascades."""
+        if self.source.camera is None:
+            if self.lpv_config.cascades > 1:
+                raise ConfigError("LPV cascades are placed around the camera: a light field without a camera "
+                                  "(a volume bake) takes one grid (cascades = 1)")
+            return np.mean(self.bounds_m, axis=0)
         return self.source.camera.position_m - self.origin_m
 
     def place_cascades(self) -> list[lpv_cascade.Cascade]:
@@ -203,12 +211,19 @@ class LpvMethod(OneBounceMethod):
         far = self.levels[-1].far
         return self.levels + ([far] if far is not None else [])
 
-    def clear_products(self) -> None:
-        super().clear_products()
+    def keeps_light_field(self) -> bool:
+        """Cascades are placed around the camera (a camera move can move them: a new solve); later
+        bounces add to each grid's accumulation in the gather (a second gather would add them twice)."""
+        return super().keeps_light_field() and self.lpv_config.cascades == 1 and self.gi.bounces == 1
+
+    def begin_solve(self, timings: dict[str, float]) -> None:
+        if len(self.levels) > 1:
+            with self.timed(timings, "lpv_place"):
+                self.follow_camera()
         for level in self.grids():
             zero.images(self.backend, list(level.inject_atlas.values()))
 
-    def per_light_view(self, view: LightView, timings: dict[str, float]) -> None:
+    def solve_view(self, view: LightView, timings: dict[str, float]) -> None:
         with self.timed(timings, "lpv_inject"):
             vpls = self.rsm
             if self._vpls is not None:
@@ -248,7 +263,7 @@ class LpvMethod(OneBounceMethod):
                               first_step=i == 0, geometry=level.blocking,
                               step_scale=1.0 if share is None else share(i + 1))
 
-    def add_bounces(self, timings: dict[str, float]) -> None:
+    def add_bounces(self, timings: dict[str, float], look_up: bool = True) -> None:
         """Bounces 2..gi.bounces on top of the first bounce (in each grid's `accumulated` and in
         `indirect`). Each: every grid, coarsest first, re-injects what its surfaces reflect of the
         previous bounce and propagates it into its `bounce_accumulated` (a finer cascade after its
@@ -274,13 +289,14 @@ class LpvMethod(OneBounceMethod):
                                              level.far.grid)
                 with self.timed(timings, "lpv_propagate"):
                     self.propagate(accumulated=level.bounce_accumulated, level=level)
-            with self.timed(timings, "lpv_lookup"):
-                if len(levels) == 1:
-                    lpv_lookup.run(be, self.gbuf, levels[0].bounce_accumulated, self.indirect, levels[0].grid,
-                                   accumulate=True, vox_normal=self.lookup_vox(levels[0]))
-                else:
-                    self.look_up(lambda level: level.bounce_accumulated, self._bounce_image)
-                    lpv_lookup.add_image(be, self._bounce_image, self.indirect)
+            if look_up:
+                with self.timed(timings, "lpv_lookup"):
+                    if len(levels) == 1:
+                        lpv_lookup.run(be, self.gbuf, levels[0].bounce_accumulated, self.indirect, levels[0].grid,
+                                       accumulate=True, vox_normal=self.lookup_vox(levels[0]))
+                    else:
+                        self.look_up(lambda level: level.bounce_accumulated, self._bounce_image)
+                        lpv_lookup.add_image(be, self._bounce_image, self.indirect)
             with self.timed(timings, "lpv_reinject"):
                 for level in levels:
                     lpv_reinject.add(be, level.bounce_accumulated, level.accumulated, level.grid)
@@ -317,10 +333,11 @@ class LpvMethod(OneBounceMethod):
                 else:
                     self.propagate(level=level)
 
-    def propagate_classes(self, timings: dict[str, float]) -> None:
+    def propagate_classes(self, timings: dict[str, float], look_up: bool = True) -> None:
         """The first bounce with emitter classes (one grid, and its far field if any): each class
-        unpacked, propagated into `class_accumulated`, added to `accumulated`, and its reading at the
-        pixels of that class recorded; then the lookup reads the total less each pixel's own class."""
+        unpacked, propagated into `class_accumulated`, added to `accumulated`, and (look_up) its reading
+        at the pixels of that class recorded; then the lookup reads the total less each pixel's own class.
+        Without look_up only the total is built (a volume bake: no pixels)."""
         be, level = self.backend, self.levels[0]
         zero.layers(be, list(level.accumulated.values()), 0, level.grid.dims[2])
         for emitter in range(lpv_inject.CLASSES):
@@ -332,31 +349,40 @@ class LpvMethod(OneBounceMethod):
             with self.timed(timings, "lpv_propagate"):
                 self.propagate(accumulated=level.class_accumulated, level=level)
                 lpv_reinject.add(be, level.class_accumulated, level.accumulated, level.grid)
-            with self.timed(timings, "lpv_lookup"):
-                lpv_lookup.own(be, self.gbuf, level.class_accumulated, self._own_light, level.grid, emitter,
-                               vox_normal=self.lookup_vox(level))
+            if look_up:
+                with self.timed(timings, "lpv_lookup"):
+                    lpv_lookup.own(be, self.gbuf, level.class_accumulated, self._own_light, level.grid, emitter,
+                                   vox_normal=self.lookup_vox(level))
             if level.own_reinject is not None:
                 with self.timed(timings, "lpv_reinject"):
                     lpv_reinject.own(be, level.class_accumulated, level.voxels, level.own_reinject, level.grid,
                                      emitter)
-        with self.timed(timings, "lpv_lookup"):
-            lpv_lookup.run(be, self.gbuf, level.accumulated, self.indirect, level.grid,
-                           vox_normal=self.lookup_vox(level), own_light=self._own_light)
+        if look_up:
+            with self.timed(timings, "lpv_lookup"):
+                lpv_lookup.run(be, self.gbuf, level.accumulated, self.indirect, level.grid,
+                               vox_normal=self.lookup_vox(level), own_light=self._own_light)
 
-    def compute(self, run_gbuffer: bool = True) -> dict[str, float]:
-        timings: dict[str, float] = {}
-        with self.timed(timings, "total"):
-            if len(self.levels) > 1:
-                with self.timed(timings, "lpv_place"):
-                    self.follow_camera()
-            inner = super().compute(run_gbuffer)
-            inner.pop("total", None)
-            timings.update(inner)
-            if self.classes:
-                self.propagate_classes(timings)
-            else:
-                self.propagate_levels(timings)
-                with self.timed(timings, "lpv_lookup"):
-                    self.look_up(lambda level: level.accumulated, self.indirect)
-            self.add_bounces(timings)
+    def finish_solve(self, timings: dict[str, float]) -> None:
+        """The first bounce's propagation; with emitter classes the gather propagates each class itself
+        (its own-light lookups need each class's volume, which one propagation overwrites)."""
+        if not self.classes:
+            self.propagate_levels(timings)
+
+    def gather_pixels(self, timings: dict[str, float]) -> None:
+        if self.classes:
+            self.propagate_classes(timings)
+        else:
+            with self.timed(timings, "lpv_lookup"):
+                self.look_up(lambda level: level.accumulated, self.indirect)
+        self.add_bounces(timings)
+
+    def solve_volume(self) -> dict[str, float]:
+        """The light field alone, no pixels (a volume bake): every grid's `accumulated` holds the light
+        of every bounce. What the gather adds to it (emitter classes, later bounces) runs without its
+        lookups."""
+        timings = self.solve_light_field()
+        if self.classes:
+            self.propagate_classes(timings, look_up=False)
+        self.add_bounces(timings, look_up=False)
+        self._solved_for = None  # `accumulated` now holds more than a gather expects: solve again first
         return timings

@@ -3,13 +3,15 @@
 measured this gather at rel_rmse_8 0.215, bias 1.15 on the Cornell box (occlusion is missing, so it is
 too bright), 0.035 with exact visibility.
 
-Passes: those of `direct`, then per RSM face: rsm_gather. With `RsmConfig.visibility = "voxel"` the
+Passes: those of `direct`, then per RSM face: rsm_gather (a gather: it reads each face's kept RSM, so a
+camera move redraws no RSM). With `RsmConfig.visibility = "voxel"` the
 scene is voxelized once per geometry change (passes/voxelize.py) and every VPL's visibility is marched
 through the occupancy grid. Products: direct, indirect, albedo.
 """
 
 from __future__ import annotations
 
+from .. import registry
 from ..grid import Grid
 from ..passes import rsm_gather, voxel_view
 from ..passes.light_views import LightView
@@ -18,7 +20,7 @@ from .direct import OneBounceMethod
 
 
 class RsmMethod(OneBounceMethod):
-    name = "rsm"
+    spec = registry.get("rsm")
 
     def set_scene(self, scene) -> None:
         super().set_scene(scene)
@@ -44,7 +46,7 @@ class RsmMethod(OneBounceMethod):
         voxel_view.run(self.backend, self.gbuf["position"], voxels["vox_albedo"], self.grid, self._voxel_view)
         return self._voxel_view
 
-    def per_light_view(self, view: LightView, timings: dict[str, float]) -> None:
+    def gather_view(self, view: LightView, timings: dict[str, float]) -> None:
         with self.timed(timings, "rsm_gather"):
             rsm_gather.run(self.backend, self.gbuf, self.rsm, self.indirect, self.rsm_config.vpl_samples,
                            self.gi.seed + view.light_index * 6 + max(view.face_index, 0),

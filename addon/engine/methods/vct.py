@@ -16,6 +16,7 @@ Products: direct, indirect, ao, albedo, glossy.
 
 from __future__ import annotations
 
+from .. import registry
 from ..config import VctConfig
 from ..grid import Grid
 from ..passes import atlas, vct_gather, vct_inject, vct_pyramid, zero
@@ -27,9 +28,7 @@ from .direct import OneBounceMethod
 
 
 class VctMethod(OneBounceMethod):
-    name = "vct"
-    products = ("direct", "indirect", "ao", "albedo", "glossy")
-    max_bounces = 8
+    spec = registry.get("vct")
 
     def __init__(self, backend, gi, rsm_config, vct_config: VctConfig | None = None):
         super().__init__(backend, gi, rsm_config)
@@ -78,14 +77,13 @@ class VctMethod(OneBounceMethod):
     def product_textures(self) -> dict:
         return {**super().product_textures(), "ao": self.ao, "glossy": self.glossy}
 
-    def clear_products(self) -> None:
-        super().clear_products()
+    def begin_solve(self, timings: dict[str, float]) -> None:
         zero.images(self.backend, [self.flux[d] for d in DIRECTIONS])
         if self._pending_light is not None:  # an update left unfinished; _flush_light zeroes it otherwise
             zero.images(self.backend, [self.light_flux[d] for d in DIRECTIONS])
         self._pending_light = None
 
-    def per_light_view(self, view: LightView, timings: dict[str, float]) -> None:
+    def solve_view(self, view: LightView, timings: dict[str, float]) -> None:
         """Views come grouped by light: a new light first hands the previous one's VPLs to `flux`."""
         with self.timed(timings, "vct_inject"):
             if self._pending_light is not None and view.light_index != self._pending_light:
@@ -129,20 +127,16 @@ class VctMethod(OneBounceMethod):
                 else:
                     self._build(1.0, self.later_bounces)
 
-    def compute(self, run_gbuffer: bool = True) -> dict[str, float]:
-        timings: dict[str, float] = {}
-        with self.timed(timings, "total"):
-            inner = super().compute(run_gbuffer)
-            inner.pop("total", None)
-            timings.update(inner)
-            if self._pending_light is not None:
-                with self.timed(timings, "vct_inject"):
-                    self._flush_light()
-            self.bounce_light(timings)
-            with self.timed(timings, "vct_gather"):
-                vct_gather.pixels(self.backend, self.pyramid, self.radiance_scale, self.gbuf, self.indirect,
-                                  self.ao, self.grid, self.vct_config, self.gi.seed, self._low)
-            with self.timed(timings, "vct_glossy"):
-                vct_gather.glossy(self.backend, self.pyramid, self.radiance_scale, self.gbuf, self._lobe_albedo,
-                                  self.glossy, self.grid, self.vct_config, self.camera().position_m, self.gi.seed)
-        return timings
+    def finish_solve(self, timings: dict[str, float]) -> None:
+        if self._pending_light is not None:
+            with self.timed(timings, "vct_inject"):
+                self._flush_light()
+        self.bounce_light(timings)
+
+    def gather_pixels(self, timings: dict[str, float]) -> None:
+        with self.timed(timings, "vct_gather"):
+            vct_gather.pixels(self.backend, self.pyramid, self.radiance_scale, self.gbuf, self.indirect,
+                              self.ao, self.grid, self.vct_config, self.gi.seed, self._low)
+        with self.timed(timings, "vct_glossy"):
+            vct_gather.glossy(self.backend, self.pyramid, self.radiance_scale, self.gbuf, self._lobe_albedo,
+                              self.glossy, self.grid, self.vct_config, self.camera().position_m, self.gi.seed)

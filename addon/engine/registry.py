@@ -1,0 +1,102 @@
+"""The method registry: one declaration per GI method, from which every list of methods derives.
+
+The settings (config.py), the Blender properties and panels, the command line, the viewport, bakes, the
+benchmark, the GPU timing tool and the tests all read their methods from here. Adding a method: its
+module under methods/ (a class whose `spec` is its entry here), its config class if it has settings
+of its own (config.GROUPS), its shaders and tests, and one `MethodSpec` below (docs/ARCHITECTURE.md,
+"How to add a method").
+
+This module imports nothing of the engine, so config.py can take its method names from it.
+"""
+
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass
+
+from .errors import ConfigError
+
+
+@dataclass(frozen=True)
+class MethodSpec:
+    """What the rest of Bounce needs to know of a method without running it."""
+
+    name: str
+    summary: str
+    module: str                  # under addon/engine/methods/
+    class_name: str
+    products: tuple[str, ...]    # the images read() returns; `albedo` with every one
+    max_bounces: int             # GIConfig.bounces it computes; more are refused
+    # The settings it reads, "group.field" or "group.*" (groups: config.GROUPS): the panels show these
+    # alone, and `python -m addon methods` lists which methods read each setting.
+    reads: tuple[str, ...]
+    # Its benchmark rows: each {"group.field": value} applied to the defaults (bridge/bench.py).
+    bench: tuple[dict, ...]
+
+    @property
+    def own_group(self) -> str | None:
+        """The settings group of its own (its config class), or None."""
+        own = [r.split(".")[0] for r in self.reads if r.split(".")[0] not in SHARED_GROUPS]
+        return own[0] if own else None
+
+    def reads_setting(self, group: str, field: str) -> bool:
+        return f"{group}.{field}" in self.reads or f"{group}.*" in self.reads
+
+
+SHARED_GROUPS = ("gi", "rsm")  # every method is configured through these; the others are methods' own
+
+_IMAGE = ("gi.method", "gi.resolution")     # every method makes an image of this size
+_LIGHT_VIEWS = ("rsm.resolution", "rsm.shadow_bias_texels")  # every method's shadow maps
+
+METHODS: tuple[MethodSpec, ...] = (
+    MethodSpec(
+        name="direct", summary="RSM-shadowed direct light only: the radiometry check against Cycles",
+        module="direct", class_name="DirectMethod", products=("direct", "albedo"), max_bounces=1,
+        reads=(*_IMAGE, *_LIGHT_VIEWS),
+        bench=({"rsm.resolution": 256}, {"rsm.resolution": 512})),
+    MethodSpec(
+        name="rsm", summary="one bounce gathered from the shadow maps' VPLs, optionally with voxel visibility",
+        module="rsm", class_name="RsmMethod", products=("direct", "indirect", "albedo"), max_bounces=1,
+        reads=(*_IMAGE, "gi.seed", "rsm.*"),
+        # Voxel visibility marches every VPL (x6 faces for point lights): on llvmpipe 256 VPLs at 64 cells
+        # is what fits a benchmark run; 1024 VPLs at 128 cells (rel_rmse_8 0.055 on cornell) takes minutes.
+        bench=({"rsm.vpl_samples": 64}, {"rsm.vpl_samples": 256}, {"rsm.vpl_samples": 1024},
+               {"rsm.vpl_samples": 256, "rsm.visibility": "voxel"})),
+    MethodSpec(
+        name="lpv", summary="light propagation volumes: VPLs propagated through an SH grid (paper 002)",
+        module="lpv", class_name="LpvMethod", products=("direct", "indirect", "albedo"), max_bounces=8,
+        reads=(*_IMAGE, "gi.bounces", *_LIGHT_VIEWS, "lpv.*"),
+        # The published scheme as the baseline row, the improved transport at three grids, and at 32
+        # without surface offsets (each cell's blocking split half and half), on one grid (no far field)
+        # and with emitter classes, docs/LPV.md.
+        bench=({"lpv.variant": "classic", "lpv.geometry_volume": True},
+               {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.grid_cells": 16},
+               {"lpv.variant": "improved", "lpv.geometry_volume": True},
+               {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.surface_offsets": False},
+               {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.far_field": False},
+               {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.emitter_classes": True},
+               {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.grid_cells": 64})),
+    MethodSpec(
+        name="vct", summary="voxel cone tracing through a six-direction radiance pyramid, glossy cones",
+        module="vct", class_name="VctMethod", products=("direct", "indirect", "ao", "albedo", "glossy"),
+        max_bounces=8, reads=(*_IMAGE, "gi.bounces", "gi.seed", *_LIGHT_VIEWS, "vct.*"),
+        # Two grid sizes at the defaults (16 cones, docs/VCT.md), the half-resolution gather, and the
+        # filtered injection (four points per VPL: no flicker as lights move, slower).
+        bench=({"vct.voxel_cells": 64}, {"vct.voxel_cells": 64, "vct.gather_scale": 2}, {"vct.voxel_cells": 128},
+               {"vct.voxel_cells": 64, "vct.filtered_injection": True})),
+)
+
+NAMES: tuple[str, ...] = tuple(m.name for m in METHODS)
+_BY_NAME = {m.name: m for m in METHODS}
+
+
+def get(name: str) -> MethodSpec:
+    if name not in _BY_NAME:
+        raise ConfigError(f"unknown method {name!r}: known methods are {', '.join(NAMES)}")
+    return _BY_NAME[name]
+
+
+def method_class(name: str):
+    """The method's class (its module imported on first use: passes and backends load with it)."""
+    spec = get(name)
+    return getattr(importlib.import_module(f"{__package__}.methods.{spec.module}"), spec.class_name)
