@@ -138,14 +138,10 @@ def _from_blender(value):
     return float(f"{value:.7g}") if isinstance(value, float) else value
 
 
-def to_config(settings) -> tuple[config.GIConfig, config.RsmConfig, config.LpvConfig, config.VctConfig]:
-    """scene.bounce -> (GIConfig, RsmConfig, LpvConfig, VctConfig), in CONFIGS' order; raises
-    ConfigError as the engine would."""
-    configs = []
-    for attr, cls in CONFIGS.items():
-        group = getattr(settings, attr)
-        configs.append(cls(**{name: _from_blender(getattr(group, name)) for name in config.limits(cls)}))
-    return tuple(configs)
+def to_config(settings) -> dict:
+    """scene.bounce -> {group: config} (config.settings' form); raises ConfigError as the engine would."""
+    return {attr: cls(**{name: _from_blender(getattr(getattr(settings, attr), name)) for name in config.limits(cls)})
+            for attr, cls in CONFIGS.items()}
 
 
 def register() -> None:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import bpy
 from bpy.props import EnumProperty, IntProperty
 
+from ..addon.engine import registry
 from ..addon.engine.errors import BounceError
 
 _PASSES = [("indirect", "Indirect", "indirect diffuse light (Cycles' Diffuse Indirect units)"),
@@ -85,10 +86,11 @@ class BOUNCE_OT_bake(bpy.types.Operator):
         self._objects = sorted((o for o in context.selected_objects), key=lambda o: o.name)
         self._next, self._done, self._failed = 0, 0, []
         try:
-            gi, rsm, lpv, vct = to_config(context.scene.bounce)
-            if self.pass_name != "direct" and gi.method == "direct":
+            settings = to_config(context.scene.bounce)
+            method = settings["gi"].method
+            if self.pass_name != "direct" and "indirect" not in registry.get(method).products:
                 raise BounceError(f"pass {self.pass_name} needs an indirect method: set Bounce > GI > Method to rsm")
-            self._baker = bake.Baker(_backend(), context.evaluated_depsgraph_get(), gi, rsm, self.size, lpv, vct)
+            self._baker = bake.Baker(_backend(), context.evaluated_depsgraph_get(), settings, self.size)
         except BounceError as exc:
             self.report({"ERROR"}, str(exc))
             return False

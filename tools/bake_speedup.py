@@ -26,7 +26,10 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", type=int, default=64)
     ap.add_argument("--ref-spp", type=int, default=1024)
-    ap.add_argument("--method", default="rsm", choices=("rsm", "lpv", "vct"))
+    from addon.engine import registry
+
+    indirect = [m.name for m in registry.METHODS if "indirect" in m.products]
+    ap.add_argument("--method", default="rsm", choices=indirect)
     ap.add_argument("--emitter-classes", action="store_true", help="lpv: LpvConfig.emitter_classes")
     args = ap.parse_args()
 
@@ -43,8 +46,9 @@ def main() -> int:
         blend = Path(tmp) / "cornell.blend"
         scenes.save("cornell", blend)
         rsm = RsmConfig(visibility="voxel") if args.method == "rsm" else RsmConfig()
-        summary = bake_file(blend, Path(tmp) / "ours", list(OBJECTS), args.size, GIConfig(method=args.method),
-                            rsm, "indirect", progress=False, lpv=LpvConfig(emitter_classes=args.emitter_classes))
+        settings = {"gi": GIConfig(method=args.method), "rsm": rsm,
+                    "lpv": LpvConfig(emitter_classes=args.emitter_classes)}
+        summary = bake_file(blend, Path(tmp) / "ours", list(OBJECTS), args.size, settings, "indirect", progress=False)
         bpy.ops.wm.open_mainfile(filepath=str(blend))
         for name in OBJECTS:
             ours = images.read_exr(Path(tmp) / "ours" / f"{name}_indirect.exr")

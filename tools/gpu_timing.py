@@ -273,8 +273,8 @@ def configs():
 def make_method(be, gi_kw: dict, rsm_kw: dict, lpv_kw: dict, vct_kw: dict, resolution: int):
     from addon.engine import config, methods
 
-    gi = config.GIConfig(resolution=resolution, **gi_kw)
-    return methods.create(be, gi, config.RsmConfig(**rsm_kw), config.LpvConfig(**lpv_kw), config.VctConfig(**vct_kw))
+    return methods.create(be, {"gi": config.GIConfig(resolution=resolution, **gi_kw), "rsm": config.RsmConfig(**rsm_kw),
+                               "lpv": config.LpvConfig(**lpv_kw), "vct": config.VctConfig(**vct_kw)})
 
 
 def summary(values: list[float]) -> dict:

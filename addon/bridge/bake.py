@@ -25,7 +25,7 @@ import bpy
 import numpy as np
 
 from ..engine import methods
-from ..engine.config import GIConfig, RsmConfig
+from ..engine.config import settings as complete_settings
 from ..engine.errors import ConfigError, SceneError
 from ..engine.lightmap import PASSES, TARGETS, check_choice, dilate, output_path, safe_name, shard, uv_problems
 from ..engine.scene import Camera
@@ -168,8 +168,8 @@ def _default_camera(size: int) -> Camera:
 class Baker:
     """The scene captured and uploaded once; then bake_image / bake_vertex_colors per object."""
 
-    def __init__(self, backend, depsgraph, gi: GIConfig, rsm: RsmConfig, size: int = 512, lpv=None, vct=None):
-        """lpv, vct: the LpvConfig / VctConfig of those methods (their defaults when None)."""
+    def __init__(self, backend, depsgraph, settings: dict, size: int = 512):
+        """settings: {group: config} (config.settings' form; missing groups take their defaults)."""
         t0 = time.perf_counter()
         define_light_switch()
         self.depsgraph = depsgraph
@@ -177,7 +177,7 @@ class Baker:
         if scene.camera is None:
             scene.camera = _default_camera(size)  # only the G-buffer size is taken from it
         self.scene = scene
-        self.method = methods.create(backend, gi, rsm, lpv, vct)
+        self.method = methods.create(backend, settings)
         self.method.set_scene(scene)
         self.texels = TexelBaker(self.method)
         self.setup_ms = (time.perf_counter() - t0) * 1e3
@@ -315,14 +315,14 @@ IMAGE_SIZE_TEXELS = 512  # a lightmap's side when none is given
 
 
 def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size: int | None = None,
-              gi: GIConfig | None = None, rsm: RsmConfig | None = None, pass_name: str = "indirect",
+              settings: dict | None = None, pass_name: str = "indirect",
               target: str = "image", overwrite: bool = False, shard_index: int = 0, shard_count: int = 1,
-              save_blend: Path | None = None, margin: int = 16, progress: bool = True, backend=None,
-              lpv=None, vct=None) -> dict:
+              save_blend: Path | None = None, margin: int = 16, progress: bool = True, backend=None) -> dict:
     """Bake the objects of `blend` (see module docstring) into out_dir; returns the summary written to
     out_dir/bake.json. Per-object problems are recorded, never raised; bad arguments raise BounceError.
-    size: the lightmap side (IMAGE_SIZE_TEXELS when None). gi, rsm, lpv, vct: the configs (their
-    defaults when None). A bake that yields no light is recorded under "warnings" and told on stderr."""
+    size: the lightmap side (IMAGE_SIZE_TEXELS when None). settings: {group: config} (config.settings'
+    form; defaults for missing groups). A bake that yields no light is recorded under "warnings" and
+    told on stderr."""
     from .pipeline import backend as default_backend
     from .pipeline import open_blend
 
@@ -333,7 +333,8 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
     size = IMAGE_SIZE_TEXELS if size is None else size
     if not 8 <= size <= 8192:
         raise ConfigError(f"--size must be in 8..8192, got {size}")
-    gi, rsm = gi or GIConfig(), rsm or RsmConfig()
+    settings = complete_settings(**(settings or {}))
+    gi = settings["gi"]
     out_dir = check_output_dir(Path(out_dir))
     if save_blend is not None and Path(save_blend).resolve() == Path(blend).resolve():
         raise ConfigError("--save-blend must not be the input file (the .blend is never modified)")
@@ -346,7 +347,7 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
     t0 = time.perf_counter()
     be = backend or default_backend()
     say(f"bake: capturing the scene, method {gi.method} setup")
-    baker = Baker(be, bpy.context.evaluated_depsgraph_get(), gi, rsm, size, lpv, vct)
+    baker = Baker(be, bpy.context.evaluated_depsgraph_get(), settings, size)
     results = _bake_objects(baker, names, out_dir, size, pass_name, target, overwrite, margin, progress)
     saved = None
     if save_blend is not None and target == "vertex-colors":
@@ -357,7 +358,7 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
         print(f"warning: {Path(blend).name}: {warning}", file=sys.stderr)
     summary = {
         "blend": str(blend), "method": gi.method, "pass": pass_name, "target": target, "size": size,
-        "config": {"gi": gi.to_dict(), "rsm": rsm.to_dict()}, "renderer": be.renderer,
+        "config": {group: config.to_dict() for group, config in settings.items()}, "renderer": be.renderer,
         "setup_ms": round(baker.setup_ms, 2), "total_ms": round((time.perf_counter() - t0) * 1e3, 2),
         "shard": [shard_index, shard_count], "saved_blend": saved, "solves": baker.method.solves,
         "scene_warnings": list(baker.scene.warnings), "warnings": warnings,
@@ -434,7 +435,7 @@ def _bake_one(baker: Baker, name: str, out_dir: Path, size: int, pass_name: str,
     return res
 
 
-def bake_volume(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, lpv, overwrite: bool = False,
+def bake_volume(blend: Path, out_dir: Path, settings: dict, overwrite: bool = False,
                 backend=None, progress: bool = True) -> dict:
     """The LPV's indirect light of the whole scene as a volume for engines: DIR/<stem>_lpv_sh.npz.
 
@@ -451,10 +452,11 @@ def bake_volume(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, lpv, o
     (plain trilinear where all are 0): a cell holding a surface facing the receiver holds light its own
     geometry half-blocked (docs/LPV.md, "Lookup"). The finest cascade is written when there are several.
     """
-    from ..engine.methods.lpv import LpvMethod
     from .pipeline import backend as default_backend
     from .pipeline import open_blend
 
+    settings = complete_settings(**settings)
+    gi = settings["gi"]
     if gi.method != "lpv":
         raise ConfigError(f"--target volume bakes the LPV's grid: use --method lpv (got {gi.method})")
     out_dir = check_output_dir(Path(out_dir))
@@ -470,7 +472,7 @@ def bake_volume(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, lpv, o
     # The light field is solved without a camera: the volume depends on no view.
     scene = replace(SceneCache().update(bpy.context.evaluated_depsgraph_get(), 1, 1), camera=None)
     be = backend or default_backend()
-    method = LpvMethod(be, gi, rsm, lpv)
+    method = methods.create(be, settings)
     method.set_scene(scene)
     timings = method.solve_volume()
     sh = {f"sh_{c}": be.read(method.accumulated[f"acc_{c}"]) for c in "rgb"}

@@ -56,8 +56,8 @@ def setting_label(setting: dict) -> str:
     return ", ".join(f"{k.split('.', 1)[1]} {v}" for k, v in setting.items()) or "defaults"
 
 
-def make_configs(method: str, setting: dict, res: int, bounces: int):
-    """(GIConfig, RsmConfig, LpvConfig, VctConfig) for one setting; the dataclasses validate every value
+def make_configs(method: str, setting: dict, res: int, bounces: int) -> dict:
+    """{group: config} (config.settings' form) for one setting; the dataclasses validate every value
     (ConfigError)."""
     from ..engine.config import GROUPS
 
@@ -69,7 +69,7 @@ def make_configs(method: str, setting: dict, res: int, bounces: int):
             raise ConfigError(f"bench setting {key!r}: must be '<group>.<field>' with a group of "
                               f"{', '.join(GROUPS)}")
         groups[group][name] = value
-    return tuple(cls.from_dict(groups[group]) for group, cls in GROUPS.items())
+    return {group: cls.from_dict(groups[group]) for group, cls in GROUPS.items()}
 
 
 def curve_spp(ref_spp: int, quick: bool) -> list[int]:
@@ -383,10 +383,10 @@ def run_bench(opt: Options) -> dict:
         for method, setting in jobs:
             label = setting_label(setting)
             bar.set_postfix_str(f"{name}: {method} {label}")
-            gi, rsm, lpv, vct = make_configs(method, setting, opt.res, opt.bounces)
+            settings = make_configs(method, setting, opt.res, opt.bounces)
             run_dir = cache / "runs" / name / f"{method}-{label.replace(' ', '').replace(',', '_')}"
             run_dir.mkdir(parents=True, exist_ok=True)
-            st = render_file(blend, run_dir, gi, rsm, repeat=repeat, lpv=lpv, vct=vct)
+            st = render_file(blend, run_dir, settings, repeat=repeat)
             renderers.add(st["renderer"])
             product = products[method]
             m = _compare(run_dir / f"{product}.exr", ref_dir / f"{product}.exr")

@@ -16,9 +16,9 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-from ..engine import methods
+from ..engine import methods, registry
 from ..engine.backends.moderngl_backend import ModernGLBackend
-from ..engine.config import GIConfig, LpvConfig, RsmConfig, VctConfig
+from ..engine.config import settings as complete_settings
 from ..engine.errors import SceneError
 from . import images
 from .capture import SceneCache, define_light_switch, image_size
@@ -86,15 +86,17 @@ def update_costs(method, repeat: int) -> dict[str, float]:
     return {kind: statistics.median(ms) for kind, ms in samples.items()}
 
 
-def render_file(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, repeat: int = 3,
-                lpv: LpvConfig | None = None, vct: VctConfig | None = None,
+def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
                 progress: Callable[[str], None] = lambda step: None, profile_updates: bool = False) -> dict:
-    """Render `blend` with gi.method; write <product>.exr for each product and stats.json; return stats.
+    """Render `blend` with {group: config} settings (config.settings' form; missing groups take their
+    defaults); write <product>.exr for each product and stats.json; return stats.
 
     The timing is the median of `repeat` full updates after one warm-up (programs compiled, geometry
     uploaded): what a user waits for when a light moves. `progress(step)` is told each step. With
     profile_updates, stats["update_ms"] holds `update_costs` (full, lights, camera) over `repeat` runs.
     """
+    settings = complete_settings(**settings)
+    gi = settings["gi"]
     progress(f"opening {blend}")
     open_blend(blend)
     define_light_switch()  # read the per-light include switch saved in the file
@@ -105,7 +107,7 @@ def render_file(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, repeat
     captured = SceneCache().update(bpy.context.evaluated_depsgraph_get(), width, height)
     progress(f"method {gi.method}: uploading {captured.triangle_count} triangles, warm-up run (compiles shaders)")
     be = backend()
-    method = methods.create(be, gi, rsm, lpv, vct)
+    method = methods.create(be, settings)
     method.set_scene(captured)
     method.run()  # warm-up
     runs = []
@@ -127,9 +129,9 @@ def render_file(blend: Path, out_dir: Path, gi: GIConfig, rsm: RsmConfig, repeat
         notes.append("the scene has no light sources: all light is zero")
     stats = {
         "method": gi.method,
-        "config": {"gi": gi.to_dict(), "rsm": rsm.to_dict(),
-                   **({"lpv": method.lpv_config.to_dict()} if gi.method == "lpv" else {}),
-                   **({"vct": method.vct_config.to_dict()} if gi.method == "vct" else {})},
+        # The groups the method reads (registry): a shared group and its own.
+        "config": {group: settings[group].to_dict() for group in settings
+                   if group in registry.SHARED_GROUPS or group == registry.get(gi.method).own_group},
         "image_size": [width, height],
         "triangles": captured.triangle_count,
         "lights": len(captured.lights),

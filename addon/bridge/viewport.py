@@ -106,11 +106,11 @@ class Overlay:
         self.camera: Camera | None = None
         self.geometry_version = self.lights_version = -1
 
-    def update(self, state: live.LiveState, camera: Camera, gi, rsm_config, lpv_config, vct_config=None) -> bool:
-        """Bring the images up to date; False when they already were."""
-        configs = (gi, rsm_config, lpv_config, vct_config)
-        if self.method is None or self.configs != configs:
-            self.method, self.configs = methods.create(backend(), gi, rsm_config, lpv_config, vct_config), configs
+    def update(self, state: live.LiveState, camera: Camera, settings: dict) -> bool:
+        """Bring the images up to date for {group: config} settings; False when they already were. The
+        method decides what to re-run (a camera move gathers from its kept light field)."""
+        if self.method is None or self.configs != settings:
+            self.method, self.configs = methods.create(backend(), settings), settings
             self.method.profile = False  # no GPU sync per pass: the callback times the whole update
             self.geometry_version = -1
         if self.geometry_version != state.geometry_version:
@@ -236,9 +236,11 @@ def _draw(context, settings) -> None:
     if moved:
         live.touch()  # navigating is interaction too: preview now, full quality once it stops
     quality = "preview" if moved or state.quality == "preview" else "full"
-    gi, rsm_config, lpv_config, vct_config = to_config(settings)
+    configs = to_config(settings)
+    gi, rsm_config = configs["gi"], configs["rsm"]
     if quality == "preview":
-        rsm_config = dataclasses.replace(rsm_config, vpl_samples=max(1, rsm_config.vpl_samples // PREVIEW_VPL_DIVISOR))
+        vpls = max(1, rsm_config.vpl_samples // PREVIEW_VPL_DIVISOR)
+        configs["rsm"] = dataclasses.replace(rsm_config, vpl_samples=vpls)
     width, height = view_size(region.width, region.height, gi.resolution, quality)
     camera = region_camera(*matrices, width, height, context.scene.unit_settings.scale_length)
     overlay = overlay_for(region_key, quality)
@@ -247,7 +249,7 @@ def _draw(context, settings) -> None:
     framebuffer, region_viewport = gpu.state.active_framebuffer_get(), gpu.state.viewport_get()
     with _restored_gpu_state():
         t0 = time.perf_counter()
-        computed = overlay.update(state, camera, gi, rsm_config, lpv_config, vct_config)
+        computed = overlay.update(state, camera, configs)
         if computed:
             backend().finish()  # one wait per update (not per pass), so the time shown is the GPU's too
     if computed:

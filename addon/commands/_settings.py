@@ -20,7 +20,7 @@ from ..engine import config
 from ..engine.config import GIConfig, LpvConfig, RsmConfig, VctConfig
 from ..engine.errors import ConfigError
 
-CONFIGS = (GIConfig, RsmConfig, LpvConfig, VctConfig)
+CONFIGS = tuple(config.GROUPS.values())
 
 # GIConfig and RsmConfig both have `resolution` and they are different ideas (image vs. shadow map).
 _PRIMARY = {(RsmConfig, "resolution"): "--rsm-resolution"}
@@ -180,14 +180,15 @@ def flag_name(cls: type, name: str) -> str:
     return _find(cls, name).flags[0]
 
 
-def configs(args, **overrides) -> tuple[GIConfig, RsmConfig, LpvConfig, VctConfig]:
-    """The four frozen configs from parsed args; overrides: {dest: value} replacing parsed values."""
+def configs(args, **overrides) -> dict:
+    """{group: config} (config.settings' form) from parsed args; overrides: {dest: value} replacing
+    parsed values."""
     values = {cls: {} for cls in CONFIGS}
     for setting in SETTINGS:
         value = overrides.get(setting.dest, getattr(args, setting.dest))
         for cls, name in setting.fields:
             values[cls][name] = value
-    return tuple(cls(**values[cls]) for cls in CONFIGS)
+    return {group: cls(**values[cls]) for group, cls in config.GROUPS.items()}
 
 
 def in_flag_terms(message: str) -> str:

@@ -77,7 +77,8 @@ def run(args) -> int:
     _check_target(args)
     index, count = parse_shard(args.shard)
     volume = args.target == "volume"
-    gi, rsm, lpv, vct = configs(args, **({"method": VOLUME_METHOD} if volume else {}))
+    settings = configs(args, **({"method": VOLUME_METHOD} if volume else {}))
+    gi = settings["gi"]
     check_bounces(gi)
     if not volume:
         _check_pass(gi, args.pass_name)
@@ -94,7 +95,7 @@ def run(args) -> int:
     out = Path(args.out)
     if volume:
         for blend in blends:
-            bake_volume(blend, out, gi, rsm, lpv, args.overwrite, progress=not args.quiet)
+            bake_volume(blend, out, settings, args.overwrite, progress=not args.quiet)
         return 0
     failed, files = [], {}
     for blend in blends:
@@ -102,9 +103,9 @@ def run(args) -> int:
         file_out = out if len(blends) == 1 else out / safe_name(blend.stem)
         if len(blends) > 1:
             out.mkdir(parents=True, exist_ok=True)
-        summary = bake_file(blend, file_out, objects, args.size, gi, rsm, args.pass_name, args.target,
+        summary = bake_file(blend, file_out, objects, args.size, settings, args.pass_name, args.target,
                             args.overwrite, index, count, Path(args.save_blend) if args.save_blend else None,
-                            args.margin, progress=not args.quiet, lpv=lpv, vct=vct)
+                            args.margin, progress=not args.quiet)
         files[str(blend)] = str(file_out / "bake.json")
         failed += [f"{blend.name}:{n}" for n, r in summary["objects"].items() if r["status"] == "error"]
     if len(blends) > 1:

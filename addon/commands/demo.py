@@ -46,8 +46,8 @@ def run(args) -> int:
     say(f"building the Cornell box -> {blend}")
     scenes.save("cornell", blend)
     say("rendering direct and indirect light with Bounce (method rsm, voxel visibility; moderngl)")
-    stats = render_file(blend, out, GIConfig(method="rsm", resolution=args.res), RsmConfig(visibility="voxel"),
-                        progress=say)
+    stats = render_file(blend, out, {"gi": GIConfig(method="rsm", resolution=args.res),
+                                     "rsm": RsmConfig(visibility="voxel")}, progress=say)
     say(f"rendering the same with Cycles ({args.spp} spp) for comparison")
     ref_dir = out / "cycles"
     ref = render_reference(blend, ref_dir, spp=args.spp, bounces=1, res=args.res, seed=0, progress=say)

@@ -27,14 +27,14 @@ def add_arguments(p) -> None:
 
 
 def run(args) -> int:
-    gi, rsm, lpv, vct = configs(args)
-    check_bounces(gi)
+    settings = configs(args)
+    check_bounces(settings["gi"])
     blend = existing_blend(args.blend)
     out = output_dir(args.out)
     from ..bridge.pipeline import render_file  # imports bpy: only when actually rendering
 
-    stats = render_file(blend, out, gi, rsm, repeat=max(1, args.repeat), lpv=lpv, vct=vct,
-                        progress=progress(args.quiet), profile_updates=args.profile_updates)
+    stats = render_file(blend, out, settings, repeat=max(1, args.repeat), progress=progress(args.quiet),
+                        profile_updates=args.profile_updates)
     summary = {"out": str(out), "total_ms": round(stats["total_ms"], 2), "notes": stats["notes"]}
     if "update_ms" in stats:
         summary["update_ms"] = {k: round(v, 2) for k, v in stats["update_ms"].items()}

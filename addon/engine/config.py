@@ -152,6 +152,22 @@ class GIConfig(_Validated):
 GROUPS: dict[str, type] = {"gi": GIConfig, "rsm": RsmConfig, "lpv": LpvConfig, "vct": VctConfig}
 
 
+def settings(**configs) -> dict[str, Any]:
+    """{group: config} for every group of GROUPS: the given configs, each group's defaults for the rest.
+    What a method is built from (methods.create), and what scene.bounce, the command line and the
+    benchmark settings turn into, so no caller lists the groups."""
+    unknown = sorted(set(configs) - set(GROUPS))
+    if unknown:
+        raise ConfigError(f"unknown settings group(s) {', '.join(unknown)}; known: {', '.join(GROUPS)}")
+    out = {}
+    for group, cls in GROUPS.items():
+        value = configs.get(group)
+        if value is not None and not isinstance(value, cls):
+            raise ConfigError(f"settings group {group!r} takes a {cls.__name__}, got {type(value).__name__}")
+        out[group] = cls() if value is None else value
+    return out
+
+
 def limits(cls) -> dict[str, dict[str, Any]]:
     """Field name -> {'default', 'min'/'max' or 'choices', 'doc'}: what Blender properties mirror."""
     out = {}

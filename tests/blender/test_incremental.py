@@ -49,8 +49,9 @@ def _method(gl, case):
     from addon.engine.config import GIConfig, LpvConfig, RsmConfig, VctConfig
 
     name, gi, lpv, vct, _ = CASES[case]
-    return methods.create(gl, GIConfig(method=name, resolution=32, **gi), RsmConfig(resolution=64, vpl_samples=16),
-                          LpvConfig(**lpv), VctConfig(**vct))
+    return methods.create(gl, {"gi": GIConfig(method=name, resolution=32, **gi),
+                               "rsm": RsmConfig(resolution=64, vpl_samples=16), "lpv": LpvConfig(**lpv),
+                               "vct": VctConfig(**vct)})
 
 
 def _fresh_images(gl, case, scene):

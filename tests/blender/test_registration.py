@@ -140,8 +140,7 @@ def test_defaults_give_default_configs(registered):
     from bounce.addon.engine import config
     from bounce.addon.properties import to_config
 
-    assert to_config(bpy.context.scene.bounce) == (config.GIConfig(), config.RsmConfig(), config.LpvConfig(),
-                                                   config.VctConfig())
+    assert to_config(bpy.context.scene.bounce) == config.settings()
 
 
 def test_settings_survive_save_and_reload(registered, tmp_path):
@@ -163,7 +162,8 @@ def test_settings_survive_save_and_reload(registered, tmp_path):
     bpy.ops.wm.open_mainfile(filepath=str(path))
     settings = bpy.context.scene.bounce
     assert settings.enabled
-    gi, rsm, lpv, _vct = to_config(settings)
+    configs = to_config(settings)
+    gi, rsm, lpv = configs["gi"], configs["rsm"], configs["lpv"]
     assert (gi.method, gi.bounces, rsm.resolution) == ("rsm", 3, 512)
     assert (lpv.variant, lpv.geometry_volume) == ("improved", True)
     assert rsm.shadow_bias_texels == 0.05  # exactly: to_config undoes Blender's float32 rounding

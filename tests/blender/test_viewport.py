@@ -185,8 +185,8 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
     for be in (gl, blender_backend):
         lpv = LpvConfig(grid_cells=grid_cells, variant="improved", geometry_volume=True,
                         emitter_classes=name == "lpv-emitter-classes")
-        method = methods.create(be, gi, rsm, lpv,
-                                VctConfig(voxel_cells=16, diffuse_cones=6, filtered_injection=name == "vct-filtered"))
+        vct = VctConfig(voxel_cells=16, diffuse_cones=6, filtered_injection=name == "vct-filtered")
+        method = methods.create(be, {"gi": gi, "rsm": rsm, "lpv": lpv, "vct": vct})
         method.set_scene(scene)
         results.append(method.run().images)
     a, b = results

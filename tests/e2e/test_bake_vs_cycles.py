@@ -30,15 +30,16 @@ def test_bake_matches_cycles_bake(tmp_path):
     ours, ours_ms = {}, {}
     for pass_name in ("indirect", "direct"):
         out = tmp_path / pass_name
-        summary = bake_file(blend, out, list(OBJECTS), SIZE, GIConfig(method="rsm"),
-                            RsmConfig(visibility="voxel", voxel_cells=128, vpl_samples=1024), pass_name, progress=False)
+        rsm = RsmConfig(visibility="voxel", voxel_cells=128, vpl_samples=1024)
+        settings = {"gi": GIConfig(method="rsm"), "rsm": rsm}
+        summary = bake_file(blend, out, list(OBJECTS), SIZE, settings, pass_name, progress=False)
         for name in OBJECTS:
             assert summary["objects"][name]["status"] == "ok", summary["objects"][name]
             ours[name, pass_name] = images.read_exr(out / f"{name}_{pass_name}.exr")
             ours_ms[name, pass_name] = summary["objects"][name]["time_ms"]
         ours_ms["setup", pass_name] = summary["setup_ms"]
     vct_out = tmp_path / "vct"
-    summary = bake_file(blend, vct_out, list(OBJECTS), SIZE, GIConfig(method="vct"), RsmConfig(), "indirect",
+    summary = bake_file(blend, vct_out, list(OBJECTS), SIZE, {"gi": GIConfig(method="vct")}, "indirect",
                         progress=False)
     for name in OBJECTS:
         assert summary["objects"][name]["status"] == "ok", summary["objects"][name]

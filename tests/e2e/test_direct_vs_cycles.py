@@ -59,8 +59,8 @@ def test_direct_matches_cycles_diffuse_direct(scene_name, tmp_path):
     blend = tmp_path / f"{scene_name}.blend"
     scenes.save(scene_name, blend)
     (tmp_path / "ours").mkdir()
-    render_file(blend, tmp_path / "ours", GIConfig(method="direct", resolution=RES), RsmConfig(resolution=512),
-                repeat=1)
+    render_file(blend, tmp_path / "ours", {"gi": GIConfig(method="direct", resolution=RES),
+                                           "rsm": RsmConfig(resolution=512)}, repeat=1)
     refs = [render_reference(blend, tmp_path / f"ref{s}", spp=SPP, bounces=1, res=RES, seed=s) for s in (0, 1)]
     assert refs[0]["width"] == RES
 

@@ -15,12 +15,12 @@ def test_rsm_gather_on_cornell(tmp_path):
     from addon.bridge.pipeline import render_file
     from addon.bridge.reference import render_reference
     from addon.engine import metrics
-    from addon.engine.config import GIConfig, RsmConfig
+    from addon.engine.config import GIConfig
 
     blend = tmp_path / "cornell.blend"
     scenes.save("cornell", blend)
     (tmp_path / "ours").mkdir()
-    stats = render_file(blend, tmp_path / "ours", GIConfig(method="rsm", resolution=64), RsmConfig(), repeat=1)
+    stats = render_file(blend, tmp_path / "ours", {"gi": GIConfig(method="rsm", resolution=64)}, repeat=1)
     render_reference(blend, tmp_path / "ref", spp=256, bounces=1, res=64, seed=0)
     ours = images.read_exr(tmp_path / "ours" / "indirect.exr")
     ref = images.read_exr(tmp_path / "ref" / "indirect.exr")

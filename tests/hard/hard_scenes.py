@@ -104,9 +104,11 @@ def make(gl, name, rsm_res=128, vpl=64):
     method, _, variant = name.partition("+")
     kw = {"resolution": rsm_res, "vpl_samples": vpl}
     if variant == "classes":
-        return methods.create(gl, GIConfig(method=method), RsmConfig(**kw), LpvConfig(emitter_classes=True))
+        return methods.create(gl, {"gi": GIConfig(method=method), "rsm": RsmConfig(**kw),
+                                   "lpv": LpvConfig(emitter_classes=True)})
     if variant == "filtered":
-        return methods.create(gl, GIConfig(method=method), RsmConfig(**kw), vct=VctConfig(filtered_injection=True))
+        return methods.create(gl, {"gi": GIConfig(method=method), "rsm": RsmConfig(**kw),
+                                   "vct": VctConfig(filtered_injection=True)})
     if variant:
         kw["visibility"] = variant
     return methods.get(method)(gl, GIConfig(method=method), RsmConfig(**kw))

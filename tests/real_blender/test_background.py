@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-METHODS = ("direct", "rsm", "lpv", "vct")
+from addon.engine.registry import NAMES as METHODS
 
 
 def test_blender_is_a_real_4x_binary(installed):

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-METHODS = ("direct", "rsm", "lpv", "vct")
+from addon.engine.registry import NAMES as METHODS
 
 
 def _crop(path: Path, area, window_h: int) -> np.ndarray:

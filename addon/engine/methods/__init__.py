@@ -1,21 +1,21 @@
 """One module per GI method: which passes run, in which order. The registry (engine/registry.py)
-declares them; `get(name)` returns a method's class, `create(backend, gi, rsm, lpv, vct)` an instance
-with its configs."""
+declares them; `get(name)` returns a method's class, `create(backend, settings)` an instance."""
 
 from __future__ import annotations
 
 from .. import registry
+from ..config import settings as complete
 
 
 def get(name: str):
     return registry.method_class(name)
 
 
-def create(backend, gi, rsm, lpv=None, vct=None):
-    """The method `gi.method` with its configs: every method takes (gi, rsm); a method with a settings
-    group of its own (registry: lpv, vct) also that group's config (its defaults when None)."""
-    cls = get(gi.method)
-    own = registry.get(gi.method).own_group
-    if own is None:
-        return cls(backend, gi, rsm)
-    return cls(backend, gi, rsm, {"lpv": lpv, "vct": vct}[own])
+def create(backend, settings: dict):
+    """The method settings["gi"].method built from {group: config} (config.settings; missing groups
+    take their defaults): every method takes the gi and rsm configs, a method with a settings group of
+    its own (registry) also that group's config."""
+    settings = complete(**settings)
+    spec = registry.get(settings["gi"].method)
+    own = (settings[spec.own_group],) if spec.own_group else ()
+    return get(spec.name)(backend, settings["gi"], settings["rsm"], *own)

@@ -13,7 +13,6 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
 OBJECTS = ("Floor", "BackWall")
-METHODS = ("direct", "rsm", "lpv", "vct")
 
 
 def select(names):
@@ -31,7 +30,7 @@ def run(result):
     settings.lpv.grid_cells, settings.vct.voxel_cells, settings.vct.diffuse_cones = 16, 16, 6
     bake = _common.bounce("addon.bridge.bake")
     methods = {}
-    for method in METHODS:
+    for method in _common.bounce("addon.engine.registry").NAMES:
         settings.gi.method = method
         pass_name = "direct" if method == "direct" else "indirect"
         select(OBJECTS)

@@ -14,7 +14,6 @@ sys.path.insert(0, os.path.dirname(__file__))
 import _common  # noqa: E402
 import bpy  # noqa: E402
 
-METHODS = ("direct", "rsm", "lpv", "vct")
 WAIT_S = 120.0  # llvmpipe: vct's first update in a window takes seconds; a GPU takes milliseconds
 
 shot_dir, result_path = _common.args()[:2]
@@ -65,7 +64,7 @@ def steps():
     settings = bpy.context.scene.bounce
     settings.lpv.grid_cells, settings.vct.voxel_cells, settings.vct.diffuse_cones = 16, 32, 6
     spot = bpy.data.objects["Spot"]
-    for method in METHODS:
+    for method in _common.bounce("addon.engine.registry").NAMES:
         entry = result["methods"].setdefault(method, {})
         for phase in ("on", "moved"):
             runs = viewport.gpu_runs
