@@ -6,9 +6,8 @@ caller per update); `unpack` copies them, once per update, into the snapshot vol
 RGBA32F 3D textures of grid.dims holding, per colour channel, the L1 SH (order 1, y, z, x) of the
 radiant intensity in W/sr that leaves the cell, by direction of travel. A VPL of flux phi and normal n
 adds phi / pi * (0.886227, 1.023327 n) (its Lambertian intensity phi / pi * max(0, n.w) projected) to
-the cell containing pos + 0.6 cell * n (not half a cell: inject.vert.glsl says why); the cell's flux is the
-integral of the intensity,
-2 sqrt(pi) * c0 (docs/LPV.md derives the units).
+the cell containing pos + 0.6 cell * n (not half a cell: inject.vert.glsl says why); the cell's flux
+is the integral of the intensity, 2 sqrt(pi) * c0 (docs/LPV.md derives the units).
 
 Portable scatter (ARCHITECTURE.md section 3): additive point splats, no atomics. The z-layers are tiles
 of one 2D atlas (passes/atlas.py: layer z is tile (z % tiles_x, z // tiles_x), one texel per cell), so
