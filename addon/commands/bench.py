@@ -1,8 +1,10 @@
-"""`python -m addon bench [--scenes a,b] [--methods direct,rsm] [--quick] [--res N] [--ref-spp N] [--out DIR]`:
-speed against error for every method x setting on every scene (see addon/bridge/bench.py).
+"""`python -m addon bench [--scenes a,b] [--methods direct,rsm] [--settings-filter all|default] [--quick]
+[--no-update-costs] [--res N] [--ref-spp N] [--out DIR]`: speed against error for every method x setting on
+every scene, with each setting's update costs (see addon/bridge/bench.py).
 
-Writes DIR/REPORT.md (the generated block between its markers; text outside them is kept) and
-DIR/<scene>.png; caches scenes and Cycles references under --cache. Prints one JSON line at the end.
+Writes DIR/REPORT.md (the generated block between its markers; text outside them is kept),
+DIR/results.json (one record per scene x method x setting) and DIR/<scene>.png; caches scenes and Cycles
+references under --cache. Prints one JSON line at the end.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ import json
 import os
 from pathlib import Path
 
+from ..bridge.bench import ROW_FILTERS  # bridge/bench.py imports without bpy
 from ..engine.config import GIConfig
 from ..engine.errors import ConfigError
 from ._args import add_quiet, output_dir
@@ -33,6 +36,11 @@ def _names(text: str | None) -> list[str] | None:
 def add_arguments(p) -> None:
     p.add_argument("--scenes", help="comma-separated scene names (default: all procedural + real scenes found)")
     p.add_argument("--methods", help="comma-separated methods (default: every implemented method)")
+    p.add_argument("--settings-filter", default="all", choices=ROW_FILTERS,
+                   help="which registry rows of each method run: all (default), or default = the row at the "
+                        "method's default settings (one run per method and scene)")
+    p.add_argument("--no-update-costs", action="store_true",
+                   help="skip timing the full / lights / camera updates of each row (faster)")
     p.add_argument("--quick", action="store_true",
                    help="CI size: reference 128 spp, Cycles curve 1/4/16 spp, 2 timed runs")
     add_field_flag(p, GIConfig, "resolution", "--res", default=128, doc="long side in pixels")
@@ -63,14 +71,16 @@ def run(args) -> int:
     check_settings(ref_spp or bench.REF_SPP, args.bounces, args.res)  # before bpy is imported
     for m in methods or ():
         bench.settings_for(m)
+    update_costs = not args.no_update_costs
     opt = bench.Options(
         scenes=scenes, methods=methods, quick=args.quick, res=args.res, ref_spp=ref_spp, bounces=args.bounces,
-        out=output_dir(args.out), cache=Path(args.cache),
+        update_costs=update_costs, row_filter=args.settings_filter, out=output_dir(args.out), cache=Path(args.cache),
         command=bench.command_line(scenes, methods, args.quick, args.res, ref_spp, args.bounces, args.out,
-                                   args.cache),
+                                   args.cache, update_costs, args.settings_filter),
     )
     with _quiet_stderr(args.quiet):
         result = bench.run_bench(opt)
-    print(json.dumps({"report": str(opt.out / "REPORT.md"), "scenes": [s["name"] for s in result["scenes"]],
+    print(json.dumps({"report": str(opt.out / "REPORT.md"), "results": str(opt.out / "results.json"),
+                      "scenes": [s["name"] for s in result["scenes"]],
                       "skipped": result["skipped"]}))
     return 0

@@ -79,7 +79,10 @@ def _fake_result():
             "name": "cornell", "source": "procedural", "size": [48, 48], "ref_spp": 128, "ref_time_s": 0.2,
             "noise_floor": {"direct": metric}, "notes": [], "plot": "cornell.png",
             "curve": {"direct": [{"spp": 1, "time_s": 0.006, "rel_rmse": 0.16, "rel_rmse_8": 0.05, "bias": 0.99}]},
-            "runs": [{"method": "direct", "setting": "resolution 256", "product": "direct",
+            "runs": [{"method": "direct", "setting": "resolution 256", "setting_fields": {"rsm.resolution": 256},
+                      "default": True, "product": "direct", "image_size": [48, 48], "triangles": 34,
+                      "config": {"gi": {"method": "direct", "resolution": 48}, "rsm": {"resolution": 256}},
+                      "update_ms": None,
                       "timings_ms": {"gbuffer": 0.4, "rsm": 2.7, "total": 3.1}, "total_ms": 3.1, "runs": 2,
                       "metrics": metric, "speedup": {"cycles_time_s": 0.006, "speedup": 1.9, "bound": "<"}}],
         }],
@@ -105,14 +108,78 @@ def test_report_formatting_and_merge_keep_hand_written_text():
     assert bench.merge_report("no markers", block).count("no markers") == 0
 
 
+def test_default_filter_keeps_the_row_at_the_defaults():
+    assert bench.select_rows("direct", "all", 64, 1) == bench.SETTINGS["direct"]
+    assert bench.select_rows("direct", "default", 64, 1) == ({"rsm.resolution": 256},)
+    assert bench.select_rows("vct", "default", 64, 1) == ({"vct.voxel_cells": 64},)
+    for method in bench.SETTINGS:  # exactly one registry row per method equals its defaults
+        (row,) = bench.select_rows(method, "default", 64, 1)
+        assert bench.is_default_row(method, row, 64, 1)
+    assert not bench.is_default_row("direct", {"rsm.resolution": 512}, 64, 1)
+    with pytest.raises(ConfigError):
+        bench.select_rows("direct", "first", 64, 1)
+
+
+def test_update_cells_and_columns():
+    assert bench.format_update_cells({"full": 172.0, "lights": 168.4, "camera": 19.0}) == \
+        ["172.00", "168.40", "19.00", "11 %"]
+    assert bench.format_update_cells(None) == ["n/a"] * 4
+    result = _fake_result()
+    result["update_costs"] = True
+    run = result["scenes"][0]["runs"][0]
+    run["update_ms"] = {"full": 3.0, "lights": 2.0, "camera": 1.5}
+    block = bench.format_report(result)
+    assert "| total ms | update full ms | update lights ms | update camera ms | camera/full | rel_rmse |" in block
+    assert "| 3.10 | 3.00 | 2.00 | 1.50 | 50 % | 0.3 | 0.06 |" in block
+    assert "Update costs (`update ... ms`): medians of 2 updates" in block
+    assert "\n" + "| --- " * 15 + "|\n" in block  # 9 fixed + 2 passes + 4 update columns
+
+
+def test_results_json_has_one_record_per_run():
+    result = _fake_result()
+    result.update(quick=True, update_costs=True, row_filter="all")
+    result["machine"]["date"] = "2026-12-01"
+    run = result["scenes"][0]["runs"][0]
+    run["update_ms"] = {"full": 3.0, "lights": 2.0, "camera": 1.5}
+    nan_run = {**run, "setting": "resolution 512", "setting_fields": {"rsm.resolution": 512}, "default": False,
+               "update_ms": None, "metrics": {**run["metrics"], "rel_rmse_8": None},
+               "speedup": {"cycles_time_s": math.nan, "speedup": math.nan, "bound": "=", "extrapolated_speedup": None}}
+    result["scenes"][0]["runs"].append(nan_run)
+    out = bench.results_json(result)
+    text = json.dumps(out, allow_nan=False)  # NaN is not JSON: an undefined speed-up must be null
+    assert json.loads(text) == out
+    assert out["schema"] == bench.RESULTS_SCHEMA and out["machine"]["date"] == "2026-12-01"
+    assert out["command"] == result["command"] and out["res"] == 48 and out["row_filter"] == "all"
+    assert [s["name"] for s in out["scenes"]] == ["cornell"] and "runs" not in out["scenes"][0]
+    first, second = out["records"]
+    assert first == {
+        "scene": "cornell", "method": "direct", "setting": {"rsm.resolution": 256}, "label": "resolution 256",
+        "default": True, "product": "direct", "config": run["config"], "image_size": [48, 48], "triangles": 34,
+        "timings_ms": {"gbuffer": 0.4, "rsm": 2.7, "total": 3.1}, "total_ms": 3.1, "runs": 2,
+        "update_ms": {"full": 3.0, "lights": 2.0, "camera": 1.5},
+        "rel_rmse": 0.3, "rel_rmse_8": 0.06, "bias": 0.997,
+        "speedup": {"cycles_time_s": 0.006, "speedup": 1.9, "bound": "<"},
+    }
+    assert second["setting"] == {"rsm.resolution": 512} and second["update_ms"] is None
+    assert second["rel_rmse_8"] is None and second["speedup"]["speedup"] is None
+
+
+def test_command_line_spells_the_new_options():
+    cmd = bench.command_line(["cornell"], ["lpv"], False, 256, 512, 1, "benchmarks/updates", "out/bench",
+                             update_costs=False, row_filter="default")
+    assert cmd == ("python -m addon bench --scenes cornell --methods lpv --settings-filter default "
+                   "--no-update-costs --res 256 --ref-spp 512 --out benchmarks/updates")
+
+
 def test_cli_rejects_bad_input_before_rendering(capsys):
     from addon import cli
 
     assert cli.main(["bench", "--methods", "nope"]) == 2
     assert cli.main(["bench", "--res", "4"]) == 2
     assert cli.main(["bench", "--methods", ","]) == 2
+    assert cli.main(["bench", "--settings-filter", "first"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 3 and all(line.startswith("error: ") for line in err)
+    assert len(err) == 4 and all(line.startswith("error: ") for line in err)
 
 
 # ------------------------------------------------------------------------------ quick bench, e2e
@@ -160,6 +227,21 @@ def test_quick_bench_on_cornell(tmp_path):
         again = cycles_equivalent_speedup(m["rel_rmse_8"], r["total_ms"] / 1000, sc["curve"]["direct"])
         assert again == r["speedup"]
     assert all(isinstance(x, (int, float)) and math.isfinite(x) for x in numbers if x is not None)
+
+    # results.json: one record per run, the report's numbers, update costs timed by default
+    results = json.loads((out / "results.json").read_text())
+    assert results["schema"] == bench.RESULTS_SCHEMA and results["command"] == result["command"]
+    assert set(results["machine"]) >= {"cpu", "bounce_renderer", "blender", "date"}
+    assert [(r["scene"], r["method"], r["setting"], r["default"]) for r in results["records"]] == \
+        [("cornell", "direct", s, i == 0) for i, s in enumerate(bench.SETTINGS["direct"])]
+    assert "| update full ms | update lights ms | update camera ms | camera/full |" in report
+    for rec, r in zip(results["records"], sc["runs"], strict=True):
+        assert rec["image_size"] == [QUICK_RES, QUICK_RES] and rec["triangles"] > 0
+        assert rec["config"]["gi"]["resolution"] == QUICK_RES and rec["config"]["rsm"] == r["config"]["rsm"]
+        assert (rec["rel_rmse_8"], rec["bias"], rec["total_ms"]) == (r["metrics"]["rel_rmse_8"], r["metrics"]["bias"],
+                                                                     r["total_ms"])
+        assert set(rec["update_ms"]) == {"full", "lights", "camera"}
+        assert all(math.isfinite(ms) and ms > 0 for ms in rec["update_ms"].values()), rec["update_ms"]
     assert all(sc["noise_floor"]["direct"][k] is not None for k in ("rel_rmse", "rel_rmse_8", "bias"))
 
     # bench's own curve (all products from one render per spp) agrees with reference.cycles_curve on
