@@ -26,7 +26,7 @@ from .. import registry
 from ..backends.base import Backend
 from ..config import GIConfig, RsmConfig
 from ..errors import ConfigError
-from ..passes import direct_light, gbuffer, rsm, zero
+from ..passes import declare, direct_light, gbuffer, rsm, zero
 from ..passes.light_views import LightView, emissive_lights, views_for
 from ..scene import Camera, Scene
 
@@ -70,6 +70,10 @@ class DirectMethod:
     spec = registry.get("direct")
     name, products, max_bounces = spec.name, spec.products, spec.max_bounces
 
+    # The passes of each half of an update (passes/declare.py), in the order they run: what the method
+    # is, read as a list; tests check that it is what runs and that every input is written before.
+    PASSES = {"setup": (), "camera": (gbuffer.DECL,), "solve": (rsm.DECL,), "gather": (direct_light.DECL,)}
+
     def __init_subclass__(cls, **kwargs):
         # A method's name, products and bounce limit are its registry entry's: declared once.
         super().__init_subclass__(**kwargs)
@@ -89,6 +93,10 @@ class DirectMethod:
     def timed(self, timings: dict[str, float], name: str):
         """Time a block into timings[name] when profiling; otherwise run it untimed (no GPU sync)."""
         return self.backend.timed(timings, name) if self.profile else contextlib.nullcontext()
+
+    def step(self, timings: dict[str, float], decl: declare.PassDecl):
+        """Time a declared pass under its declared name (`timed`)."""
+        return self.timed(timings, decl.name)
 
     def set_scene(self, scene: Scene) -> None:
         """Upload geometry once; call again only when geometry changes. Camera and lights may change
@@ -144,12 +152,17 @@ class DirectMethod:
             return
         be = self.backend
         self._size = size
-        self.gbuf = {k: be.texture(size) for k in gbuffer.CHANNELS}
-        self.gbuf_target = be.target([self.gbuf[k] for k in gbuffer.CHANNELS], be.depth_texture(size))
+        self.gbuf = declare.allocate(be, gbuffer.DECL.outputs, size)
+        self.gbuf_target = be.target(list(self.gbuf.values()), be.depth_texture(size))
         self.allocate_products(size)
 
     def allocate_products(self, size: tuple[int, int]) -> None:
-        self.direct = self.backend.texture(size)
+        """The products (registry), as their gather passes declare them, each also an attribute
+        (`self.direct`, `self.indirect`, ...): the overlay and bakes sample them."""
+        ports = {p.name: p for decl in self.PASSES["gather"] for p in decl.outputs if p.group == "product"}
+        self._products = declare.allocate(self.backend, [ports[n] for n in self.products if n != "albedo"], size)
+        for name, texture in self._products.items():
+            setattr(self, name, texture)
 
     def camera(self) -> Camera:
         """The current camera in the uploaded geometry's (re-centred) frame."""
@@ -186,7 +199,7 @@ class DirectMethod:
         timings: dict[str, float] = {}
         with self.timed(timings, "total"):
             if run_gbuffer:
-                with self.timed(timings, "gbuffer"):
+                with self.step(timings, gbuffer.DECL):
                     gbuffer.run(self.backend, self.gbuf_target, self.gbuf, self._meshes[gbuffer.SPEC.name],
                                 self.camera())
             if keep:
@@ -223,7 +236,7 @@ class DirectMethod:
 
     def _draw_rsm(self, view: LightView, slot: int, timings: dict[str, float]) -> None:
         self.rsm, self.rsm_target = self._rsm_slot(slot)
-        with self.timed(timings, "rsm"):
+        with self.step(timings, rsm.DECL):
             rsm.run(self.backend, self.rsm_target, self._meshes[rsm.SPEC.name], view)
 
     def _solve(self, views: list[LightView], timings: dict[str, float], slots) -> None:
@@ -241,7 +254,7 @@ class DirectMethod:
         self.gather_pixels(timings)
 
     def _gather_view(self, view: LightView, timings: dict[str, float]) -> None:
-        with self.timed(timings, "direct_light"):
+        with self.step(timings, direct_light.DECL):
             direct_light.run(self.backend, self.gbuf["position"], self.gbuf["normal"], self.rsm["position"],
                              self.direct, view, self.rsm_config.shadow_bias_texels)
         self.gather_view(view, timings)
@@ -284,7 +297,7 @@ class DirectMethod:
         """After every face's gather: per-pixel reads of the light field (lookups, cones)."""
 
     def product_textures(self) -> dict:
-        return {"direct": self.direct}
+        return dict(self._products)
 
 
 class OneBounceMethod(DirectMethod):
@@ -298,13 +311,6 @@ class OneBounceMethod(DirectMethod):
                               f"GIConfig.bounces = {gi.bounces}")
         super().__init__(backend, gi, rsm_config)
 
-    def allocate_products(self, size: tuple[int, int]) -> None:
-        super().allocate_products(size)
-        self.indirect = self.backend.texture(size)
-
     def clear_products(self) -> None:
         super().clear_products()
         zero.images(self.backend, [self.indirect])
-
-    def product_textures(self) -> dict:
-        return {**super().product_textures(), "indirect": self.indirect}

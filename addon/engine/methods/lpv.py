@@ -41,6 +41,7 @@ from ..errors import ConfigError
 from ..grid import Grid
 from ..passes import (
     atlas,
+    declare,
     lpv_cascade,
     lpv_far_field,
     lpv_inject,
@@ -48,6 +49,7 @@ from ..passes import (
     lpv_propagate,
     lpv_reinject,
     rsm_reduce,
+    voxelize,
     zero,
 )
 from ..passes.light_views import LightView
@@ -144,6 +146,14 @@ class LpvVolume:
 
 class LpvMethod(OneBounceMethod):
     spec = registry.get("lpv")
+    PASSES = declare.extend(
+        OneBounceMethod.PASSES, setup=(voxelize.DECL, lpv_propagate.BLOCKING_DECL),
+        # Per cascade, coarsest first: a finer one's inflow reads its parent's propagated light.
+        solve=(lpv_cascade.PLACE_DECL, lpv_inject.DECL, lpv_propagate.DECL, lpv_cascade.INFLOW_DECL,
+               lpv_far_field.DECL),
+        # With emitter classes the lookup's own-class readings need each class's propagation: the
+        # gather runs them (propagate_classes); later bounces re-inject and propagate in the gather too.
+        gather=(lpv_inject.DECL, lpv_propagate.DECL, lpv_lookup.DECL, lpv_reinject.DECL))
 
     def __init__(self, backend, gi, rsm_config, lpv_config: LpvConfig | None = None):
         super().__init__(backend, gi, rsm_config)
@@ -218,13 +228,13 @@ class LpvMethod(OneBounceMethod):
 
     def begin_solve(self, timings: dict[str, float]) -> None:
         if len(self.levels) > 1:
-            with self.timed(timings, "lpv_place"):
+            with self.step(timings, lpv_cascade.PLACE_DECL):
                 self.follow_camera()
         for level in self.grids():
             zero.images(self.backend, list(level.inject_atlas.values()))
 
     def solve_view(self, view: LightView, timings: dict[str, float]) -> None:
-        with self.timed(timings, "lpv_inject"):
+        with self.step(timings, lpv_inject.DECL):
             vpls = self.rsm
             if self._vpls is not None:
                 rsm_reduce.run(self.backend, self.rsm, self._vpls, self._reduce)
@@ -276,7 +286,7 @@ class LpvMethod(OneBounceMethod):
         for bounce in range(self.gi.bounces - 1):
             for i in reversed(range(len(levels))):
                 level = levels[i]
-                with self.timed(timings, "lpv_reinject"):
+                with self.step(timings, lpv_reinject.DECL):
                     # With emitter classes the first bounce's surfaces reflect the other classes' light.
                     lpv_reinject.run(be, previous[i], level.voxels, level.snapshots[0], level.grid,
                                      own=level.own_reinject if bounce == 0 else None)
@@ -287,17 +297,17 @@ class LpvMethod(OneBounceMethod):
                     if level.far is not None:
                         lpv_far_field.source(be, level.snapshots[0], level.grid, level.far.snapshots[0],
                                              level.far.grid)
-                with self.timed(timings, "lpv_propagate"):
+                with self.step(timings, lpv_propagate.DECL):
                     self.propagate(accumulated=level.bounce_accumulated, level=level)
             if look_up:
-                with self.timed(timings, "lpv_lookup"):
+                with self.step(timings, lpv_lookup.DECL):
                     if len(levels) == 1:
                         lpv_lookup.run(be, self.gbuf, levels[0].bounce_accumulated, self.indirect, levels[0].grid,
                                        accumulate=True, vox_normal=self.lookup_vox(levels[0]))
                     else:
                         self.look_up(lambda level: level.bounce_accumulated, self._bounce_image)
                         lpv_lookup.add_image(be, self._bounce_image, self.indirect)
-            with self.timed(timings, "lpv_reinject"):
+            with self.step(timings, lpv_reinject.DECL):
                 for level in levels:
                     lpv_reinject.add(be, level.bounce_accumulated, level.accumulated, level.grid)
             previous = [level.bounce_accumulated for level in levels]
@@ -317,7 +327,7 @@ class LpvMethod(OneBounceMethod):
         # Coarsest first: a finer cascade's inflow reads its parent's propagated light.
         for i in reversed(range(len(self.levels))):
             level = self.levels[i]
-            with self.timed(timings, "lpv_inject"):
+            with self.step(timings, lpv_inject.DECL):
                 lpv_inject.unpack(be, level.inject_atlas, level.snapshots[0], level.grid, level.atlas)
                 if level.far is not None:
                     far = level.far
@@ -326,7 +336,7 @@ class LpvMethod(OneBounceMethod):
                     parent = self.levels[i + 1]
                     lpv_cascade.inflow(be, level.cascade, level.snapshots[0], parent.grid, parent.accumulated,
                                        parent.snapshots[0], self.lpv_config.variant)
-            with self.timed(timings, "lpv_propagate"):
+            with self.step(timings, lpv_propagate.DECL):
                 if len(self.levels) > 1:
                     with self.timed(timings, f"lpv_propagate_cascade{i}"):
                         self.propagate(level=level)
@@ -341,24 +351,24 @@ class LpvMethod(OneBounceMethod):
         be, level = self.backend, self.levels[0]
         zero.layers(be, list(level.accumulated.values()), 0, level.grid.dims[2])
         for emitter in range(lpv_inject.CLASSES):
-            with self.timed(timings, "lpv_inject"):
+            with self.step(timings, lpv_inject.DECL):
                 lpv_inject.unpack(be, level.inject_atlas, level.snapshots[0], level.grid, level.atlas, emitter)
                 if level.far is not None:
                     far = level.far
                     lpv_inject.unpack(be, far.inject_atlas, far.snapshots[0], far.grid, far.atlas, emitter)
-            with self.timed(timings, "lpv_propagate"):
+            with self.step(timings, lpv_propagate.DECL):
                 self.propagate(accumulated=level.class_accumulated, level=level)
                 lpv_reinject.add(be, level.class_accumulated, level.accumulated, level.grid)
             if look_up:
-                with self.timed(timings, "lpv_lookup"):
+                with self.step(timings, lpv_lookup.DECL):
                     lpv_lookup.own(be, self.gbuf, level.class_accumulated, self._own_light, level.grid, emitter,
                                    vox_normal=self.lookup_vox(level))
             if level.own_reinject is not None:
-                with self.timed(timings, "lpv_reinject"):
+                with self.step(timings, lpv_reinject.DECL):
                     lpv_reinject.own(be, level.class_accumulated, level.voxels, level.own_reinject, level.grid,
                                      emitter)
         if look_up:
-            with self.timed(timings, "lpv_lookup"):
+            with self.step(timings, lpv_lookup.DECL):
                 lpv_lookup.run(be, self.gbuf, level.accumulated, self.indirect, level.grid,
                                vox_normal=self.lookup_vox(level), own_light=self._own_light)
 
@@ -372,7 +382,7 @@ class LpvMethod(OneBounceMethod):
         if self.classes:
             self.propagate_classes(timings)
         else:
-            with self.timed(timings, "lpv_lookup"):
+            with self.step(timings, lpv_lookup.DECL):
                 self.look_up(lambda level: level.accumulated, self.indirect)
         self.add_bounces(timings)
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from .. import registry
 from ..grid import Grid
-from ..passes import rsm_gather, voxel_view
+from ..passes import declare, rsm_gather, voxel_view, voxelize
 from ..passes.light_views import LightView
 from ..passes.voxelize import Voxelizer
 from .direct import OneBounceMethod
@@ -21,6 +21,7 @@ from .direct import OneBounceMethod
 
 class RsmMethod(OneBounceMethod):
     spec = registry.get("rsm")
+    PASSES = declare.extend(OneBounceMethod.PASSES, setup=(voxelize.DECL,), gather=(rsm_gather.DECL,))
 
     def set_scene(self, scene) -> None:
         super().set_scene(scene)
@@ -47,7 +48,7 @@ class RsmMethod(OneBounceMethod):
         return self._voxel_view
 
     def gather_view(self, view: LightView, timings: dict[str, float]) -> None:
-        with self.timed(timings, "rsm_gather"):
+        with self.step(timings, rsm_gather.DECL):
             rsm_gather.run(self.backend, self.gbuf, self.rsm, self.indirect, self.rsm_config.vpl_samples,
                            self.gi.seed + view.light_index * 6 + max(view.face_index, 0),
                            occupancy=self.voxels["vox_albedo"] if self.voxels else None,

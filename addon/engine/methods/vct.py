@@ -19,7 +19,7 @@ from __future__ import annotations
 from .. import registry
 from ..config import VctConfig
 from ..grid import Grid
-from ..passes import atlas, vct_gather, vct_inject, vct_pyramid, zero
+from ..passes import atlas, declare, vct_gather, vct_inject, vct_pyramid, voxelize, zero
 from ..passes.atlas import Atlas
 from ..passes.light_views import LightView
 from ..passes.vct_inject import DIRECTIONS
@@ -29,6 +29,9 @@ from .direct import OneBounceMethod
 
 class VctMethod(OneBounceMethod):
     spec = registry.get("vct")
+    PASSES = declare.extend(OneBounceMethod.PASSES, setup=(voxelize.DECL,),
+                            solve=(vct_inject.DECL, vct_pyramid.DECL, vct_gather.BOUNCE_DECL, vct_pyramid.DECL),
+                            gather=(vct_gather.PIXELS_DECL, vct_gather.GLOSSY_DECL))
 
     def __init__(self, backend, gi, rsm_config, vct_config: VctConfig | None = None):
         super().__init__(backend, gi, rsm_config)
@@ -67,15 +70,10 @@ class VctMethod(OneBounceMethod):
 
     def allocate_products(self, size: tuple[int, int]) -> None:
         super().allocate_products(size)
-        self.ao = self.backend.texture(size)
-        self.glossy = self.backend.texture(size)
         self._lobe_albedo = vct_gather.split_albedo_texture(self.backend)
         scale = self.vct_config.gather_scale
         low = vct_gather.low_size(size, scale)
         self._low = (self.backend.texture(low), self.backend.texture(low)) if scale > 1 else None
-
-    def product_textures(self) -> dict:
-        return {**super().product_textures(), "ao": self.ao, "glossy": self.glossy}
 
     def begin_solve(self, timings: dict[str, float]) -> None:
         zero.images(self.backend, [self.flux[d] for d in DIRECTIONS])
@@ -85,7 +83,7 @@ class VctMethod(OneBounceMethod):
 
     def solve_view(self, view: LightView, timings: dict[str, float]) -> None:
         """Views come grouped by light: a new light first hands the previous one's VPLs to `flux`."""
-        with self.timed(timings, "vct_inject"):
+        with self.step(timings, vct_inject.DECL):
             if self._pending_light is not None and view.light_index != self._pending_light:
                 self._flush_light()
             vct_inject.run(self.backend, self._light_target, self._points, self.rsm, self.grid, self.atlas,
@@ -112,16 +110,16 @@ class VctMethod(OneBounceMethod):
         # Lights may change between updates (set_lights); the geometry's largest albedo only with set_scene.
         self.radiance_scale = vct_pyramid.radiance_scale([*self.source.lights, *self.emissive], self.bounds_m,
                                                          self.grid.cell_size_m, self.gi.bounces, self._albedo_max)
-        with self.timed(timings, "vct_pyramid"):
+        with self.step(timings, vct_pyramid.DECL):
             self._build(1.0, None)
         if self.gi.bounces == 1:
             return
         for bounce in range(2, self.gi.bounces + 1):
-            with self.timed(timings, "vct_bounce"):
+            with self.step(timings, vct_gather.BOUNCE_DECL):
                 vct_gather.bounce(be, self.pyramid, self.radiance_scale, self.voxels, self.next_bounce, self.grid,
                                   cfg, self.gi.seed + bounce)
                 vct_pyramid.accumulate(be, self.later_bounces, self.next_bounce, self.grid, first=bounce == 2)
-            with self.timed(timings, "vct_pyramid"):
+            with self.step(timings, vct_pyramid.DECL):
                 if bounce < self.gi.bounces:
                     self._build(0.0, self.next_bounce)
                 else:
@@ -129,14 +127,14 @@ class VctMethod(OneBounceMethod):
 
     def finish_solve(self, timings: dict[str, float]) -> None:
         if self._pending_light is not None:
-            with self.timed(timings, "vct_inject"):
+            with self.step(timings, vct_inject.DECL):
                 self._flush_light()
         self.bounce_light(timings)
 
     def gather_pixels(self, timings: dict[str, float]) -> None:
-        with self.timed(timings, "vct_gather"):
+        with self.step(timings, vct_gather.PIXELS_DECL):
             vct_gather.pixels(self.backend, self.pyramid, self.radiance_scale, self.gbuf, self.indirect,
                               self.ao, self.grid, self.vct_config, self.gi.seed, self._low)
-        with self.timed(timings, "vct_glossy"):
+        with self.step(timings, vct_gather.GLOSSY_DECL):
             vct_gather.glossy(self.backend, self.pyramid, self.radiance_scale, self.gbuf, self._lobe_albedo,
                               self.glossy, self.grid, self.vct_config, self.camera().position_m, self.gi.seed)

@@ -24,6 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..backends.base import Backend, ShaderSpec, Var
+from .declare import GBUF_ALBEDO, GBUF_NORMAL, GBUF_POSITION, TRIANGLES, PassDecl
 
 _TRI_ATTRS = (Var("uv0", "vec2"), Var("uv1", "vec2"), Var("uv2", "vec2"), Var("p0", "vec3"), Var("p1", "vec3"),
               Var("p2", "vec3"), Var("n0", "vec3"), Var("n1", "vec3"), Var("n2", "vec3"), Var("albedo", "vec3"),
@@ -43,6 +44,10 @@ POINTS = ShaderSpec(name="bake_points", vertex="bake/points.vert.glsl", fragment
                                 Var("albedo", "vec3")),
                     varyings=(Var("v_pos_ws", "vec3"), Var("v_normal_ws", "vec3"), Var("v_albedo", "vec3")),
                     outputs=_OUTPUTS)
+
+
+DECL = PassDecl("bake_gbuffer", "camera", (TRIANGLES,), (GBUF_POSITION, GBUF_NORMAL, GBUF_ALBEDO),
+                "an object's triangles rasterized in UV space: lightmap texels as G-buffer pixels")
 
 
 def triangle_attributes(uv: np.ndarray, positions: np.ndarray, normals: np.ndarray,

@@ -9,6 +9,7 @@ each pixel is shaded by exactly one face.
 from __future__ import annotations
 
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
+from .declare import DIRECT, GBUF_NORMAL, GBUF_POSITION, LIGHT_VIEWS, RSM_POSITION, PassDecl
 from .light_views import LightView
 
 SPEC = ShaderSpec(
@@ -25,6 +26,10 @@ SPEC = ShaderSpec(
         Var("spot_cos_half", "float"), Var("spot_blend", "float"), Var("shadow_bias_texels", "float"),
     ),
 )
+
+
+DECL = PassDecl("direct_light", "gather", (GBUF_POSITION, GBUF_NORMAL, RSM_POSITION, LIGHT_VIEWS), (DIRECT,),
+                "one light face's shadow-mapped direct light, added")
 
 
 def run(backend: Backend, gbuf_position, gbuf_normal, rsm_position, direct, view: LightView,

@@ -11,6 +11,7 @@ from __future__ import annotations
 from ..backends.base import Backend, ShaderSpec, Var
 from ..scene import Camera
 from . import zero
+from .declare import GBUFFER, TRIANGLES, PassDecl
 
 SPEC = ShaderSpec(
     name="gbuffer",
@@ -24,7 +25,10 @@ SPEC = ShaderSpec(
 )
 
 
-CHANNELS = ("position", "normal", "albedo", "specular")  # the outputs' textures, in order
+CHANNELS = tuple(port.name for port in GBUFFER)  # the outputs' textures, in order
+
+
+DECL = PassDecl("gbuffer", "camera", (TRIANGLES,), GBUFFER, "the scene rasterized from the camera")
 
 
 def run(backend: Backend, target, textures: dict, mesh, camera: Camera) -> None:

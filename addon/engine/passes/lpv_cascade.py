@@ -19,6 +19,7 @@ import numpy as np
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
 from . import lpv_propagate
+from .declare import LPV_ACCUMULATED, LPV_SNAPSHOT, TRIANGLES, VOXELS, PassDecl
 
 PAD_CELLS = 1.5  # Grid.fit's padding
 # The lookup blends a cascade into its parent over BAND_CELLS of its cells, starting BAND_START_CELLS
@@ -39,6 +40,12 @@ class Cascade:
     interior_lo: tuple[int, int, int] = (0, 0, 0)
     interior_hi: tuple[int, int, int] = (0, 0, 0)
     parent_offset: tuple[int, int, int] = (0, 0, 0)
+
+
+PLACE_DECL = PassDecl("lpv_place", "solve", (TRIANGLES,), VOXELS,
+                      "finer cascades re-placed around the camera, re-voxelized where they moved")
+INFLOW_DECL = PassDecl("lpv_inflow", "solve", (LPV_ACCUMULATED, LPV_SNAPSHOT), (LPV_SNAPSHOT,),
+                       "a parent cascade's light entering a finer one (timed in lpv_inject)")
 
 
 def _fitted(lo: np.ndarray, hi: np.ndarray, cell_m: float) -> Grid:

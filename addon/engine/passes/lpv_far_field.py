@@ -27,6 +27,7 @@ from __future__ import annotations
 
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
+from .declare import LPV_ACCUMULATED, LPV_SNAPSHOT, VOX_OFFSET, VOX_PROJECTED, PassDecl
 
 # Below a coarse grid of 16 cells along the longest side the far field resolves too little of a scene
 # (16-cell grids with an 8-cell far field, measured: thin-wall 0.25 -> 0.50, window-room 0.90 -> 1.03).
@@ -58,6 +59,10 @@ VOXELS = ShaderSpec(
     images=(Image("vox_projected", "3D", "RGBA32F", "write"), Image("vox_offset", "3D", "RGBA32F", "write")),
     uniforms=(Var("dims", "ivec3"), Var("fine_dims", "ivec3")),
 )
+
+
+DECL = PassDecl("lpv_far_field", "solve", (LPV_SNAPSHOT, VOX_PROJECTED, VOX_OFFSET), (LPV_ACCUMULATED,),
+                "light beyond the near steps carried on a grid of twice the cell (timed in lpv_propagate)")
 
 
 def grid_for(fine: Grid) -> Grid:

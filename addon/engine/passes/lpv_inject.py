@@ -28,6 +28,7 @@ import numpy as np
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
 from .atlas import Atlas, splat, splat_spec
+from .declare import LPV_ATLAS, LPV_SNAPSHOT, RSM, PassDecl
 
 # +x -x +y -y +z -z: a normal's dominant axis and its sign.
 CLASSES = 6
@@ -36,6 +37,10 @@ SPEC = splat_spec("lpv_inject", "lpv/inject.vert.glsl", "lpv/inject.frag.glsl",
                   varyings=(Var("v_r", "vec4"), Var("v_g", "vec4"), Var("v_b", "vec4")),
                   outputs=(Var("out_r", "vec4"), Var("out_g", "vec4"), Var("out_b", "vec4")))
 SPEC_CLASSES = dataclasses.replace(SPEC, name="lpv_inject_classes", defines=(("EMITTER_CLASSES", "1"),))
+
+
+DECL = PassDecl("lpv_inject", "solve", RSM, (LPV_ATLAS, LPV_SNAPSHOT),
+                "each face's VPLs splatted into the atlas; once per update unpacked into the snapshot")
 
 
 def spec(classes: bool) -> ShaderSpec:

@@ -23,7 +23,11 @@ from __future__ import annotations
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
 from . import lpv_cascade
+from .declare import GBUF_NORMAL, GBUF_POSITION, INDIRECT, LPV_ACCUMULATED, VOX_NORMAL, PassDecl
 from .lpv_cascade import Cascade
+
+DECL = PassDecl("lpv_lookup", "gather", (GBUF_POSITION, GBUF_NORMAL, LPV_ACCUMULATED, VOX_NORMAL), (INDIRECT,),
+                "the accumulated SH read at every pixel")
 
 
 def _spec(accumulate: bool, geometry_volume: bool, cascade: bool, own: str = "") -> ShaderSpec:

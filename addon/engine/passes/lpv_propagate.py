@@ -29,6 +29,7 @@ import numpy as np
 from .. import sh
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
+from .declare import LPV_ACCUMULATED, LPV_BLOCKING, LPV_SNAPSHOT, VOX_OFFSET, VOX_PROJECTED, PassDecl
 
 _UNIFORMS = (Var("dims", "ivec3"), Var("first_step", "int"), Var("source_weight", "float"),
              Var("step_weight", "float"), Var("m_cross", "float"), Var("m_along", "float"),
@@ -36,6 +37,12 @@ _UNIFORMS = (Var("dims", "ivec3"), Var("first_step", "int"), Var("source_weight"
 _IMAGES = tuple(Image(f"dst_{c}", "3D", "RGBA32F", "write") for c in "rgb") + tuple(
     Image(f"acc_{c}", "3D", "RGBA32F", "read_write") for c in "rgb")
 _SRC = tuple(Sampler(f"src_{c}", "3D") for c in "rgb")
+
+
+DECL = PassDecl("lpv_propagate", "solve", (LPV_SNAPSHOT, LPV_BLOCKING), (LPV_SNAPSHOT, LPV_ACCUMULATED),
+                "propagation steps, accumulated (with emitter classes the gather runs them per class)")
+BLOCKING_DECL = PassDecl("lpv_blocking", "setup", (VOX_PROJECTED, VOX_OFFSET), (LPV_BLOCKING,),
+                         "the geometry volume's blocking per axis, once per voxelization")
 
 
 def _spec(variant: str, geometry_volume: bool) -> ShaderSpec:

@@ -24,6 +24,7 @@ import dataclasses
 
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
+from .declare import LPV_ACCUMULATED, LPV_SNAPSHOT, VOX_ALBEDO, VOX_NORMAL, VOX_PROJECTED, PassDecl
 
 SPEC = ShaderSpec(
     name="lpv_reinject",
@@ -55,6 +56,10 @@ ADD = ShaderSpec(
     images=tuple(Image(f"acc_{c}", "3D", "RGBA32F", "read_write") for c in "rgb"),
     uniforms=(Var("dims", "ivec3"),),
 )
+
+
+DECL = PassDecl("lpv_reinject", "gather", (LPV_ACCUMULATED, VOX_NORMAL, VOX_ALBEDO, VOX_PROJECTED),
+                (LPV_SNAPSHOT, LPV_ACCUMULATED), "the next bounce re-emitted by the voxelized surfaces")
 
 
 def run(backend: Backend, acc: dict, voxels: dict, snapshot: dict, grid: Grid, own: dict | None = None) -> None:

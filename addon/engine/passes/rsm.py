@@ -12,6 +12,7 @@ surfel sends back at the emitter stops there.
 from __future__ import annotations
 
 from ..backends.base import Backend, ShaderSpec, Var
+from .declare import LIGHT_VIEWS, RSM, TRIANGLES, PassDecl
 from .light_views import LightView
 
 SPEC = ShaderSpec(
@@ -30,6 +31,9 @@ SPEC = ShaderSpec(
     varyings=(Var("v_pos_ws", "vec3"), Var("v_normal_ws", "vec3"), Var("v_albedo", "vec3")),
     outputs=(Var("out_position", "vec4"), Var("out_normal", "vec4"), Var("out_flux", "vec4")),
 )
+
+
+DECL = PassDecl("rsm", "solve", (TRIANGLES, LIGHT_VIEWS), RSM, "the scene seen from one light face")
 
 
 def run(backend: Backend, target, mesh, view: LightView) -> None:

@@ -15,6 +15,7 @@ import numpy as np
 
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
+from .declare import GBUF_NORMAL, GBUF_POSITION, INDIRECT, RSM, VOX_ALBEDO, PassDecl
 
 _SAMPLERS = (Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("rsm_position", "2D"),
              Sampler("rsm_normal", "2D"), Sampler("rsm_flux", "2D"))
@@ -42,6 +43,10 @@ SPEC_VOXEL_VISIBILITY = ShaderSpec(
               Var("offset_cells", "float")),
     defines=(("VOXEL_VISIBILITY", "1"),),
 )
+
+
+DECL = PassDecl("rsm_gather", "gather", (GBUF_POSITION, GBUF_NORMAL, *RSM, VOX_ALBEDO), (INDIRECT,),
+                "one face's VPLs gathered at every pixel (voxel visibility: through the occupancy), added")
 
 
 def strata_per_side(vpl_samples: int) -> int:

@@ -10,6 +10,7 @@ textures at resolution / factor: flux and area summed exactly, position and norm
 from __future__ import annotations
 
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
+from .declare import RSM, PassDecl
 
 SPEC = ShaderSpec(
     name="rsm_reduce",
@@ -19,6 +20,9 @@ SPEC = ShaderSpec(
     images=(Image("out_position", "2D"), Image("out_normal", "2D"), Image("out_flux", "2D")),
     uniforms=(Var("factor", "int"),),
 )
+
+
+DECL = PassDecl("rsm_reduce", "solve", RSM, RSM, "one VPL per block of an RSM face, for a coarse injection")
 
 
 def factor_for(rsm_resolution: int, grid_cells: int, vpls_per_cell: int = 2) -> int:

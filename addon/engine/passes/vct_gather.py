@@ -21,6 +21,19 @@ from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_coun
 from ..brdf import split_albedo_table
 from ..config import VctConfig
 from ..grid import Grid
+from . import declare
+from .declare import (
+    AO,
+    GBUF_NORMAL,
+    GBUF_POSITION,
+    GBUF_SPECULAR,
+    INDIRECT,
+    VCT_PYRAMID,
+    VOX_ALBEDO,
+    VOX_NORMAL,
+    VOX_PROJECTED,
+    PassDecl,
+)
 from .vct_inject import DIRECTIONS
 from .vct_pyramid import level_count, named, texture_size
 
@@ -73,6 +86,15 @@ BOUNCE = ShaderSpec(
     images=tuple(Image(f"next_{d}", "3D") for d in DIRECTIONS),
     uniforms=_DIFFUSE_UNIFORMS,
 )
+
+
+PIXELS_DECL = PassDecl("vct_gather", "gather", (GBUF_POSITION, GBUF_NORMAL, VCT_PYRAMID), (INDIRECT, AO),
+                       "diffuse cones at every pixel")
+GLOSSY_DECL = PassDecl("vct_glossy", "gather", (GBUF_POSITION, GBUF_NORMAL, GBUF_SPECULAR, VCT_PYRAMID),
+                       (declare.GLOSSY,),
+                       "specular cones over each glossy lobe")
+BOUNCE_DECL = PassDecl("vct_bounce", "solve", (VCT_PYRAMID, VOX_ALBEDO, VOX_NORMAL, VOX_PROJECTED), (VCT_PYRAMID,),
+                       "the next bounce gathered at the voxels")
 
 
 def cone_uniforms(grid: Grid, config: VctConfig, seed: int, radiance_scale: float) -> dict:

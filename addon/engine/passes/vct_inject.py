@@ -27,6 +27,7 @@ import numpy as np
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
 from .atlas import Atlas, splat, splat_spec
+from .declare import RSM, VCT_FLUX, VOX_PROJECTED, PassDecl
 from .lpv_inject import emitter_class
 
 DIRECTIONS = ("px", "nx", "py", "ny", "pz", "nz")  # travel along +x, -x, +y, -y, +z, -z
@@ -38,6 +39,10 @@ SPEC = splat_spec("vct_inject", "vct/inject.vert.glsl", "vct/inject.frag.glsl",
 SPEC_FILTERED = dataclasses.replace(SPEC, name="vct_inject_filtered", defines=(("FILTERED_INJECTION", "1"),),
                                     samplers=(*SPEC.samplers, Sampler("vox_projected", "3D")))
 FILTER_CORNERS = 4  # points per RSM texel when filtered: atlas.texel_points(copies=FILTER_CORNERS)
+
+
+DECL = PassDecl("vct_inject", "solve", (*RSM, VOX_PROJECTED), (VCT_FLUX,),
+                "each face's VPLs splatted per travel direction; each light capped by the geometry")
 
 
 def spec(filtered: bool) -> ShaderSpec:

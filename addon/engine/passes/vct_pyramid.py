@@ -25,6 +25,7 @@ from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_coun
 from ..grid import Grid
 from ..scene import Light
 from .atlas import Atlas
+from .declare import VCT_FLUX, VCT_PYRAMID, VOX_PROJECTED, PassDecl
 from .vct_inject import DIRECTIONS
 
 _GRID = (Var("dims", "ivec3"),)
@@ -36,6 +37,10 @@ HALF_BOUND = 2.0**14
 # level0 clamps to this (twice HALF_BOUND, below 65504): reached only by later bounces' gathered light,
 # whose bound is not proven (radiance_scale), never by the first bounce's; it keeps the pyramid finite.
 HALF_CLAMP = 2.0**15
+
+
+DECL = PassDecl("vct_pyramid", "solve", (VCT_FLUX, VOX_PROJECTED), (VCT_PYRAMID,),
+                "level 0 from the flux, the levels above by opacity compositing")
 
 
 def _level0_spec(add: bool, isotropic: bool) -> ShaderSpec:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
+from .declare import GBUF_POSITION, VOX_ALBEDO, VOXEL_VIEW, PassDecl
 
 SPEC = ShaderSpec(
     name="voxel_view",
@@ -18,6 +19,9 @@ SPEC = ShaderSpec(
     images=(Image("view", "2D", "RGBA32F", "write"),),
     uniforms=(Var("grid_origin", "vec3"), Var("cell_size", "float"), Var("grid_dims", "ivec3")),
 )
+
+
+DECL = PassDecl("voxel_view", "gather", (GBUF_POSITION, VOX_ALBEDO), (VOXEL_VIEW,), "the voxel grid on the surfaces")
 
 
 def run(backend: Backend, gbuf_position, vox_albedo, grid: Grid, view) -> None:

@@ -31,6 +31,7 @@ from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_coun
 from ..grid import Grid
 from ..scene import Scene
 from . import zero
+from .declare import TRIANGLES, VOXELS, PassDecl
 
 _UNIFORMS = (Var("grid_origin", "vec3"), Var("cell_size", "float"), Var("dims", "ivec3"), Var("axis", "int"),
              Var("layer", "int"))
@@ -64,6 +65,9 @@ MERGE = ShaderSpec(
 
 # Axis a's volume stores (u, v, w) = the grid coordinates permuted so w runs along a (its layers).
 _PERMUTATION = ((1, 2, 0), (2, 0, 1), (0, 1, 2))
+
+
+DECL = PassDecl("voxelize", "setup", (TRIANGLES,), VOXELS, "the scene's surfaces per cell of a grid")
 
 
 def triangle_normals(positions: np.ndarray) -> np.ndarray:
