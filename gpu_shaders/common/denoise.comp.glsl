@@ -1,0 +1,79 @@
+// One iteration of the edge-aware a-trous wavelet filter (passes/denoise.py, whose numpy `reference`
+// is this shader's twin): every covered pixel becomes the normalised, G-buffer-weighted mean of the
+// 5 x 5 taps `step_px` pixels apart around it. The weights never look at the values, so the filter is
+// linear: a flat field stays flat and nothing but geometry stops it.
+//
+// A tap's weight is the B3-spline kernel times
+// - normal agreement max(0, n . n_q)^normal_power (creases),
+// - exp(-(plane^2 + excess^2)) with plane = |n . (p_q - p)| / (plane_sigma * footprint) (depth steps)
+//   and excess = max(0, |p_q - p| - expected) / (position_sigma * expected), expected = |offset| *
+//   footprint (surfaces that are neighbours in the image but apart in space: silhouettes, and the UV
+//   charts of a lightmap).
+// The footprint (m) is the distance to the nearest covered neighbour along x and along y, the larger of
+// the two: the nearest neighbour lies on the pixel's own surface, even next to an edge.
+
+// The B3 spline (1, 4, 6, 4, 1) / 16 at tap k in -2..2; denoise.KERNEL is the same. A function, not a
+// const array: Blender translates bodies for Metal and Vulkan, and no other body here uses const arrays.
+float b3(int k) {
+    return k == 0 ? 0.375 : (abs(k) == 1 ? 0.25 : 0.0625);
+}
+
+bool covered(ivec2 q, ivec2 size) {
+    return all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, size)) && texelFetch(gbuf_position, q, 0).w != 0.0;
+}
+
+// Distance (m) to the nearer covered neighbour along `axis`, or -1 where neither side is covered.
+float axis_footprint(ivec2 px, vec3 p, ivec2 axis, ivec2 size) {
+    float nearest = -1.0;
+    for (int side = -1; side <= 1; side += 2) {
+        ivec2 q = px + side * axis;
+        if (covered(q, size)) {
+            float d = distance(texelFetch(gbuf_position, q, 0).xyz, p);
+            nearest = nearest < 0.0 ? d : min(nearest, d);
+        }
+    }
+    return nearest;
+}
+
+void main() {
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 size = textureSize(gbuf_position, 0);
+    if (any(greaterThanEqual(px, size))) {
+        return;
+    }
+    vec4 pos = texelFetch(gbuf_position, px, 0);
+    if (pos.w == 0.0) {
+        imageStore(filtered, px, vec4(0.0));  // no geometry: stays exactly 0
+        return;
+    }
+    vec3 p = pos.xyz;
+    float footprint = max(axis_footprint(px, p, ivec2(1, 0), size), axis_footprint(px, p, ivec2(0, 1), size));
+    if (footprint <= 0.0) {
+        imageStore(filtered, px, texelFetch(source, px, 0));  // isolated pixel: no scale to compare with
+        return;
+    }
+    vec3 n = texelFetch(gbuf_normal, px, 0).xyz;
+    vec4 sum = vec4(0.0);
+    float total = 0.0;
+    for (int j = -2; j <= 2; j++) {
+        for (int i = -2; i <= 2; i++) {
+            ivec2 offset = ivec2(i, j) * step_px;
+            ivec2 q = px + offset;
+            if (!covered(q, size)) {
+                continue;
+            }
+            float w = b3(i) * b3(j);
+            if (i != 0 || j != 0) {
+                vec3 d = texelFetch(gbuf_position, q, 0).xyz - p;
+                float facing = pow(max(dot(n, texelFetch(gbuf_normal, q, 0).xyz), 0.0), normal_power);
+                float plane = abs(dot(n, d)) / (plane_sigma * footprint);
+                float expected = length(vec2(offset)) * footprint;
+                float excess = max(length(d) - expected, 0.0) / (position_sigma * expected);
+                w *= facing * exp(-(plane * plane + excess * excess));
+            }
+            sum += w * texelFetch(source, q, 0);
+            total += w;
+        }
+    }
+    imageStore(filtered, px, sum / total);  // total >= the centre's kernel weight > 0
+}
