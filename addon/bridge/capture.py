@@ -373,6 +373,12 @@ def _light(obj, m: np.ndarray, scale: float, warnings: list[str]) -> Light | Non
     if kind in ("POINT", "SPOT") and ld.shadow_soft_size > 0:
         warnings.append(f"light {obj.name!r}: radius {ld.shadow_soft_size:g} treated as a point light")
     if kind == "AREA":
+        # Spread narrows the emission cone and an unnormalized power grows with the area: neither is
+        # modelled (the emitter is Lambertian of total power `energy`), so the capture says so.
+        if float(getattr(ld, "spread", np.pi)) < np.pi - 1e-4:
+            warnings.append(f"light {obj.name!r}: spread {np.degrees(ld.spread):.0f} deg treated as 180 deg")
+        if not compat.area_power_normalized(ld):
+            warnings.append(f"light {obj.name!r}: Normalize is off; its power is taken as normalized")
         shape = ld.shape if ld.shape in AREA_SHAPES else "SQUARE"
         sy = ld.size_y if shape in ("RECTANGLE", "ELLIPSE") else ld.size
         # Cycles sizes an area light by its object scale too.

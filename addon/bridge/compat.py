@@ -42,6 +42,18 @@ def clear_light_exposure(light_data) -> None:
         light_data.exposure = 0.0
 
 
+def normalize_area_power(light_data) -> None:
+    """An area light's energy as its total power whatever its size: Blender 5.0's Normalize on; 4.x
+    has no such switch and always normalizes."""
+    if hasattr(light_data, "normalize"):
+        light_data.normalize = True
+
+
+def area_power_normalized(light_data) -> bool:
+    """Whether an area light's energy is its total power (Normalize on, or a version without it)."""
+    return bool(getattr(light_data, "normalize", True))
+
+
 # How GPUFrameBuffer takes {"texture": t, "layer": k}. Blender 4.3 built against Python 3.13 matches
 # the attachment dict's keys inverted (a key is taken as "texture" when it is *not* "texture", and so
 # on): the documented dict raises "'GPUTexture' object cannot be interpreted as an integer", while

@@ -87,6 +87,7 @@ def _light(name: str, kind: str, location, energy: float, direction=(0.0, 0.0, -
     light.energy = energy  # W for point/spot/area, W/m^2 (strength) for sun
     light.color = (1.0, 1.0, 1.0)
     compat.clear_light_exposure(light)
+    compat.normalize_area_power(light)
     light.use_shadow = True
     if kind in {"POINT", "SPOT"}:
         light.shadow_soft_size = 0.0
@@ -294,8 +295,14 @@ def build_cornell_point() -> None:
 
 def build_cornell_area() -> None:
     _cornell("cornell-area")
-    _light("Area", "AREA", (0.0, 0.0, 1.98), 100.0, shape="SQUARE", size=0.5, spread=math.pi,
-           normalize=True)
+    _light("Area", "AREA", (0.0, 0.0, 1.98), 100.0, shape="SQUARE", size=0.5, spread=math.pi)
+
+
+def build_cornell_large_area() -> None:
+    """A 1 x 1 m square area light (200 W) 2 cm under the ceiling: half the box's width, so near it the
+    light's shape matters (a point at its centre is far too bright below it and casts hard shadows)."""
+    _cornell("cornell-large-area")
+    _light("Area", "AREA", (0.0, 0.0, 1.98), 200.0, shape="SQUARE", size=1.0, spread=math.pi)
 
 
 def build_textured() -> None:
@@ -353,6 +360,7 @@ SCENES = {
     "cornell-sun": build_cornell_sun,
     "cornell-point": build_cornell_point,
     "cornell-area": build_cornell_area,
+    "cornell-large-area": build_cornell_large_area,
     "cornell-glossy": build_cornell_glossy,
     "textured": build_textured,
     "window-room": build_window_room,

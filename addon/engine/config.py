@@ -71,6 +71,10 @@ class RsmConfig(_Validated):
     visibility: str = _choice("none", ("none", "voxel"), "VPL visibility in the `rsm` gather: none or voxel-traced")
     voxel_cells: int = _num(64, 8, 512, "voxel grid cells along the scene's longest side (voxel visibility)")
     voxel_offset_cells: float = _num(1.5, 0.0, 4.0, "ray ends moved off their surfaces, in cells")
+    # An area light is split into patches_per_side^2 patches (sectors for disks and ellipses), each
+    # with its exact unshadowed irradiance and the shadow of its centre (area_light.py): shadows soften
+    # in that many steps; each patch costs its own RSM faces.
+    area_patches: int = _num(2, 1, 8, "patches per side an area light is split into, each shadowed from its centre")
 
 
 @dataclass(frozen=True)

@@ -8,6 +8,7 @@ per texel separately).
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
@@ -42,6 +43,9 @@ class Light:
     # meshes, light_views.emissive_lights). Light the RSM's surfels reflect back towards it does not pass
     # it (rsm.frag.glsl: their flux times 1 - the disc's view factor); 0 = none.
     occluder_radius_m: float = 0.0
+    # The light's shape as polygons (area_light.Emitter): the direct pass integrates it exactly and
+    # position_m is only where its shadow is taken from. None: a point (or Lambertian point) emitter.
+    emitter: Any = None
 
     def __post_init__(self):
         if self.kind not in LIGHT_KINDS:

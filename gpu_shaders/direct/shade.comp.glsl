@@ -1,6 +1,7 @@
 // Shadow-mapped direct diffuse light of one light face at every G-buffer pixel, added to `direct`.
 // Output unit: Cycles' Diffuse Direct pass = irradiance / pi (W/m^2/sr per unit albedo).
 #include "common/light.glsl"
+#include "common/polygon.glsl"
 
 const float PI = 3.14159265;
 
@@ -40,8 +41,15 @@ void main() {
         dist = length(d);
         vec3 w = d / max(dist, 1e-9);
         to_light = -w;
-        vec3 intensity = light_intensity(light_kind, w, emit_axis, light_color_intensity, spot_cos_half, spot_blend);
-        irradiance = intensity * max(dot(n, to_light), 0.0) / max(dist * dist, 1e-12);
+        if (poly_count > 0) {
+            // A light with its shape (an area light's patch, an emissive mesh's triangles): the exact
+            // unshadowed irradiance of its polygons; light_pos_ws is where its shadow is taken from.
+            irradiance = emitter_irradiance(emitters, poly_first, poly_count, p, n);
+        } else {
+            vec3 intensity = light_intensity(light_kind, w, emit_axis, light_color_intensity, spot_cos_half,
+                                             spot_blend);
+            irradiance = intensity * max(dot(n, to_light), 0.0) / max(dist * dist, 1e-12);
+        }
         texel_m = sqrt(texel_scale) * dist;
     }
     if (all(equal(irradiance, vec3(0.0)))) {

@@ -30,6 +30,7 @@ EXPECTED_OBJECTS = {
     "cornell-sun": CORNELL | {"Sun"},
     "cornell-point": CORNELL | {"Point"},
     "cornell-area": CORNELL | {"Area"},
+    "cornell-large-area": CORNELL | {"Area"},
     "cornell-glossy": CORNELL | {"Spot"},
     "textured": CORNELL | {"Spot"},
     "emissive": CORNELL | {"EmissivePanel"},

@@ -12,17 +12,29 @@ def quad(origin, u, v):
     return [[p[0], p[1], p[2]], [p[0], p[2], p[3]]]
 
 
-def test_flat_panel_is_two_area_lights():
+def test_flat_panel_is_area_lights_facing_both_ways():
     # A 0.5 x 0.5 m panel of radiance 20 facing -z: each side emits pi L A = pi * 20 * 0.25 W (Cycles'
-    # mesh emission is two-sided), so two AREA lamps of that power facing -z and +z.
+    # mesh emission is two-sided). Its triangles are larger than a grouping cell (2 m / 8 = 0.25 m), so
+    # they are split and the panel becomes 2 x 2 groups, each two AREA lamps (facing -z and +z) of its
+    # share, carrying its triangles (Light.emitter) emitting on that side.
     tris = np.array(quad([-0.25, 0.25, 1.98], [0.5, 0, 0], [0, -0.5, 0]))
     emission = np.full((2, 3), 20.0)
     lamps = emissive_lights(tris, emission, scene_extent_m=2.0)
-    assert [lamp.kind for lamp in lamps] == ["AREA", "AREA"]
-    for lamp in lamps:
-        assert lamp.power_w == pytest.approx(np.pi * 20 * 0.25)
-        np.testing.assert_allclose(lamp.position_m, [0, 0, 1.98], atol=1e-12)
-    np.testing.assert_allclose(sorted(lamp.direction[2] for lamp in lamps), [-1.0, 1.0])
+    assert [lamp.kind for lamp in lamps] == ["AREA"] * 8
+    for side in (-1.0, 1.0):
+        facing = [lamp for lamp in lamps if lamp.direction[2] == pytest.approx(side)]
+        assert len(facing) == 4
+        assert sum(lamp.power_w for lamp in facing) == pytest.approx(np.pi * 20 * 0.25)
+        centre = sum(lamp.position_m * lamp.power_w for lamp in facing) / sum(lamp.power_w for lamp in facing)
+        np.testing.assert_allclose(centre, [0, 0, 1.98], atol=1e-12)
+        area = 0.0
+        for lamp in facing:
+            v = lamp.emitter.vertices
+            normals = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
+            area += 0.5 * np.linalg.norm(normals, axis=1).sum()
+            # Each triangle emits towards the lamp's side: its winding normal times its sidedness.
+            assert np.all((normals @ lamp.direction) * lamp.emitter.sided > 0)
+        assert area == pytest.approx(0.25)
 
 
 def test_closed_emitter_is_one_point_light():
@@ -43,12 +55,13 @@ def test_no_emission_no_lamps():
     assert emissive_lights(np.zeros((0, 3, 3)), np.zeros((0, 3)), 1.0) == []
 
 
-def test_flat_panel_lamps_carry_the_panel_as_occluder():
-    # The panel (0.25 m^2) blocks what surfaces send back at it: both lamps carry a disc of its area.
+def test_flat_panel_lamps_carry_their_part_as_occluder():
+    # Each group blocks what surfaces send back at it: its lamps carry a disc of the group's area (the
+    # panel's quarter here).
     tris = np.array(quad([-0.25, 0.25, 1.98], [0.5, 0, 0], [0, -0.5, 0]))
     lamps = emissive_lights(tris, np.full((2, 3), 20.0), scene_extent_m=2.0)
     for lamp in lamps:
-        assert lamp.occluder_radius_m == pytest.approx(np.sqrt(0.25 / np.pi))
+        assert lamp.occluder_radius_m == pytest.approx(np.sqrt(0.25 / 4 / np.pi))
 
 
 @pytest.mark.parametrize("h, a, r", [(0.02, 0.0, 0.28), (0.02, 0.2, 0.28), (0.02, 0.3, 0.28), (0.5, 0.4, 0.3),

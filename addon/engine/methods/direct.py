@@ -23,6 +23,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .. import registry
+from ..area_light import emitter_table, split_area_light
 from ..backends.base import Backend
 from ..config import GIConfig, RsmConfig
 from ..errors import ConfigError
@@ -39,8 +40,12 @@ RSM_BYTES_PER_TEXEL = 3 * 16 + 4
 
 def lights_key(lights) -> tuple:
     """Equal for equal light lists: what a light field was solved for (lights may be changed in place)."""
-    return tuple(tuple(v.tobytes() if isinstance(v, np.ndarray) else v for v in dataclasses.astuple(light))
-                 for light in lights)
+    def key(value):
+        if isinstance(value, np.ndarray):
+            return value.tobytes()
+        return tuple(key(v) for v in value) if isinstance(value, tuple) else value
+
+    return tuple(key(dataclasses.astuple(light)) for light in lights)
 
 
 @dataclass
@@ -121,6 +126,7 @@ class DirectMethod:
         self._rsm_slots: list[tuple[dict, object]] = []  # (textures, target) per kept face, made on use
         self._kept_faces = max(1, RSM_KEEP_BYTES // (RSM_BYTES_PER_TEXEL * n * n))
         self.rsm, self.rsm_target = self._rsm_slot(0)  # the face being drawn or read (hooks use it)
+        self._emitter_rows = None  # the emitter table on the GPU (light_views)
         self._solved_for = None  # lights_key of the light field on the GPU; None: none is
         self.solves = 0          # how many updates solved (bakes report it)
         self._size = None
@@ -160,6 +166,9 @@ class DirectMethod:
         """The products (registry), as their gather passes declare them, each also an attribute
         (`self.direct`, `self.indirect`, ...): the overlay and bakes sample them."""
         ports = {p.name: p for decl in self.PASSES["gather"] for p in decl.outputs if p.group == "product"}
+        undeclared = [n for n in self.products if n != "albedo" and n not in ports]
+        if undeclared:
+            raise TypeError(f"method {self.name}: no gather pass in PASSES declares the product(s) {undeclared}")
         self._products = declare.allocate(self.backend, [ports[n] for n in self.products if n != "albedo"], size)
         for name, texture in self._products.items():
             setattr(self, name, texture)
@@ -172,10 +181,30 @@ class DirectMethod:
         return replace(cam, view=cam.view @ shift)
 
     def light_views(self) -> list[LightView]:
+        """Every light's RSM faces, in the uploaded (re-centred) frame; area lights split into patches.
+        Also makes the emitter table of the lights with a shape (`self.emitters`), whose rows each
+        view's uniforms name."""
         bounds = self.bounds_m
-        lights = [replace(light, position_m=light.position_m - self.origin_m) for light in self.source.lights]
+        lights = []
+        for light in self.source.lights:
+            local = replace(light, position_m=light.position_m - self.origin_m)
+            lights += split_area_light(local, self.rsm_config.area_patches) if local.kind == "AREA" else [local]
         lights += self.emissive
-        return [v for i, light in enumerate(lights) for v in views_for(light, i, bounds, self.rsm_config.resolution)]
+        table, ranges = emitter_table(lights)
+        self._upload_emitters(table)
+        views = []
+        for i, light in enumerate(lights):
+            for view in views_for(light, i, bounds, self.rsm_config.resolution):
+                view.uniforms.update(poly_first=ranges[i][0], poly_count=ranges[i][1])
+                views.append(view)
+        return views
+
+    def _upload_emitters(self, table: np.ndarray) -> None:
+        """The emitter table as a texture (TABLE_TEXELS_PER_ROW x rows), re-uploaded only when it changes."""
+        if self._emitter_rows is not None and np.array_equal(self._emitter_rows, table):
+            return
+        self._emitter_rows = table
+        self.emitters = self.backend.texture((table.shape[1], table.shape[0]), data=table)
 
     def keeps_light_field(self) -> bool:
         """Whether the light field stays valid when only the camera or the G-buffer changes (methods
@@ -256,7 +285,7 @@ class DirectMethod:
     def _gather_view(self, view: LightView, timings: dict[str, float]) -> None:
         with self.step(timings, direct_light.DECL):
             direct_light.run(self.backend, self.gbuf["position"], self.gbuf["normal"], self.rsm["position"],
-                             self.direct, view, self.rsm_config.shadow_bias_texels)
+                             self.direct, view, self.rsm_config.shadow_bias_texels, self.emitters)
         self.gather_view(view, timings)
 
     def read(self) -> dict[str, np.ndarray]:

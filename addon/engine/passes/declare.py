@@ -72,6 +72,9 @@ TRIANGLES = Port("scene", "triangles", "mesh", "scene", "world positions (m), no
 LIGHT_VIEWS = Port("scene", "light_views", "uniforms", "scene",
                    "per light face: view-projection, intensity (W/sr) or sun irradiance (W/m^2)")
 
+EMITTERS = Port("scene", "emitters", "RGBA32F", "table",
+                "per polygon of an emitter with its shape: vertices (m), radiance (W/m^2/sr), sidedness")
+
 GBUFFER = (_image("gbuffer", "position", "world position (m), w = 1 where geometry"),
            _image("gbuffer", "normal", "world normal (unit), towards the viewer"),
            _image("gbuffer", "albedo", "diffuse albedo (linear), w = 1 where geometry"),

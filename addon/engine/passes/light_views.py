@@ -1,9 +1,9 @@
 """Where each light's RSM looks from: one perspective face for a spot, six cube faces for a point or
 area light, one orthographic view fitted to the scene bounds for a sun. Pure numpy.
 
-Area lights are modelled as a Lambertian point emitter at their centre, I(w) = P / pi * cos (exact
-far from the light, too bright close to a large one); ARCHITECTURE.md allows this "cosine-weighted
-spot" until polygonal area lights land.
+An area light's RSM looks from its centre as a Lambertian point, I(w) = P / pi * cos: its VPLs. A
+light with a shape (area_light.split_area_light's patches, emissive triangles: Light.emitter) is lit
+exactly in the direct pass from its polygons and shadowed from its position.
 """
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..area_light import MAX_POLYGONS_PER_LIGHT, Emitter
 from ..scene import Light
 from ..transforms import box_corners, look_along, orthographic, perspective
 
@@ -37,24 +38,27 @@ def emissive_lights(positions_m: np.ndarray, emission: np.ndarray, scene_extent_
                     ) -> list[Light]:
     """Emissive triangles as lamps: triangles are grouped by the cell of a coarse grid (`bins` cells
     along the scene's longest extent) their centroid falls in, one lamp per group: at most bins^3
-    lamps, and a small emitter (Sponza's sphere) is one lamp, not hundreds.
+    lamps, and a small emitter (Sponza's sphere) is one lamp, not hundreds; a triangle larger than a cell
+    is split first. Each lamp keeps its triangles (Light.emitter) when it has few enough: the direct pass
+    integrates them exactly and shadows them from the lamp's position.
 
     Cycles' mesh emission is two-sided: each side of a surface of radiance L emits pi L A. Flat groups
     (area-weighted normals mostly agree) become two AREA lights, one per side; closed ones (a sphere:
-    normals cancel, the inner side's light stays inside) one isotropic POINT light of pi L A. Exact far
-    from the emitter; near a large one (a ceiling 2 cm behind a panel) a point is far too concentrated.
+    normals cancel, the inner side's light stays inside) one isotropic POINT light of pi L A: their RSMs'
+    VPLs. Without its triangles a lamp is exact only far from the emitter.
     """
     lum = emission.max(axis=1) if len(emission) else np.zeros(0)
     sel = lum > 0
     if not np.any(sel):
         return []
-    p = np.asarray(positions_m, np.float64)[sel]
-    e = np.asarray(emission, np.float64)[sel]
+    cell = max(scene_extent_m / bins, 1e-9)
+    # Triangles larger than a cell are split first, so a large panel becomes several lamps: each is
+    # shadowed from its own centre, and the shadows soften in as many steps.
+    p, e = _subdivided(np.asarray(positions_m, np.float64)[sel], np.asarray(emission, np.float64)[sel], cell)
     cross = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
     area = 0.5 * np.linalg.norm(cross, axis=1)
     centroid = p.mean(axis=1)
     lo = centroid.min(axis=0)
-    cell = max(scene_extent_m / bins, 1e-9)
     keys = np.floor((centroid - lo) / cell).astype(np.int64)
     _, group = np.unique(keys, axis=0, return_inverse=True)
     lights = []
@@ -69,18 +73,46 @@ def emissive_lights(positions_m: np.ndarray, emission: np.ndarray, scene_extent_
         net = 0.5 * cross[m].sum(axis=0)  # area-weighted normal sum
         power = float(flux.max())
         color = flux / power
+        tris, facing = p[m], np.sign(cross[m] @ net)  # +1 where a triangle winds towards net's side
         if np.linalg.norm(net) > 0.5 * total_area:
             # The emitter is opaque: what its light's surfels reflect back at it stops there (a ceiling
             # 2 cm behind a panel sends most of its light into the panel's back), modelled as a disc of
             # the group's area (disc_view_factor).
             radius = float(np.sqrt(total_area / np.pi))
             lights.append(Light("AREA", position, net, color, power_w=power, name="emissive",
-                                occluder_radius_m=radius))
+                                occluder_radius_m=radius, emitter=_triangles(tris, e[m], facing)))
             lights.append(Light("AREA", position, -net, color, power_w=power, name="emissive (back)",
-                                occluder_radius_m=radius))
+                                occluder_radius_m=radius, emitter=_triangles(tris, e[m], -facing)))
         else:
-            lights.append(Light("POINT", position, [0, 0, -1], color, power_w=power, name="emissive"))
+            # Closed (a sphere): each triangle's outer side, as wound, is what can be seen from outside.
+            lights.append(Light("POINT", position, [0, 0, -1], color, power_w=power, name="emissive",
+                                emitter=_triangles(tris, e[m], np.ones(len(tris)))))
     return lights
+
+
+def _subdivided(triangles: np.ndarray, radiance: np.ndarray, max_edge_m: float, levels: int = 4):
+    """Triangles (k, 3, 3) with radiance (k, 3), each whose longest edge exceeds max_edge_m split into
+    four at its edges' midpoints (winding kept), up to `levels` times."""
+    for _ in range(levels):
+        edges = np.linalg.norm(triangles - np.roll(triangles, -1, axis=1), axis=2).max(axis=1)
+        big = edges > max_edge_m
+        if not big.any():
+            break
+        a, b, c = (triangles[big, i] for i in range(3))
+        ab, bc, ca = (a + b) / 2, (b + c) / 2, (c + a) / 2
+        children = np.concatenate([np.stack(t, axis=1) for t in ((a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca))])
+        triangles = np.concatenate([triangles[~big], children])
+        radiance = np.concatenate([radiance[~big], np.tile(radiance[big], (4, 1))])
+    return triangles, radiance
+
+
+def _triangles(triangles: np.ndarray, radiance: np.ndarray, sided: np.ndarray) -> Emitter | None:
+    """Emissive triangles (k, 3, 3) as an Emitter, emitting on the `sided` side of their winding; None
+    (the lamp stays a point) when there are too many for the direct pass's per-pixel loop."""
+    if len(triangles) > MAX_POLYGONS_PER_LIGHT:
+        return None
+    vertices = np.concatenate([triangles, triangles[:, 2:3]], axis=1)  # the 4th corner repeats the 3rd
+    return Emitter(vertices, np.full(len(triangles), 3), radiance, sided)
 
 
 def disc_view_factor(height_m, offset_m, radius_m):

@@ -1,0 +1,64 @@
+// Irradiance from polygonal emitters (area lights with their shape, emissive triangles): the GLSL twin
+// of addon/engine/area_light.py. The emitter table `emitters` (RGBA32F) holds one polygon per row:
+// texels 0..3 its vertices (xyz, m; texel 0's w = the vertex count, 3 or 4), texel 4 its radiance (rgb,
+// W/m^2/sr) and sidedness (+1 emits towards (v1 - v0) x (v2 - v0), -1 away from it, 0 both ways).
+
+const int POLYGON_MAX_VERTICES = 4;
+
+// E / L (sr) at p with unit normal n from the polygon v[0..count), the part above p's horizon (clipped
+// by Sutherland-Hodgman), whichever way it winds: Lambert's formula, (1/2) |sum theta_i n.g_i|.
+float polygon_irradiance(vec3 p, vec3 n, vec3 v[POLYGON_MAX_VERTICES], int count) {
+    vec3 c[POLYGON_MAX_VERTICES + 1];
+    int m = 0;
+    for (int i = 0; i < count; ++i) {
+        vec3 a = v[i] - p;
+        vec3 b = v[(i + 1) % count] - p;
+        float da = dot(n, a);
+        float db = dot(n, b);
+        if (da > 0.0) {
+            c[m] = a;
+            m += 1;
+        }
+        if ((da > 0.0) != (db > 0.0)) {
+            c[m] = a + (b - a) * (da / (da - db));
+            m += 1;
+        }
+    }
+    if (m < 3) {
+        return 0.0;
+    }
+    float total = 0.0;
+    for (int i = 0; i < m; ++i) {
+        vec3 a = normalize(c[i]);
+        vec3 b = normalize(c[(i + 1) % m]);
+        vec3 axb = cross(a, b);
+        float len = length(axb);
+        if (len > 1e-20) {
+            // atan rather than acos: exact for the tiny angles of a small, far polygon in fp32
+            total += atan(len, dot(a, b)) * dot(n, axb) / len;
+        }
+    }
+    return 0.5 * abs(total);
+}
+
+// Sum over rows [first, first + count) of the table: radiance x E / L, per colour (W/m^2), the rows
+// whose emitting side p does not face left out.
+vec3 emitter_irradiance(sampler2D emitters, int first, int count, vec3 p, vec3 n) {
+    vec3 e = vec3(0.0);
+    for (int r = first; r < first + count; ++r) {
+        vec3 v[POLYGON_MAX_VERTICES];
+        vec4 t0 = texelFetch(emitters, ivec2(0, r), 0);
+        int k = int(t0.w + 0.5);
+        v[0] = t0.xyz;
+        for (int i = 1; i < POLYGON_MAX_VERTICES; ++i) {
+            v[i] = texelFetch(emitters, ivec2(i, r), 0).xyz;
+        }
+        vec4 rad = texelFetch(emitters, ivec2(POLYGON_MAX_VERTICES, r), 0);
+        float side = dot(cross(v[1] - v[0], v[2] - v[0]), p - v[0]);
+        if (rad.w * side < 0.0 || (rad.w != 0.0 && side == 0.0)) {
+            continue;  // p is behind this polygon's emitting side
+        }
+        e += rad.rgb * polygon_irradiance(p, n, v, k);
+    }
+    return e;
+}
