@@ -27,6 +27,7 @@ import math
 import os
 import platform
 import re
+import subprocess
 import sys
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -119,6 +120,25 @@ def cpu_model() -> str:
     return platform.processor() or "unknown CPU"
 
 
+REPO_ROOT = Path(__file__).resolve().parents[2]
+
+
+def code_version(root: Path = REPO_ROOT) -> dict:
+    """The commit the run measured and whether the code that makes the images (addon/, gpu_shaders/)
+    differed from it: figures are tied to code, and a run on uncommitted edits says so. None outside
+    a git checkout."""
+    def git(*args: str) -> str | None:
+        try:
+            return subprocess.run(["git", "-C", str(root), *args], capture_output=True, text=True,
+                                  check=True).stdout.strip()
+        except (OSError, subprocess.CalledProcessError):
+            return None
+
+    commit = git("rev-parse", "HEAD")
+    changes = git("status", "--porcelain", "--", "addon", "gpu_shaders")
+    return {"commit": commit, "dirty": None if changes is None else bool(changes)}
+
+
 def _num(x, fmt: str = "{:.4g}") -> str:
     return "n/a" if x is None else fmt.format(x)
 
@@ -191,6 +211,12 @@ def format_scene(sc: dict) -> str:
     return "\n".join(out)
 
 
+def _format_commit(machine: dict) -> str:
+    if not machine.get("commit"):
+        return ""
+    return f"; code at commit {machine['commit'][:12]}" + (" with uncommitted changes" if machine["dirty"] else "")
+
+
 def format_report(result: dict) -> str:
     """The generated block of REPORT.md (between MARK_BEGIN and MARK_END)."""
     m = result["machine"]
@@ -200,7 +226,7 @@ def format_report(result: dict) -> str:
         f"Produced by: `{result['command']}`\n",
         f"Machine: {m['platform']}; CPU {m['cpu']} ({m['cores']} cores); Bounce backend: {m['bounce_renderer']}; "
         f"Cycles device: {m['cycles_device']}; Blender {m['blender']}"
-        + (f"; run on {m['date']}" if m.get("date") else "") + ".\n",
+        + (f"; run on {m['date']}" if m.get("date") else "") + _format_commit(m) + ".\n",
         f"Settings: {result['res']} px long side, {result['bounces']} diffuse bounce(s), reference "
         f"{result['ref_spp']} spp, Bounce times = median of {result['repeat']} full updates after a warm-up "
         "(read-back included), Cycles times = one render call (scene sync + BVH + sampling, no file I/O). "
@@ -499,7 +525,7 @@ def run_bench(opt: Options) -> dict:
     result["machine"] = {"platform": platform.platform(), "cpu": cpu_model(), "cores": os.cpu_count(),
                          "bounce_renderer": ", ".join(sorted(renderers)) or "n/a",
                          "cycles_device": ", ".join(sorted(devices)) or "n/a", "blender": bpy.app.version_string,
-                         "date": datetime.now(UTC).strftime("%Y-%m-%d")}
+                         "date": datetime.now(UTC).strftime("%Y-%m-%d"), **code_version()}
     report = opt.out / "REPORT.md"
     existing = report.read_text() if report.is_file() else None
     report.write_text(merge_report(existing, format_report(result)))

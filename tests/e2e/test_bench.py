@@ -164,6 +164,20 @@ def test_results_json_has_one_record_per_run():
     assert second["rel_rmse_8"] is None and second["speedup"]["speedup"] is None
 
 
+def test_code_version_names_the_commit(tmp_path):
+    import re
+
+    version = bench.code_version()
+    assert re.fullmatch(r"[0-9a-f]{40}", version["commit"]) and isinstance(version["dirty"], bool)
+    assert bench.code_version(tmp_path) == {"commit": None, "dirty": None}  # not a checkout
+    result = _fake_result()
+    result["machine"].update(date="2026-12-01", commit="0123456789abcdef" * 2 + "01234567", dirty=True)
+    assert "Blender 5.0.1; run on 2026-12-01; code at commit 0123456789ab with uncommitted changes." \
+        in bench.format_report(result)
+    result["machine"]["dirty"] = False
+    assert "; code at commit 0123456789ab.\n" in bench.format_report(result)
+
+
 def test_command_line_spells_the_new_options():
     cmd = bench.command_line(["cornell"], ["lpv"], False, 256, 512, 1, "benchmarks/updates", "out/bench",
                              update_costs=False, row_filter="default")
@@ -231,7 +245,7 @@ def test_quick_bench_on_cornell(tmp_path):
     # results.json: one record per run, the report's numbers, update costs timed by default
     results = json.loads((out / "results.json").read_text())
     assert results["schema"] == bench.RESULTS_SCHEMA and results["command"] == result["command"]
-    assert set(results["machine"]) >= {"cpu", "bounce_renderer", "blender", "date"}
+    assert set(results["machine"]) >= {"cpu", "bounce_renderer", "blender", "date", "commit", "dirty"}
     assert [(r["scene"], r["method"], r["setting"], r["default"]) for r in results["records"]] == \
         [("cornell", "direct", s, i == 0) for i, s in enumerate(bench.SETTINGS["direct"])]
     assert "| update full ms | update lights ms | update camera ms | camera/full |" in report
