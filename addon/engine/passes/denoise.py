@@ -23,12 +23,13 @@ the two):
   neighbours in the image that are apart in space (silhouettes; a lightmap's UV charts, whose texels
   are neighbours in UV only) get ~0 weight.
 Pixels with coverage 0 are written 0 and weigh nothing; a covered pixel without a covered neighbour
-keeps its value. With the defaults the kernel reaches 2 (1 + 2 + 4) = 14 pixels; `noise_factor` is
-the standard deviation it leaves of i.i.d. noise on a plane.
+keeps its value. After k iterations the kernel reaches 2 (2^k - 1) pixels (`iterations_for` picks k
+for an image size); `noise_factor` is the standard deviation it leaves of i.i.d. noise on a plane.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -39,11 +40,27 @@ from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_coun
 KERNEL = np.array([1.0, 4.0, 6.0, 4.0, 1.0]) / 16.0
 
 
+# The kernel's reach, 2 (2^k - 1) px after k iterations, as a share of the image's long side
+# (`iterations_for`). The filter is guided by geometry only, so it also flattens the indirect's real rise
+# into concave corners once it reaches that far. On cornell, vct's indirect against Cycles (512 spp;
+# rel_rmse / rel_rmse_8, unfiltered 0.60 / 0.15) was best with 2 iterations at 128 px (0.175 / 0.125;
+# 3: 0.21 / 0.15) and with 3 to 4 at 512 px (0.155 / 0.131 and 0.157 / 0.129; 2: 0.169 / 0.140):
+# reaches of 6, 14 and 30 px, 4.7 %, 2.7 % and 5.9 % of the long side (tools/denoise_cost.py).
+REACH_FRACTION = 0.05
+
+
+def iterations_for(long_side_px: int) -> int:
+    """The iterations whose reach is nearest REACH_FRACTION of the long side: 2 at 128 px, 3 at 256,
+    4 at 512, 5 at 1024."""
+    return max(1, round(math.log2(REACH_FRACTION * long_side_px / 2 + 1)))
+
+
 @dataclass(frozen=True)
 class Params:
-    # Iterations, each with twice the previous tap spacing (1, 2, 4, ... px): three leave a kernel of
-    # standard deviation sqrt(1 + 4 + 16) = 4.6 px per axis, which cuts i.i.d. noise ~16-fold
-    # (`noise_factor`) while indirect shadows a few pixels wide keep their shape.
+    # Iterations, each with twice the previous tap spacing (1, 2, 4, ... px); callers pass
+    # iterations_for(their image's long side). Three (GIConfig's default 256 px) leave a kernel of
+    # standard deviation sqrt(1 + 4 + 16) = 4.6 px per axis, which cuts i.i.d. noise 16.6-fold
+    # (`noise_factor`).
     iterations: int = 3
     # Exponent on max(0, n . n_q): a tap whose normal is 15 degrees off weighs 0.33, 30 degrees 0.01,
     # so creases stay sharp while smooth-shaded curves still blur at small tap spacings.
@@ -68,12 +85,14 @@ SPEC = ShaderSpec(
 )
 
 
-def _destinations(iterations: int, out, scratch) -> list:
+def _destinations(iterations: int, noisy, out, scratch) -> list:
     """The texture each iteration writes, alternating so that the last one writes `out`."""
     if iterations < 1:
         raise ValueError(f"denoise: iterations must be >= 1, not {iterations}")
     if iterations > 1 and scratch is None:
         raise ValueError("denoise: two or more iterations need a scratch texture")
+    if noisy is out or noisy is scratch or out is scratch:
+        raise ValueError("denoise: noisy, out and scratch must be different textures")
     return [out if (iterations - 1 - k) % 2 == 0 else scratch for k in range(iterations)]
 
 
@@ -82,7 +101,7 @@ def run(backend: Backend, gbuf: dict, noisy, out, scratch=None, params: Params =
     program = backend.program(SPEC)
     groups = group_count(out.size, SPEC.local_size)
     source = noisy
-    for k, dest in enumerate(_destinations(params.iterations, out, scratch)):
+    for k, dest in enumerate(_destinations(params.iterations, noisy, out, scratch)):
         backend.dispatch(program, groups,
                          uniforms={"step_px": 1 << k, "normal_power": params.normal_power,
                                    "plane_sigma": params.plane_sigma_footprints,
