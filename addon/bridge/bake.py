@@ -265,12 +265,12 @@ def _emits(light) -> bool:
 
 def empty_light_warning(scene) -> str | None:
     """Why every value baked from the captured engine Scene would be zero, or None: no light with
-    power > 0 and no emissive triangle. A lit world does not help: no method lights with it yet."""
-    if any(_emits(light) for light in scene.lights) or bool(np.any(scene.emission > 0)):
+    power > 0, no emissive triangle and a black world."""
+    world_lit = np.any(scene.world_color > 0) or (scene.world_map is not None and np.any(scene.world_map > 0))
+    if any(_emits(light) for light in scene.lights) or bool(np.any(scene.emission > 0)) or world_lit:
         return None
-    if np.any(scene.world_color > 0):
-        return "the scene's only light is the world colour, which Bounce does not light with: every baked value is zero"
-    return "the scene has no light sources (no light with power > 0, no emissive surface): every baked value is zero"
+    return ("the scene has no light sources (no light with power > 0, no emissive surface, a black world): "
+            "every baked value is zero")
 
 
 ZERO_LIGHT = "no light: every baked value is zero"

@@ -26,7 +26,8 @@ import bpy
 import numpy as np
 
 from ..engine.scene import AREA_SHAPES, Camera, Light, Scene
-from . import compat
+from ..engine.world import directions as world_directions
+from . import compat, world_capture
 
 NEUTRAL_ALBEDO = 0.8  # Cycles' own fallback surface is a 0.8 grey diffuse
 
@@ -399,7 +400,11 @@ class SceneCache:
     image averages are cached until an Image update). `geometry_reads` counts re-triangulated meshes.
     """
 
-    def __init__(self):
+    def __init__(self, world_maps: bool = True):
+        """world_maps: render a world that varies with direction into a map (world_capture.py, about
+        1.5 s per change); without, such a world lights as its average colour (the interactive
+        viewport, where a Cycles render from a timer would stall the UI)."""
+        self.world_maps = world_maps
         self.blocks: dict[tuple, _Block] = {}
         self.images: dict[str, np.ndarray | None] = {}
         self.geometry_reads = 0
@@ -415,6 +420,16 @@ class SceneCache:
                 self._dirty.add(u.id.original.name)
             elif isinstance(u.id, bpy.types.Image):
                 self.images.pop(u.id.original.name, None)
+
+    def _capture_world(self, world, out: Scene) -> None:
+        """The world's light into out.world_color (constant) or out.world_map (a map, with its mean as
+        world_color): a world that varies with direction is rendered by Cycles unless world_maps is off."""
+        if self.world_maps and world_capture.needs_map(world):
+            out.world_map = world_capture.world_map(world)
+            _, omega = world_directions(*out.world_map.shape[:2])
+            out.world_color = (np.tensordot(omega, out.world_map, axes=2) / omega.sum()).astype(np.float32)
+        else:
+            out.world_color = world_color(world, out.warnings).astype(np.float32)
 
     def invalidate(self) -> None:
         """Forget everything: the next update re-reads every mesh."""
@@ -480,7 +495,7 @@ class SceneCache:
         for _, _, warn, _ in mats.values():
             if warn:
                 out.warnings.append(warn)
-        out.world_color = world_color(scene_bl.world, out.warnings).astype(np.float32)
+        self._capture_world(scene_bl.world, out)
         if scene_bl.camera is not None:
             if width is None or height is None:
                 pct = scene_bl.render.resolution_percentage / 100.0

@@ -43,7 +43,8 @@ _versions = itertools.count(1)  # never reset, so an overlay can never mistake a
 
 @dataclasses.dataclass
 class LiveState:
-    cache: SceneCache = dataclasses.field(default_factory=SceneCache)
+    # No Cycles render of the world from the UI's timer: a textured world lights as its average here.
+    cache: SceneCache = dataclasses.field(default_factory=lambda: SceneCache(world_maps=False))
     scene_name: str | None = None
     scene: Scene | None = None      # the last capture (its camera is replaced by each region's)
     geometry_version: int = 0
@@ -102,7 +103,7 @@ def _lights(scene: Scene) -> list:
 def capture(depsgraph) -> tuple[str, ...]:
     """Capture the depsgraph's scene; bump the versions of what differs from the last capture."""
     if depsgraph.scene.name != STATE.scene_name:
-        STATE.cache, STATE.scene, STATE.scene_name = SceneCache(), None, depsgraph.scene.name
+        STATE.cache, STATE.scene, STATE.scene_name = SceneCache(world_maps=False), None, depsgraph.scene.name
     previous = STATE.scene
     # 1 x 1: the scene camera is not what the viewport shows; each region builds its own camera.
     scene = STATE.cache.update(depsgraph, 1, 1)

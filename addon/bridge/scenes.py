@@ -305,6 +305,35 @@ def build_cornell_large_area() -> None:
     _light("Area", "AREA", (0.0, 0.0, 1.98), 200.0, shape="SQUARE", size=1.0, spread=math.pi)
 
 
+def _world(color=(0.0, 0.0, 0.0), strength: float = 1.0, sky: bool = False) -> None:
+    """The scene's world: a constant colour x strength, or (sky) a Sky Texture without its sun disc
+    (the scene's own SUN lamp is the sun) x strength."""
+    world = bpy.context.scene.world
+    tree = compat.node_tree(world)
+    background = tree.nodes["Background"]
+    background.inputs["Color"].default_value = (*color, 1.0)
+    background.inputs["Strength"].default_value = strength
+    if sky:
+        tex = tree.nodes.new("ShaderNodeTexSky")
+        tex.sun_disc = False
+        tree.links.new(tex.outputs["Color"], background.inputs["Color"])
+
+
+def build_cornell_grey_world() -> None:
+    """The spot-lit Cornell box under Blender's default world, a uniform grey 0.05: it enters through the
+    open front and lights the box besides the spot (7 % of the direct light in Cycles)."""
+    _cornell_spot("cornell-grey-world")
+    _world((0.05, 0.05, 0.05))
+
+
+def build_window_sky() -> None:
+    """window-room lit by its sun and a sky (Sky Texture, no sun disc) through the window: the sky's
+    light enters at every angle the opening allows, the sun's as one patch on the floor."""
+    build_window_room()
+    bpy.context.scene["bounce_scene"] = "window-sky"
+    _world(strength=1.0, sky=True)
+
+
 def build_textured() -> None:
     """The spot-lit Cornell box with an image-textured floor and back wall (UVs span each wall)."""
     _cornell_spot("textured", textured=True)
@@ -361,6 +390,8 @@ SCENES = {
     "cornell-point": build_cornell_point,
     "cornell-area": build_cornell_area,
     "cornell-large-area": build_cornell_large_area,
+    "cornell-grey-world": build_cornell_grey_world,
+    "window-sky": build_window_sky,
     "cornell-glossy": build_cornell_glossy,
     "textured": build_textured,
     "window-room": build_window_room,

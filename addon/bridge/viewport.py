@@ -120,6 +120,7 @@ class Overlay:
             # Geometry on the GPU is still valid: only the camera and the lights are new.
             self.method.set_camera(camera)
             self.method.set_lights(state.scene.lights)
+            self.method.set_world(state.scene.world_color, state.scene.world_map)
             run_gbuffer = not _same_camera(self.camera, camera)
         else:
             return False

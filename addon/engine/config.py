@@ -75,6 +75,9 @@ class RsmConfig(_Validated):
     # with its exact unshadowed irradiance and the shadow of its centre (area_light.py): shadows soften
     # in that many steps; each patch costs its own RSM faces.
     area_patches: int = _num(2, 1, 8, "patches per side an area light is split into, each shadowed from its centre")
+    # The world (sky, HDRI, a constant colour) lights as this many suns, each a region of the sky with
+    # its exact vector irradiance (world.py) and its own shadow map; 0 leaves the world out.
+    world_suns: int = _num(32, 0, 256, "suns the world's light is split into (0: the world does not light)")
 
 
 @dataclass(frozen=True)

@@ -95,8 +95,9 @@ def first_copies(positions_m: np.ndarray) -> np.ndarray:
 @dataclass
 class Scene:
     """Triangles (n, 3 corners, 3) with per-corner normals, per-triangle diffuse albedo and emitted
-    radiance (W/m^2/sr, emission colour x strength), lights, the world colour (constant radiance) and
-    the camera. Empty scenes are valid: zero triangles, zero lights.
+    radiance (W/m^2/sr, emission colour x strength), lights, the world (a constant radiance
+    `world_color`, or an equirectangular radiance map `world_map` in world.py's layout that then
+    replaces it) and the camera. Empty scenes are valid: zero triangles, zero lights.
 
     The glossy lobe (optional, None = none): per triangle `specular` (n, 3), the GGX lobe's reflectance
     at normal incidence F0 (metals: their base colour; dielectrics ((ior - 1) / (ior + 1))^2 x 2 x
@@ -108,6 +109,7 @@ class Scene:
     emission: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
     lights: list[Light] = field(default_factory=list)
     world_color: np.ndarray = field(default_factory=lambda: np.zeros(3, np.float32))
+    world_map: np.ndarray | None = None
     camera: Camera | None = None
     warnings: list[str] = field(default_factory=list)
     # Per triangle: False where the object is hidden from the camera but still reflects light (the

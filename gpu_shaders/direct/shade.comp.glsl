@@ -17,6 +17,72 @@ int cube_face(vec3 d) {
     return d.z >= 0.0 ? 4 : 5;
 }
 
+// Soft sun shadows (percentage-closer soft shadows): a sun of angular diameter 2 atan(sun_tan_half)
+// casts a penumbra (receiver depth - blocker depth) x sun_tan_half wide on each side. The mean depth of
+// the blockers found in a disc of the widest penumbra sizes the filter; the lit share of a disc that
+// wide is the visibility. Both discs are SOFT_SAMPLES texels on a Vogel spiral (fixed: no per-pixel
+// noise). A world region (world.py) is such a sun, as wide as its share of the sky.
+const int SOFT_SAMPLES = 16;
+const float MAX_SOFT_TEXELS = 16.0;
+
+vec2 vogel(int i) {
+    float r = sqrt((float(i) + 0.5) / float(SOFT_SAMPLES));
+    float a = float(i) * 2.39996323;
+    return r * vec2(cos(a), sin(a));
+}
+
+float sun_depth(vec2 uv, ivec2 size) {
+    vec4 occ = texelFetch(rsm_position, clamp(ivec2(uv), ivec2(0), size - 1), 0);
+    return occ.w > 0.0 ? dot(occ.xyz, emit_axis) : 1e30;  // no geometry: nothing blocks
+}
+
+// The receiver's own plane seen from the sun: its depth change per texel of the shadow map, so a disc
+// sample is compared with the plane's depth there, not the centre's (else a surface the sun lights at
+// a slant shadows itself across the disc). From two tangents of the plane, their texel steps a, b and
+// depth steps da, db: depth(delta) = [da db] [a b]^-1 delta.
+vec2 receiver_slope(vec3 n, ivec2 size) {
+    vec3 t1 = normalize(cross(n, abs(n.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
+    vec3 t2 = cross(n, t1);
+    vec2 a = (light_view_projection * vec4(t1, 0.0)).xy * 0.5 * vec2(size);
+    vec2 b = (light_view_projection * vec4(t2, 0.0)).xy * 0.5 * vec2(size);
+    float da = dot(t1, emit_axis);
+    float db = dot(t2, emit_axis);
+    float det = a.x * b.y - a.y * b.x;
+    if (abs(det) < 1e-12) {
+        return vec2(0.0);  // the sun grazes the surface: it receives (almost) nothing anyway
+    }
+    return vec2(b.y * da - a.y * db, a.x * db - b.x * da) / det;
+}
+
+// A texel with no geometry lies outside everything the sun sees. Taken as lit, it lets a disc that
+// reaches past a closed room's outer walls light the room's inside; it counts as the centre does.
+float soft_sun_visibility(vec2 uv, ivec2 size, float receiver, float bias_m, float texel_m, vec3 n) {
+    vec2 slope = receiver_slope(n, size);
+    float centre_lit = sun_depth(uv, size) >= receiver - bias_m ? 1.0 : 0.0;
+    float search = min(MAX_SOFT_TEXELS, sun_tan_half * float(size.x));
+    float blockers = 0.0;
+    float depth_sum = 0.0;
+    for (int i = 0; i < SOFT_SAMPLES; ++i) {
+        vec2 offset = search * vogel(i);
+        float d = sun_depth(uv + offset, size);
+        if (d < receiver + dot(slope, offset) - bias_m) {
+            blockers += 1.0;
+            depth_sum += d;
+        }
+    }
+    if (blockers == 0.0) {
+        return 1.0;
+    }
+    float radius = clamp((receiver - depth_sum / blockers) * sun_tan_half / texel_m, 0.5, MAX_SOFT_TEXELS);
+    float lit = 0.0;
+    for (int i = 0; i < SOFT_SAMPLES; ++i) {
+        vec2 offset = radius * vogel(i);
+        float d = sun_depth(uv + offset, size);
+        lit += d >= 1e29 ? centre_lit : (d >= receiver + dot(slope, offset) - bias_m ? 1.0 : 0.0);
+    }
+    return lit / float(SOFT_SAMPLES);
+}
+
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(px, textureSize(gbuf_position, 0)))) {
@@ -70,7 +136,10 @@ void main() {
         ivec2 size = textureSize(rsm_position, 0);
         ivec2 texel = clamp(ivec2((ndc.xy * 0.5 + 0.5) * vec2(size)), ivec2(0), size - 1);
         vec4 occ = texelFetch(rsm_position, texel, 0);
-        if (occ.w > 0.0) {
+        if (light_kind == LIGHT_SUN && sun_tan_half > 0.0) {
+            lit = soft_sun_visibility((ndc.xy * 0.5 + 0.5) * vec2(size), size, dot(p_test, emit_axis), bias_m,
+                                      texel_m, n);
+        } else if (occ.w > 0.0) {
             float receiver = light_kind == LIGHT_SUN ? dot(p_test, emit_axis) : length(p_test - light_pos_ws);
             float occluder = light_kind == LIGHT_SUN ? dot(occ.xyz, emit_axis) : length(occ.xyz - light_pos_ws);
             lit = receiver <= occluder + bias_m ? 1.0 : 0.0;

@@ -35,6 +35,8 @@ EXPECTED_OBJECTS = {
     "textured": CORNELL | {"Spot"},
     "emissive": CORNELL | {"EmissivePanel"},
     "window-room": ROOM | {f"NorthWall.{p}" for p in ("Below", "Above", "Left", "Right")} | {"Sun", "Camera"},
+    "window-sky": ROOM | {f"NorthWall.{p}" for p in ("Below", "Above", "Left", "Right")} | {"Sun", "Camera"},
+    "cornell-grey-world": CORNELL | {"Spot"},
     "thin-wall": {f"Left.{n}" for n in ROOM - {"EastWall"} | {"NorthWall"}}
     | {f"Right.{n}" for n in ROOM - {"WestWall"} | {"NorthWall"}}
     | {"SharedWall", "Point", "Camera"},
@@ -81,6 +83,9 @@ def _scene_hash() -> str:
             if hasattr(inp, "default_value"):
                 h.update(repr(np.array(inp.default_value).tolist()).encode())
     h.update(repr((scene.render.resolution_x, scene.render.resolution_y, tuple(scene.world.color))).encode())
+    background = scene.world.node_tree.nodes["Background"].inputs
+    h.update(repr((tuple(background["Color"].default_value), background["Strength"].default_value,
+                   background["Color"].is_linked)).encode())
     return h.hexdigest()
 
 
@@ -136,7 +141,15 @@ def test_scene_builds_complete(fresh_blend, name):
     assert {o.name for o in scene.objects} == EXPECTED_OBJECTS[name]
     assert scene.camera is not None and scene.camera.type == "CAMERA"
     assert scene.render.resolution_percentage == 100 and scene.unit_settings.scale_length == 1.0
-    assert scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value == 0.0
+    # A black world but where the scene is about the world: Blender's default grey, a sky.
+    background = scene.world.node_tree.nodes["Background"].inputs
+    if name == "cornell-grey-world":
+        assert tuple(background["Color"].default_value)[:3] == pytest.approx((0.05,) * 3)
+        assert background["Strength"].default_value == 1.0
+    elif name == "window-sky":
+        assert background["Color"].is_linked and background["Strength"].default_value == 1.0
+    else:
+        assert background["Strength"].default_value == 0.0
 
     lamps = [o.data for o in scene.objects if o.type == "LIGHT"]
     emitters = [m for m in bpy.data.materials

@@ -127,6 +127,22 @@ def test_area_light_gives_its_polygons_irradiance(gl, shape, sx, sy):
         assert img[row, col] == pytest.approx(e / np.pi, rel=1e-4)
 
 
+def test_uniform_world_over_an_open_plane_gives_its_radiance(gl):
+    # A uniform world of radiance L: a surface that sees the whole sky gets E = pi L (Diffuse Direct = L).
+    # The world's suns sum to pi L exactly on an upward normal (world.py); the occluder's shadow is
+    # away from the tested point (its 0.3-0.7 square casts no shadow on (-0.7, -0.7) for any sun with
+    # a direction above 35 degrees; lower suns shadow a few percent of the sky there, hence rtol 3e-2).
+    floor = np.array(quad(-1, 1, -1, 1, 0.0), np.float32)
+    cam = make_scene(Light("POINT", [0, 0, 2], [0, 0, -1], [1, 1, 1])).camera
+    scene = Scene(floor, np.tile([0, 0, 1], (2, 3, 1)).astype(np.float32), np.full((2, 3), 0.8, np.float32),
+                  np.zeros((2, 3), np.float32), [], world_color=np.array([0.5, 1.0, 2.0], np.float32), camera=cam)
+    method = DirectMethod(gl, GIConfig(), RsmConfig(resolution=256))
+    method.set_scene(scene)
+    img = method.run().images["direct"]
+    row, col = pixel_of(cam, np.array([-0.7, -0.7, 0.0]))
+    np.testing.assert_allclose(img[row, col, :3], [0.5, 1.0, 2.0], rtol=1e-4)
+
+
 def test_sun_irradiance(gl):
     light = Light("SUN", [0, 0, 10], [0, 0, -1], [1.0, 0.5, 0.25], sun_strength=3.0)
     method = DirectMethod(gl, GIConfig(), RsmConfig(resolution=256))

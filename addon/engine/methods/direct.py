@@ -22,7 +22,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .. import registry
+from .. import registry, world
 from ..area_light import emitter_table, split_area_light
 from ..backends.base import Backend
 from ..config import GIConfig, RsmConfig
@@ -36,6 +36,12 @@ from ..scene import Camera, Scene
 # at every update. 256 MB holds 75 faces at 256^2 texels (3 RGBA32F + depth: 52 bytes a texel).
 RSM_KEEP_BYTES = 256 * 2**20
 RSM_BYTES_PER_TEXEL = 3 * 16 + 4
+
+
+def world_key(scene: Scene) -> tuple:
+    """Equal for equal worlds (colour and map)."""
+    world_map = None if scene.world_map is None else (scene.world_map.shape, scene.world_map.tobytes())
+    return np.asarray(scene.world_color, np.float32).tobytes(), world_map
 
 
 def lights_key(lights) -> tuple:
@@ -127,6 +133,7 @@ class DirectMethod:
         self._kept_faces = max(1, RSM_KEEP_BYTES // (RSM_BYTES_PER_TEXEL * n * n))
         self.rsm, self.rsm_target = self._rsm_slot(0)  # the face being drawn or read (hooks use it)
         self._emitter_rows = None  # the emitter table on the GPU (light_views)
+        self._world_key, self._world_suns = None, []
         self._solved_for = None  # lights_key of the light field on the GPU; None: none is
         self.solves = 0          # how many updates solved (bakes report it)
         self._size = None
@@ -147,6 +154,26 @@ class DirectMethod:
 
     def set_lights(self, lights: list) -> None:
         self.source = replace(self.source, lights=list(lights))
+
+    def set_world(self, world_color, world_map=None) -> None:
+        """The world's light (Scene.world_color / world_map) for the next updates."""
+        self.source = replace(self.source, world_color=np.asarray(world_color, np.float32), world_map=world_map)
+
+    def world_suns(self) -> list:
+        """The world as suns (world.py), recomputed only when the world changes."""
+        key = world_key(self.source)
+        if key != self._world_key:
+            count = self.rsm_config.world_suns
+            world_map = self.source.world_map
+            if world_map is None and np.any(self.source.world_color > 0):
+                world_map = world.constant_map(self.source.world_color)
+            self._world_key = key
+            self._world_suns = world.world_suns(world_map, count) if count and world_map is not None else []
+        return self._world_suns
+
+    def light_key(self) -> tuple:
+        """What a light field is solved for: the lights and the world."""
+        return lights_key(self.source.lights), world_key(self.source)
 
     def _allocate_images(self) -> None:
         """Camera-sized targets, (re)made only when the camera's size changes; none without a camera
@@ -190,6 +217,7 @@ class DirectMethod:
             local = replace(light, position_m=light.position_m - self.origin_m)
             lights += split_area_light(local, self.rsm_config.area_patches) if local.kind == "AREA" else [local]
         lights += self.emissive
+        lights += self.world_suns()
         table, ranges = emitter_table(lights)
         self._upload_emitters(table)
         views = []
@@ -222,7 +250,7 @@ class DirectMethod:
         self._allocate_images()
         views = self.light_views()
         keep = len(views) <= self._kept_faces
-        key = lights_key(self.source.lights)
+        key = self.light_key()
         if solve is None:
             solve = not (keep and self.keeps_light_field() and self._solved_for == key)
         timings: dict[str, float] = {}
@@ -259,7 +287,7 @@ class DirectMethod:
         timings: dict[str, float] = {}
         with self.timed(timings, "total"), self.timed(timings, "solve"):
             self._solve(views, timings, range(len(views)) if keep else [0] * len(views))
-        self._solved_for = lights_key(self.source.lights) if keep else None
+        self._solved_for = self.light_key() if keep else None
         self.solves += 1
         return timings
 

@@ -108,8 +108,9 @@ class VctMethod(OneBounceMethod):
         at the voxels from a pyramid of the bounce before it alone (so none is counted twice)."""
         be, cfg = self.backend, self.vct_config
         # Lights may change between updates (set_lights); the geometry's largest albedo only with set_scene.
-        self.radiance_scale = vct_pyramid.radiance_scale([*self.source.lights, *self.emissive], self.bounds_m,
-                                                         self.grid.cell_size_m, self.gi.bounces, self._albedo_max)
+        lights = [*self.source.lights, *self.emissive, *self.world_suns()]
+        self.radiance_scale = vct_pyramid.radiance_scale(lights, self.bounds_m, self.grid.cell_size_m, self.gi.bounces,
+                                                         self._albedo_max)
         with self.step(timings, vct_pyramid.DECL):
             self._build(1.0, None)
         if self.gi.bounces == 1:

@@ -28,7 +28,7 @@ SPEC = ShaderSpec(
         Var("emit_axis", "vec3"), Var("light_kind", "int"),
         Var("light_color_intensity", "vec3"), Var("face_index", "int"),
         Var("spot_cos_half", "float"), Var("spot_blend", "float"), Var("shadow_bias_texels", "float"),
-        Var("poly_first", "int"), Var("poly_count", "int"),
+        Var("poly_first", "int"), Var("poly_count", "int"), Var("sun_tan_half", "float"),
     ),
 )
 

@@ -165,6 +165,8 @@ def _common_uniforms(light: Light, emit_axis: np.ndarray, texel_scale: float) ->
         "spot_cos_half": float(np.cos(light.spot_size_rad / 2.0)) if spot else -1.0,
         "spot_blend": float(light.spot_blend) if spot else 0.0,
         "occluder_radius": float(light.occluder_radius_m),
+        # A sun's angular radius (its tangent): its shadows' penumbra (direct_light's soft shadows).
+        "sun_tan_half": float(np.tan(light.sun_angle_rad / 2.0)) if light.kind == "SUN" else 0.0,
     }
 
 

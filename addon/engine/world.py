@@ -1,0 +1,116 @@
+"""The world as a light: an environment map of radiance split into regions, each a sun. Pure numpy.
+
+Why suns: every method already lights with suns (an orthographic RSM each: soft visibility from K of
+them, VPLs for the indirect light, the same in every method's light field). A region R of the sky
+lights a surface of normal n with E = int_R L(w) max(0, n.w) dw; while R lies wholly above the
+surface's horizon the max is inactive and E = n . V_R with V_R = int_R L(w) w dw, the region's vector
+irradiance. So a sun along V_R of strength |V_R| is exact for every receiver whose horizon does not cut
+R; the partition splits first at the horizon plane of floors and ceilings (the equator), then each
+region at its power median along its wider side, so the brightest parts (a sun disc in an HDRI) get
+the smallest regions.
+
+Map layout (the capture writes it so, bridge/world_capture.py): equirectangular, float32 (h, w, 3) W/m^2/sr
+per colour, row 0 = up (+z), column c = longitude 2 pi (c + 0.5) / w - pi about +z with longitude 0
+along +x (direction (cos lat cos lon, cos lat sin lon, sin lat)).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .scene import Light
+
+LUMA = np.array([0.2126, 0.7152, 0.0722])  # Rec.709 luminance: power is split by what the eye weighs
+
+
+def directions(height: int, width: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per texel its unit direction (h, w, 3) and solid angle (h, w) in sr (summing to 4 pi)."""
+    lat = np.pi / 2 - np.pi * (np.arange(height) + 0.5) / height
+    lon = 2 * np.pi * (np.arange(width) + 0.5) / width - np.pi
+    lat_g, lon_g = np.meshgrid(lat, lon, indexing="ij")
+    d = np.stack([np.cos(lat_g) * np.cos(lon_g), np.cos(lat_g) * np.sin(lon_g), np.sin(lat_g)], axis=-1)
+    # Exact band areas: 2 pi (sin(top) - sin(bottom)) / width per texel of a row.
+    edges = np.pi / 2 - np.pi * np.arange(height + 1) / height
+    band = 2 * np.pi * (np.sin(edges[:-1]) - np.sin(edges[1:])) / width
+    return d, np.repeat(band[:, None], width, axis=1)
+
+
+def texel_vectors(height: int, width: int) -> np.ndarray:
+    """Per texel int w dw over its latitude-longitude rectangle (h, w, 3), in closed form: a uniform
+    map's vector irradiance sums exactly (a floor under a uniform sky gets pi L, not a quadrature of it)."""
+    lat = np.pi / 2 - np.pi * np.arange(height + 1) / height           # row edges, top to bottom
+    lon = 2 * np.pi * np.arange(width + 1) / width - np.pi            # column edges
+    lat0, lat1 = lat[1:], lat[:-1]                                     # bottom, top of each row
+    cos2 = (lat1 - lat0) / 2 + (np.sin(2 * lat1) - np.sin(2 * lat0)) / 4  # int cos^2(lat) dlat
+    z = (np.sin(lat1) ** 2 - np.sin(lat0) ** 2) / 2                     # int sin cos dlat
+    x = np.sin(lon[1:]) - np.sin(lon[:-1])                             # int cos(lon) dlon
+    y = np.cos(lon[:-1]) - np.cos(lon[1:])                             # int sin(lon) dlon
+    dlon = lon[1:] - lon[:-1]
+    return np.stack([cos2[:, None] * x[None, :], cos2[:, None] * y[None, :], z[:, None] * dlon[None, :]], axis=-1)
+
+
+def constant_map(radiance: np.ndarray, height: int = 16, width: int = 32) -> np.ndarray:
+    return np.broadcast_to(np.asarray(radiance, np.float32), (height, width, 3)).copy()
+
+
+def regions(power: np.ndarray, count: int) -> list[tuple[slice, slice]]:
+    """Split the map (per-texel power (h, w)) into `count` rectangles of texels: the two hemispheres
+    first, then repeatedly the region of largest power at its power median along its longer side
+    (in texels weighted by cos(lat) for longitude). Regions with no power are never split."""
+    h, w = power.shape
+    rects = [(slice(0, h // 2), slice(0, w)), (slice(h // 2, h), slice(0, w))] if h >= 2 else [(slice(0, h),
+                                                                                              slice(0, w))]
+    while len(rects) < count:
+        totals = [power[r].sum() for r in rects]
+        order = np.argsort(totals)[::-1]
+        for i in order:
+            split = _split(power, rects[i])
+            if split is not None:
+                rects[i:i + 1] = list(split)
+                break
+        else:
+            break  # nothing left to split: fewer regions than asked
+    return rects
+
+
+def _split(power: np.ndarray, rect: tuple[slice, slice]):
+    rows, cols = rect
+    n_rows, n_cols = rows.stop - rows.start, cols.stop - cols.start
+    block = power[rect]
+    if block.sum() <= 0 or n_rows * n_cols < 2:
+        return None
+    mid_lat = np.pi / 2 - np.pi * (rows.start + rows.stop) / 2 / power.shape[0]
+    along_rows = n_rows > n_cols * max(np.cos(mid_lat), 0.05) and n_rows > 1 or n_cols < 2
+    profile = block.sum(axis=1) if along_rows else block.sum(axis=0)
+    cut = int(np.searchsorted(np.cumsum(profile), 0.5 * profile.sum()))
+    cut = min(max(cut, 1), len(profile) - 1)  # both halves keep at least one texel
+    if along_rows:
+        return (slice(rows.start, rows.start + cut), cols), (slice(rows.start + cut, rows.stop), cols)
+    return (rows, slice(cols.start, cols.start + cut)), (rows, slice(cols.start + cut, cols.stop))
+
+
+def world_suns(world_map: np.ndarray, count: int) -> list[Light]:
+    """The map's light as at most `count` suns (module docstring): each region's vector irradiance V_c
+    per colour; the sun shines along -(luminance-weighted direction), strength |V| along it."""
+    radiance = np.asarray(world_map, np.float64)
+    _, solid_angle = directions(*radiance.shape[:2])
+    vectors = texel_vectors(*radiance.shape[:2])
+    power = (radiance @ LUMA) * solid_angle
+    suns = []
+    for rect in regions(power, count):
+        vec = np.einsum("ijc,ijk->ck", radiance[rect], vectors[rect])  # (3 colours, xyz): V per colour
+        luma_vec = LUMA @ vec
+        norm = np.linalg.norm(luma_vec)
+        if norm <= 0:
+            continue
+        toward = luma_vec / norm  # where the region lies, seen from the scene
+        strength = np.maximum(vec @ toward, 0.0)  # per colour, W/m^2 on a surface facing it
+        peak = float(strength.max())
+        if peak <= 0:
+            continue
+        # As wide as the region: a cone of the region's solid angle (omega = 2 pi (1 - cos half-angle)).
+        omega = float(solid_angle[rect].sum())
+        angle = 2.0 * float(np.arccos(np.clip(1.0 - omega / (2.0 * np.pi), -1.0, 1.0)))
+        suns.append(Light("SUN", toward * 1e3, -toward, strength / peak, sun_strength=peak, sun_angle_rad=angle,
+                          name="world"))
+    return suns
