@@ -44,8 +44,9 @@ KERNEL = np.array([1.0, 4.0, 6.0, 4.0, 1.0]) / 16.0
 # (`iterations_for`). The filter is guided by geometry only, so it also flattens the indirect's real rise
 # into concave corners once it reaches that far. On cornell, vct's indirect against Cycles (512 spp;
 # rel_rmse / rel_rmse_8, unfiltered 0.60 / 0.15) was best with 2 iterations at 128 px (0.175 / 0.125;
-# 3: 0.21 / 0.15) and with 3 to 4 at 512 px (0.155 / 0.131 and 0.157 / 0.129; 2: 0.169 / 0.140):
-# reaches of 6, 14 and 30 px, 4.7 %, 2.7 % and 5.9 % of the long side (tools/denoise_cost.py).
+# 3: 0.21 / 0.15), 3 at 256 px (0.162 / 0.129; 2: 0.172 / 0.138, 4: 0.21 / 0.17) and 3 to 4 at 512 px
+# (0.155 / 0.131 and 0.157 / 0.129; 2: 0.169 / 0.140): reaches of 4.7 %, 5.5 % and 2.7 to 5.9 % of the
+# long side (tools/denoise_cost.py).
 REACH_FRACTION = 0.05
 
 
