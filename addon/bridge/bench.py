@@ -217,6 +217,13 @@ def _format_commit(machine: dict) -> str:
     return f"; code at commit {machine['commit'][:12]}" + (" with uncommitted changes" if machine["dirty"] else "")
 
 
+def _format_load(machine: dict) -> str:
+    if "load_average_1min" not in machine:
+        return ""
+    start, end = machine["load_average_1min"]
+    return f"; load average {start:.1f} at the start, {end:.1f} at the end ({machine['cores']} cores)"
+
+
 def format_report(result: dict) -> str:
     """The generated block of REPORT.md (between MARK_BEGIN and MARK_END)."""
     m = result["machine"]
@@ -226,7 +233,7 @@ def format_report(result: dict) -> str:
         f"Produced by: `{result['command']}`\n",
         f"Machine: {m['platform']}; CPU {m['cpu']} ({m['cores']} cores); Bounce backend: {m['bounce_renderer']}; "
         f"Cycles device: {m['cycles_device']}; Blender {m['blender']}"
-        + (f"; run on {m['date']}" if m.get("date") else "") + _format_commit(m) + ".\n",
+        + (f"; run on {m['date']}" if m.get("date") else "") + _format_commit(m) + _format_load(m) + ".\n",
         f"Settings: {result['res']} px long side, {result['bounces']} diffuse bounce(s), reference "
         f"{result['ref_spp']} spp, Bounce times = median of {result['repeat']} full updates after a warm-up "
         "(read-back included), Cycles times = one render call (scene sync + BVH + sampling, no file I/O). "
@@ -495,6 +502,8 @@ def run_bench(opt: Options) -> dict:
               "repeat": repeat, "quick": quick, "curve_spp": spps, "update_costs": opt.update_costs,
               "row_filter": opt.row_filter, "scenes": [], "skipped": skipped}
     renderers, devices = set(), set()
+    load_at_start = os.getloadavg()[0]
+    version = code_version()  # before the first method module is imported: the code the run measures
     for name, src in scene_list:
         bar.set_postfix_str(f"{name}: scene + references")
         blend = _cache_blend(name, src, cache)
@@ -525,7 +534,9 @@ def run_bench(opt: Options) -> dict:
     result["machine"] = {"platform": platform.platform(), "cpu": cpu_model(), "cores": os.cpu_count(),
                          "bounce_renderer": ", ".join(sorted(renderers)) or "n/a",
                          "cycles_device": ", ".join(sorted(devices)) or "n/a", "blender": bpy.app.version_string,
-                         "date": datetime.now(UTC).strftime("%Y-%m-%d"), **code_version()}
+                         "date": datetime.now(UTC).strftime("%Y-%m-%d"), **version,
+                         # other processes on the machine slow the timings: the 1-minute load at both ends
+                         "load_average_1min": [round(load_at_start, 2), round(os.getloadavg()[0], 2)]}
     report = opt.out / "REPORT.md"
     existing = report.read_text() if report.is_file() else None
     report.write_text(merge_report(existing, format_report(result)))

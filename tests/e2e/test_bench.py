@@ -174,8 +174,9 @@ def test_code_version_names_the_commit(tmp_path):
     result["machine"].update(date="2026-12-01", commit="0123456789abcdef" * 2 + "01234567", dirty=True)
     assert "Blender 5.0.1; run on 2026-12-01; code at commit 0123456789ab with uncommitted changes." \
         in bench.format_report(result)
-    result["machine"]["dirty"] = False
-    assert "; code at commit 0123456789ab.\n" in bench.format_report(result)
+    result["machine"].update(dirty=False, load_average_1min=[0.52, 3.0])
+    assert "; code at commit 0123456789ab; load average 0.5 at the start, 3.0 at the end (2 cores).\n" \
+        in bench.format_report(result)
 
 
 def test_command_line_spells_the_new_options():
@@ -245,7 +246,8 @@ def test_quick_bench_on_cornell(tmp_path):
     # results.json: one record per run, the report's numbers, update costs timed by default
     results = json.loads((out / "results.json").read_text())
     assert results["schema"] == bench.RESULTS_SCHEMA and results["command"] == result["command"]
-    assert set(results["machine"]) >= {"cpu", "bounce_renderer", "blender", "date", "commit", "dirty"}
+    assert set(results["machine"]) >= {"cpu", "bounce_renderer", "blender", "date", "commit", "dirty",
+                                          "load_average_1min"}
     assert [(r["scene"], r["method"], r["setting"], r["default"]) for r in results["records"]] == \
         [("cornell", "direct", s, i == 0) for i, s in enumerate(bench.SETTINGS["direct"])]
     assert "| update full ms | update lights ms | update camera ms | camera/full |" in report
