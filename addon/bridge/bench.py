@@ -29,7 +29,7 @@ import platform
 import re
 import subprocess
 import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -39,7 +39,8 @@ from ..engine.errors import ConfigError
 # Method -> the settings it is benchmarked at (the registry's `bench` rows): each a dict of
 # "gi.<field>" / "rsm.<field>" / ... -> value. Small on purpose: every setting costs a run per scene.
 SETTINGS: dict[str, tuple[dict, ...]] = {m.name: m.bench for m in registry.METHODS}
-REAL_SCENES = ("sponza", "sibenik", "conference")  # /work/shared/scenes/<name>/<name>.blend
+REPO_ROOT = Path(__file__).resolve().parents[2]
+REAL_SCENES = ("sponza", "sibenik", "conference")  # ../shared/scenes/<name>/<name>.blend beside the checkout
 CURVE_SPP = (1, 4, 16, 64, 256)
 QUICK_CURVE_SPP = (1, 4, 16)
 REF_SPP, QUICK_REF_SPP = 1024, 128
@@ -118,9 +119,6 @@ def cpu_model() -> str:
     except OSError:
         pass
     return platform.processor() or "unknown CPU"
-
-
-REPO_ROOT = Path(__file__).resolve().parents[2]
 
 
 def code_version(root: Path = REPO_ROOT) -> dict:
@@ -319,7 +317,7 @@ class Options:
     row_filter: str = "all"  # ROW_FILTERS: which registry rows of each method run
     out: Path = Path("benchmarks")
     cache: Path = Path("out/bench")
-    shared_scenes: Path = field(default_factory=lambda: Path(__file__).resolve().parents[3] / "shared" / "scenes")
+    shared_scenes: Path = REPO_ROOT.parent / "shared" / "scenes"
     command: str = "python -m addon bench"
 
 
