@@ -45,3 +45,13 @@ def test_blender_compile_error_names_file_and_line(blender_backend, tmp_path, mo
     monkeypatch.setattr(shader_source, "SHADER_ROOT", tmp_path)
     with pytest.raises(ShaderCompileError, match=r"gpu_shaders/broken\.comp\.glsl:2"):
         blender_backend.program(ShaderSpec(name="broken", compute="broken.comp.glsl", local_size=(1, 1, 1)))
+
+
+def test_a_new_moderngl_backend_leaves_blenders_context_current(blender_backend):
+    # Creating a moderngl context makes it current; the backend must hand the caller's back (a bake
+    # in background mode makes one, and Blender's next texture failed: "gpu.texture.new(...) failed").
+    from addon.engine.backends.moderngl_backend import ModernGLBackend
+
+    ModernGLBackend()
+    tex = blender_backend.texture((4, 4), data=np.ones((4, 4, 4), np.float32))
+    np.testing.assert_array_equal(blender_backend.read(tex), 1.0)

@@ -126,10 +126,16 @@ class ModernGLBackend(Backend):
         except ImportError as exc:  # pragma: no cover - the venv always has it
             raise BackendUnavailable(f"moderngl is not installed: {exc}") from exc
         self._mgl = moderngl
+        self._egl = _EglCurrent()
+        # Creating a context makes it current and `with ctx:` below releases it: the caller's context
+        # (Blender's gpu module in background mode) must be made current again at the end, or its next
+        # call fails ("gpu.texture.new(...) failed" after a bake made a second backend).
+        callers = self._egl.save()
         if ctx is None:
             try:
                 ctx = moderngl.create_standalone_context(backend="egl", require=430)
             except Exception as exc:
+                self._egl.restore(callers)
                 raise BackendUnavailable(f"no EGL OpenGL 4.3 context: {exc}") from exc
         self.ctx = ctx
         # GL objects whose Python handles die are queued and released by _collect() inside our own
@@ -137,7 +143,6 @@ class ModernGLBackend(Backend):
         # or new scene leaked its buffers and textures; "auto" would release from __del__, possibly
         # while Blender's context is current, deleting its objects of the same names.
         ctx.gc_mode = "context_gc"
-        self._egl = _EglCurrent()
         with ctx:
             current = self._egl.save()
         self._own_context = current[3] if current else None
@@ -146,6 +151,7 @@ class ModernGLBackend(Backend):
         self._gl.glFramebufferTextureLayer.argtypes = [ctypes.c_uint] * 3 + [ctypes.c_int] * 2
         self._gl.glClearDepth.argtypes = [ctypes.c_double]
         self._gl.glClear.argtypes = [ctypes.c_uint]
+        self._egl.restore(callers)
 
     @property
     def renderer(self) -> str:
