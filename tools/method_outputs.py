@@ -41,6 +41,7 @@ def settings_of(case: dict) -> dict:
 
     fields = {group: dict(case.get(group, {})) for group in config.GROUPS}
     fields["gi"]["resolution"] = SIZE_PX
+    fields["gi"]["denoise"] = False  # the record predates the filter: the raw gathers
     fields["rsm"]["resolution"] = RSM_TEXELS
     return {group: cls(**fields[group]) for group, cls in config.GROUPS.items()}
 

@@ -71,9 +71,6 @@ CLASSES_KNOWN_DEFECTS = {
 # both faces of a wall thinner than a cell, and a cone passing near it reads the far face's light.
 VCT = "vct: "
 VCT_KNOWN_DEFECTS = {
-    "test_light_moving_1mm_per_frame[vct]": "frame-to-frame change 0.011 against 0.007: a VPL's flux moves a "
-                                            "whole voxel when it crosses a cell border (the default injection "
-                                            "is unfiltered, for speed; filtered_injection: 0.003, vct+filtered)",
     "test_camera_inside_closed_block[vct]": "indirect up to 0.095 inside a closed block (exact 0; 0.054 before "
                                             "exact voxel areas): its walls are one cell thick, so their lit outer "
                                             "faces share voxels with the inner faces the cones pass",

@@ -27,7 +27,7 @@ from ..area_light import emitter_table, split_area_light
 from ..backends.base import Backend
 from ..config import GIConfig, RsmConfig
 from ..errors import ConfigError
-from ..passes import declare, direct_light, gbuffer, rsm, zero
+from ..passes import declare, denoise, direct_light, gbuffer, rsm, zero
 from ..passes.light_views import LightView, emissive_lights, views_for
 from ..scene import Camera, Scene
 
@@ -84,6 +84,8 @@ class DirectMethod:
     # The passes of each half of an update (passes/declare.py), in the order they run: what the method
     # is, read as a list; tests check that it is what runs and that every input is written before.
     PASSES = {"setup": (), "camera": (gbuffer.DECL,), "solve": (rsm.DECL,), "gather": (direct_light.DECL,)}
+    # Products of a stochastic gather, filtered after it when GIConfig.denoise (passes/denoise.py).
+    NOISY: tuple[str, ...] = ()
 
     def __init_subclass__(cls, **kwargs):
         # A method's name, products and bounce limit are its registry entry's: declared once.
@@ -199,6 +201,9 @@ class DirectMethod:
         self._products = declare.allocate(self.backend, [ports[n] for n in self.products if n != "albedo"], size)
         for name, texture in self._products.items():
             setattr(self, name, texture)
+        # Per noisy product: the filter's output and scratch (the output then becomes the product).
+        self._filtered = {n: (self.backend.texture(size), self.backend.texture(size))
+                          for n in self.NOISY if self.gi.denoise}
 
     def camera(self) -> Camera:
         """The current camera in the uploaded geometry's (re-centred) frame."""
@@ -276,6 +281,7 @@ class DirectMethod:
                     self.finish_solve(timings)
                 with self.timed(timings, "gather"):
                     self.gather_pixels(timings)
+                    self.filter_products(timings)
             self._solved_for = key if keep else None
             self.solves += 1 if solve or not keep else 0
         return timings
@@ -309,6 +315,21 @@ class DirectMethod:
             self.rsm, self.rsm_target = self._rsm_slot(slot)
             self._gather_view(view, timings)
         self.gather_pixels(timings)
+        self.filter_products(timings)
+
+    def filter_products(self, timings: dict[str, float]) -> None:
+        """The noisy products filtered along their surfaces (GIConfig.denoise): each filtered into its
+        spare texture, which then becomes the product (and the old one the spare)."""
+        if not self._filtered:
+            return
+        iterations = denoise.iterations_for(max(self.gbuf["position"].size))
+        with self.step(timings, denoise.DECL):
+            for name, (out, scratch) in self._filtered.items():
+                noisy = self._products[name]
+                denoise.run(self.backend, self.gbuf, noisy, out, scratch, denoise.Params(iterations=iterations))
+                self._products[name] = out
+                self._filtered[name] = (noisy, scratch)
+                setattr(self, name, out)
 
     def _gather_view(self, view: LightView, timings: dict[str, float]) -> None:
         with self.step(timings, direct_light.DECL):

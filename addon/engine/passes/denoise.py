@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
+from .declare import GBUF_NORMAL, GBUF_POSITION, INDIRECT, PassDecl
 
 # The B3 spline (1, 4, 6, 4, 1) / 16 of the a-trous wavelet transform, taps -2..2; the shader's b3().
 KERNEL = np.array([1.0, 4.0, 6.0, 4.0, 1.0]) / 16.0
@@ -84,6 +85,11 @@ SPEC = ShaderSpec(
     uniforms=(Var("step_px", "int"), Var("normal_power", "float"), Var("plane_sigma", "float"),
               Var("position_sigma", "float")),
 )
+
+
+DECL = PassDecl("denoise", "gather", (GBUF_POSITION, GBUF_NORMAL, INDIRECT), (INDIRECT,),
+                "a stochastic gather's products (indirect; vct's ao and glossy too) filtered along their "
+                "surfaces (GIConfig.denoise)")
 
 
 def _destinations(iterations: int, noisy, out, scratch) -> list:
