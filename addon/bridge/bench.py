@@ -127,8 +127,9 @@ def code_version(root: Path = REPO_ROOT) -> dict:
     a git checkout."""
     def git(*args: str) -> str | None:
         try:
-            return subprocess.run(["git", "-C", str(root), *args], capture_output=True, text=True,
-                                  check=True).stdout.strip()
+            # no optional locks: a status must not hold index.lock while someone commits in this checkout
+            return subprocess.run(["git", "--no-optional-locks", "-C", str(root), *args], capture_output=True,
+                                  text=True, check=True).stdout.strip()
         except (OSError, subprocess.CalledProcessError):
             return None
 
