@@ -1,0 +1,71 @@
+"""tools/readme_figures.py: README.md's generated figure blocks equal what the tool makes from the
+committed results.json files (a hand edit or a stale table fails here), and the rewrite is idempotent."""
+
+import importlib.util
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+_spec = importlib.util.spec_from_file_location("readme_figures", ROOT / "tools" / "readme_figures.py")
+readme_figures = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(readme_figures)
+
+MACHINE = {"cpu": "Some CPU", "cores": 2, "bounce_renderer": "llvmpipe", "blender": "5.0.1", "date": "2026-12-01",
+           "commit": "0123456789abcdef" * 2 + "01234567", "dirty": False, "load_average_1min": [0.5, 2.3]}
+
+
+def _record(scene, method, default=True, update_ms=None, rel_rmse_8=0.5, bias=0.9):
+    return {"scene": scene, "method": method, "default": default, "image_size": [256, 192],
+            "update_ms": update_ms, "rel_rmse_8": rel_rmse_8, "bias": bias}
+
+
+def _results(records):
+    return {"command": "python -m addon bench X", "repeat": 5, "res": 128, "ref_spp": 128, "machine": MACHINE,
+            "records": records}
+
+
+def test_readme_blocks_equal_the_tool_output():
+    text = readme_figures.README.read_text()
+    assert readme_figures.rewrite(text, readme_figures.render_blocks()) == text, \
+        "README.md's figure blocks are stale or edited by hand: run .venv/bin/python tools/readme_figures.py"
+
+
+def test_rewrite_is_idempotent_and_keeps_the_text_around_blocks():
+    text = ("intro\n<!-- figures:a:begin -->\nold a\n<!-- figures:a:end -->\nmiddle\n"
+            "<!-- figures:b:begin -->\nold b\n<!-- figures:b:end -->\ntail\n")
+    once = readme_figures.rewrite(text, {"a": "new a\n"})
+    assert once == text.replace("old a", "new a")
+    assert readme_figures.rewrite(once, {"a": "new a\n"}) == once
+    blocks = readme_figures.render_blocks()
+    readme = readme_figures.rewrite(readme_figures.README.read_text(), blocks)
+    assert readme_figures.rewrite(readme, blocks) == readme
+    with pytest.raises(ValueError, match="no markers for block"):
+        readme_figures.rewrite(text, {"c": "x\n"})
+
+
+def test_update_costs_block():
+    records = [_record("cornell", "direct", update_ms={"full": 15.0, "lights": 5.8, "camera": 10.8}),
+               _record("cornell", "lpv", update_ms={"full": 172.0, "lights": 168.0, "camera": 19.0}),
+               _record("cornell", "lpv", default=False, update_ms={"full": 1.0, "lights": 1.0, "camera": 1.0}),
+               _record("sponza", "lpv", update_ms={"full": 200.0, "lights": 150.0, "camera": 40.0})]
+    block = readme_figures.update_costs_block(_results(records))
+    assert block.startswith("**Update costs** of each method at its default settings.\n\n"
+                            "Produced by `python -m addon bench X`\non 2026-12-01 (commit 0123456789ab; Some CPU, "
+                            "2 cores, load average 0.5 / 2.3 at the start / end; llvmpipe; Blender 5.0.1). "
+                            "Medians of 5 updates of each kind;")
+    assert "| cornell | 256 x 192 | direct | 15.0 | 5.8 | 10.8 | 72 % |" in block
+    assert "| cornell | 256 x 192 | lpv | 172.0 | 168.0 | 19.0 | 11 % |" in block
+    assert "| 1.0 |" not in block  # only the default rows
+    assert block.endswith("lpv's camera update costs 11.0 % on cornell, 20.0 % on sponza of its full update "
+                          "(target <= 15 %: not met).\n")
+
+
+def test_accuracy_block():
+    records = [_record("cornell", "direct", rel_rmse_8=0.1024, bias=0.9957), _record("cornell", "lpv"),
+               _record("cornell", "lpv", default=False, rel_rmse_8=9.0), _record("emissive", "direct"),
+               _record("emissive", "lpv", rel_rmse_8=None)]
+    lines = readme_figures.accuracy_block(_results(records)).splitlines()
+    assert lines[0] == "**Accuracy against Cycles** of each method at its default settings."
+    assert lines[5:] == ["| scene | direct | lpv |", "| --- | --- | --- |",
+                         "| cornell | 0.102 / 0.996 | 0.500 / 0.900 |", "| emissive | 0.500 / 0.900 | – |"]

@@ -1,0 +1,135 @@
+"""Rewrite README.md's generated figure blocks from the benchmarks' results.json files.
+
+    .venv/bin/python tools/readme_figures.py            # rewrite the blocks in README.md
+    .venv/bin/python tools/readme_figures.py --check    # exit 1 if a block differs from its results.json
+
+A block is the text between `<!-- figures:NAME:begin -->` and `<!-- figures:NAME:end -->`; everything
+outside the markers is left as it is. Each block is a function of one results.json (written by
+`python -m addon bench` beside its REPORT.md), so a README figure cannot drift from the run it quotes:
+tests/unit/test_readme_figures.py fails when a block was edited by hand or its results.json changed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+README = ROOT / "README.md"
+UPDATES_JSON = ROOT / "benchmarks" / "updates" / "results.json"
+DEFAULTS_JSON = ROOT / "benchmarks" / "defaults" / "results.json"
+LPV_CAMERA_TARGET_PCT = 15  # the issue's target: lpv's camera update <= 15 % of its full update
+_BLOCK = re.compile(r"(<!-- figures:(?P<name>[a-z0-9-]+):begin -->\n)(?P<body>.*?)(<!-- figures:(?P=name):end -->)",
+                    re.S)
+
+
+def load(path: Path) -> dict:
+    return json.loads(path.read_text())
+
+
+def _produced_by(results: dict) -> str:
+    """Two lines: the command, then when, where and on which code (markdown joins them)."""
+    m = results["machine"]
+    code = f"commit {m['commit'][:12]}" + (" with uncommitted changes" if m["dirty"] else "")
+    start, end = m["load_average_1min"]  # timings shared the cores with whatever else ran
+    return (f"Produced by `{results['command']}`\n"
+            f"on {m['date']} ({code}; {m['cpu']}, {m['cores']} cores, load average {start:.1f} / {end:.1f} at the "
+            f"start / end; {m['bounce_renderer']}; Blender {m['blender']}).")
+
+
+def _default_records(results: dict) -> list[dict]:
+    """Each method's record at its default settings, in the run's order."""
+    return [r for r in results["records"] if r["default"]]
+
+
+def _methods(records: list[dict]) -> list[str]:
+    return list(dict.fromkeys(r["method"] for r in records))
+
+
+def _camera_pct(update_ms: dict) -> float:
+    return 100 * update_ms["camera"] / update_ms["full"]
+
+
+def update_costs_block(results: dict) -> str:
+    """Table: full / lights / camera update ms per scene and method at its defaults, camera as a
+    percentage of full; then lpv's ratio against the issue's target."""
+    records = _default_records(results)
+    lines = ["**Update costs** of each method at its default settings.", "",
+             _produced_by(results) + f" Medians of {results['repeat']} updates of each kind; lights = every light "
+             "moved 1 cm, camera = the camera moved 1 cm.", "",
+             "| scene | size | method | full ms | lights ms | camera ms | camera / full |",
+             "| --- | --- | --- | --- | --- | --- | --- |"]
+    for r in records:
+        u = r["update_ms"]
+        w, h = r["image_size"]
+        lines.append(f"| {r['scene']} | {w} x {h} | {r['method']} | {u['full']:.1f} | {u['lights']:.1f} | "
+                     f"{u['camera']:.1f} | {_camera_pct(u):.0f} % |")
+    lpv = [r for r in records if r["method"] == "lpv"]
+    if lpv:
+        ratios = ", ".join(f"{_camera_pct(r['update_ms']):.1f} % on {r['scene']}" for r in lpv)
+        met = all(_camera_pct(r["update_ms"]) <= LPV_CAMERA_TARGET_PCT for r in lpv)
+        lines += ["", f"lpv's camera update costs {ratios} of its full update (target <= {LPV_CAMERA_TARGET_PCT} %: "
+                      f"{'met' if met else 'not met'})."]
+    return "\n".join(lines) + "\n"
+
+
+def accuracy_block(results: dict) -> str:
+    """Table: each method's rel_rmse_8 / bias at its defaults on every scene of the run."""
+    records = _default_records(results)
+    methods = _methods(records)
+    by_key = {(r["scene"], r["method"]): r for r in records}
+    lines = ["**Accuracy against Cycles** of each method at its default settings.", "",
+             _produced_by(results) + f" {results['res']} px long side, Cycles reference {results['ref_spp']} spp; "
+             "cells: rel_rmse_8 / bias (direct against Cycles' Diffuse Direct, the others against Diffuse Indirect).",
+             "", "| scene | " + " | ".join(methods) + " |", "| --- " * (1 + len(methods)) + "|"]
+    for scene in dict.fromkeys(r["scene"] for r in records):
+        cells = []
+        for method in methods:
+            r = by_key.get((scene, method))
+            cells.append("–" if r is None or r["rel_rmse_8"] is None else f"{r['rel_rmse_8']:.3f} / {r['bias']:.3f}")
+        lines.append(f"| {scene} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+# block name -> (its results.json, the function that formats it)
+BLOCKS: dict[str, tuple[Path, Callable[[dict], str]]] = {
+    "update-costs": (UPDATES_JSON, update_costs_block),
+    "accuracy": (DEFAULTS_JSON, accuracy_block),
+}
+
+
+def render_blocks() -> dict[str, str]:
+    return {name: fmt(load(path)) for name, (path, fmt) in BLOCKS.items()}
+
+
+def rewrite(text: str, blocks: dict[str, str]) -> str:
+    """`text` with the body of every block named in `blocks` replaced; a named block missing from the
+    text is an error (a README edit removed its markers)."""
+    missing = set(blocks) - {m["name"] for m in _BLOCK.finditer(text)}
+    if missing:
+        raise ValueError(f"README has no markers for block(s): {', '.join(sorted(missing))}")
+    return _BLOCK.sub(lambda m: m[1] + blocks.get(m["name"], m["body"]) + m[4], text)
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--check", action="store_true", help="exit 1 if README.md's blocks are not up to date")
+    args = p.parse_args(argv)
+    text = README.read_text()
+    new = rewrite(text, render_blocks())
+    if args.check:
+        if new != text:
+            print("README.md's figure blocks differ from benchmarks' results.json: run tools/readme_figures.py",
+                  file=sys.stderr)
+            return 1
+        return 0
+    README.write_text(new)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
