@@ -72,8 +72,12 @@ class TexelBaker:
     def shade(self) -> dict[str, np.ndarray]:
         """Run the light passes on the current G-buffer: images row 0 = top (V = 1), alpha = coverage;
         'direct', 'albedo' and, for indirect methods, 'indirect'."""
-        # The light field is solved once per scene: later objects only gather (method.compute decides).
+        # The light field is solved once per scene: later objects only gather (method.compute decides);
+        # GIConfig.samples gathers are averaged (refine).
         self.last_timings = self.method.compute(run_gbuffer=False)
+        for _ in range(self.method.gi.samples - 1):
+            for key, ms in self.method.refine().items():
+                self.last_timings[key] = self.last_timings.get(key, 0.0) + ms
         return self.method.read()
 
     def bake_triangles(self, uv, positions, normals, albedo, size: tuple[int, int]) -> dict[str, np.ndarray]:

@@ -56,6 +56,7 @@ class LiveState:
     # Written by the viewport overlay, read by the panel.
     last_update_ms: float = 0.0
     info: str = ""
+    samples: int = 0                # gathers the overlay has averaged since the last change
     note: str | None = None         # the overlay shows something other than what was asked, and why
     error: str | None = None
 
@@ -171,6 +172,16 @@ def tick() -> float | None:
         return None
 
 
+def redraw_soon() -> None:
+    """Another redraw of the 3D views shortly (a draw callback asks for its next refinement so)."""
+    if not bpy.app.timers.is_registered(_redraw_once):
+        bpy.app.timers.register(_redraw_once, first_interval=0.0)
+
+
+def _redraw_once() -> None:
+    tag_redraw()
+
+
 def tag_redraw() -> None:
     wm = bpy.context.window_manager
     for window in wm.windows if wm else ():
@@ -202,6 +213,7 @@ def unregister() -> None:
         handlers = getattr(bpy.app.handlers, name)
         while fn in handlers:
             handlers.remove(fn)
-    if bpy.app.timers.is_registered(tick):
-        bpy.app.timers.unregister(tick)
+    for timer in (tick, _redraw_once):
+        if bpy.app.timers.is_registered(timer):
+            bpy.app.timers.unregister(timer)
     reset()

@@ -115,12 +115,18 @@ def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
         progress(f"timed run {i + 1}/{repeat}")
         runs.append(method.run())
     result = runs[-1]
+    written = result.images
+    refine_ms = 0.0
+    if gi.samples > 1:  # the written images average gi.samples gathers (refine), timed apart
+        progress(f"averaging {gi.samples} gathers")
+        refine_ms = sum(method.refine().get("total", 0.0) for _ in range(gi.samples - 1))
+        written = method.read()
     update_ms = None
     if profile_updates:
         progress(f"timing the three kinds of update ({repeat} of each)")
         update_ms = update_costs(method, max(repeat, 1))
     progress(f"writing {out_dir}")
-    for name, pixels in result.images.items():
+    for name, pixels in written.items():
         images.write_exr(out_dir / f"{name}.exr", pixels)
     notes = list(captured.warnings)
     if captured.triangle_count == 0:
@@ -138,6 +144,8 @@ def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
         "timings_ms": {k: statistics.median(r.timings_ms[k] for r in runs) for k in result.timings_ms},
         "total_ms": statistics.median(r.timings_ms["total"] for r in runs),
         "runs": repeat,
+        "samples": gi.samples,
+        "refine_ms": refine_ms,  # the gathers after the first, all together
         **({"update_ms": update_ms} if update_ms is not None else {}),
         "renderer": be.renderer,
         "blender_version": bpy.app.version_string,

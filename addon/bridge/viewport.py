@@ -54,6 +54,7 @@ MODE_WEIGHTS = {"COMBINED": (1.0, 1.0), "INDIRECT": (0.0, 1.0), "DIRECT": (1.0, 
 PREVIEW_SCALE = 0.5        # preview quality: half the resolution ...
 PREVIEW_VPL_DIVISOR = 4    # ... and a quarter of the VPLs: ~8x less gather work while a light is dragged
 MAX_OVERLAYS = 8           # (region, quality) pairs kept; regions come and go with the UI layout
+MAX_SAMPLES = 64           # gathers averaged while nothing changes (progressive refinement, rsm and vct)
 
 _backend: BlenderGPUBackend | None = None
 _overlays: collections.OrderedDict = collections.OrderedDict()
@@ -251,12 +252,24 @@ def _draw(context, settings) -> None:
     with _restored_gpu_state():
         t0 = time.perf_counter()
         computed = overlay.update(state, camera, configs)
-        if computed:
+        # Nothing changed: one more gather averaged in while the view is still (progressive refinement),
+        # and another redraw asked for until MAX_SAMPLES.
+        refined = False
+        if not computed and quality == "full" and overlay.method.samples < MAX_SAMPLES:
+            before = overlay.method.samples
+            overlay.method.refine()  # nothing where the method has no noisy product or needs a solve
+            refined = overlay.method.samples > before
+        if computed or refined:
             backend().finish()  # one wait per update (not per pass), so the time shown is the GPU's too
-    if computed:
+    if computed or refined:
         gpu_runs += 1
         state.last_update_ms = (time.perf_counter() - t0) * 1e3  # uploads included
-        state.info = f"{gi.method}, {width} x {height} px ({quality}): {state.last_update_ms:.1f} ms"
+        samples = overlay.method.samples
+        state.samples = samples
+        state.info = (f"{gi.method}, {width} x {height} px ({quality}): {state.last_update_ms:.1f} ms"
+                      + (f", {samples} sample(s)" if overlay.method.NOISY else ""))
+    if overlay.method.NOISY and quality == "full" and overlay.method.samples < MAX_SAMPLES:
+        live.redraw_soon()
     view_mode, state.note = shown_view(overlay.method, settings.view_mode)
     with _restored_gpu_state(), framebuffer.bind():
         gpu.state.viewport_set(*region_viewport)

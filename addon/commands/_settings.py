@@ -28,6 +28,7 @@ _PRIMARY = {(RsmConfig, "resolution"): "--rsm-resolution"}
 # The short spellings of earlier releases: the README, tests and benchmarks use them.
 _ALIASES = {
     (GIConfig, "resolution"): ("--res",),
+    (GIConfig, "samples"): ("--accumulate",),
     (RsmConfig, "resolution"): ("--rsm-res",),
     (LpvConfig, "grid_cells"): ("--grid",),
     (LpvConfig, "cell_size_m"): ("--cell-size",),

@@ -154,6 +154,10 @@ class GIConfig(_Validated):
     # On: the products of the stochastic gathers (rsm's VPLs, vct's jittered cones) are filtered along
     # their surfaces, guided by the G-buffer (passes/denoise.py): vct's per-pixel noise on cornell
     # 0.60 -> 0.17 for 1-6 % of its update. Off: the raw gather, as the papers describe it.
+    # Progressive refinement: a render or bake averages this many gathers of the stochastic methods,
+    # each with other VPLs / cone rotations (DirectMethod.refine; noise / sqrt(samples)); the viewport
+    # keeps adding gathers while nothing changes.
+    samples: int = _num(1, 1, 1024, "gathers averaged per render or bake (rsm, vct: noise falls as 1 / sqrt)")
     denoise: bool = field(default=True, metadata={
         "doc": "filter the stochastic gathers' noise along each surface (never across edges)"})
     seed: int = _num(0, 0, 2**31 - 1, "seed of every stochastic choice")

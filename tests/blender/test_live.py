@@ -50,6 +50,7 @@ def test_moving_a_light_is_one_recomputation_without_mesh_reads(live_cornell, mo
     monkeypatch.setattr(gbuffer, "run", lambda *a, **k: gbuffer_runs.append(1))
     before = viewport.backend().read(viewport.overlay_for(1, "full").method.direct)
     reads, captures, runs = live.STATE.cache.geometry_reads, live.STATE.captures, viewport.gpu_runs
+    solves = viewport.overlay_for(1, "full").method.solves
     spot = bpy.data.objects["Spot"]
     for dx in (0.05, 0.1, 0.15):  # a drag: three updates, each through the depsgraph handler
         spot.location.x = dx
@@ -57,11 +58,13 @@ def test_moving_a_light_is_one_recomputation_without_mesh_reads(live_cornell, mo
         assert bpy.app.timers.is_registered(live.tick)  # one timer, however many updates
     assert live.tick() is None  # timers do not fire in background mode: run it as Blender would
     draw_offscreen(viewport, live_cornell, 64, 48)
-    draw_offscreen(viewport, live_cornell, 64, 48)  # nothing new: no second recomputation
+    draw_offscreen(viewport, live_cornell, 64, 48)  # nothing new: no second solve, one refinement gather
     assert live.STATE.captures == captures + 1
     assert live.STATE.changed == ("lights",)
     assert live.STATE.cache.geometry_reads == reads  # exactly 0 meshes re-read
-    assert viewport.gpu_runs == runs + 1
+    method = viewport.overlay_for(1, "full").method
+    assert method.solves == solves + 1 and method.samples == 2
+    assert viewport.gpu_runs == runs + 2
     assert gbuffer_runs == []  # camera and geometry unchanged: only the light passes ran
     after = viewport.backend().read(viewport.overlay_for(1, "full").method.direct)
     assert np.abs(after - before).max() > 0.01  # and the light did move

@@ -133,9 +133,10 @@ def test_overlay_adds_albedo_times_light_times_exposure(cornell, mode, w_direct,
     np.testing.assert_allclose(added[..., :3], expected, rtol=1e-5, atol=1e-5 * expected.max())
 
 
-def test_redraw_without_changes_does_not_recompute(cornell):
+def test_redraw_without_changes_does_not_recompute(cornell, monkeypatch):
     from bounce.addon.bridge import viewport
 
+    monkeypatch.setattr(viewport, "MAX_SAMPLES", 1)  # no progressive refinement: the next test's subject
     first = draw_offscreen(viewport, cornell)
     runs = viewport.gpu_runs
     cornell.scene.bounce.exposure = 1.0  # a display setting: redraw only
@@ -144,6 +145,23 @@ def test_redraw_without_changes_does_not_recompute(cornell):
     clear = np.array(CLEAR, np.float32)
     # Exposure 0 -> 1 doubles what is added (fp32 sums with the clear colour: a few ulp of ~2).
     np.testing.assert_allclose(second[..., :3] - clear[:3], 2.0 * (first[..., :3] - clear[:3]), rtol=1e-5, atol=1e-6)
+
+
+def test_still_view_refines_progressively(cornell):
+    # Nothing changes: each redraw averages one more gather (no solve, no G-buffer), the panel says how
+    # many, and successive images differ less and less (the mean of n gathers moves by ~1/n per sample).
+    from bounce.addon.bridge import live, viewport
+
+    images = [draw_offscreen(viewport, cornell)]
+    method = viewport.overlay_for(1, "full").method
+    solves = method.solves
+    for _ in range(7):
+        images.append(draw_offscreen(viewport, cornell))
+    assert method.samples == 8 and method.solves == solves
+    assert "8 sample(s)" in live.status()
+    steps = [float(np.abs(b - a).mean()) for a, b in zip(images, images[1:], strict=False)]
+    assert steps[-1] < 0.5 * steps[0], steps
+    assert bpy.app.timers.is_registered(live._redraw_once)  # the next refinement is asked for
 
 
 def test_navigating_gives_preview_then_full_quality(cornell):

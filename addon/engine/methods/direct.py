@@ -27,7 +27,7 @@ from ..area_light import emitter_table, split_area_light
 from ..backends.base import Backend
 from ..config import GIConfig, RsmConfig
 from ..errors import ConfigError
-from ..passes import declare, denoise, direct_light, gbuffer, rsm, zero
+from ..passes import accumulate, declare, denoise, direct_light, gbuffer, rsm, zero
 from ..passes.light_views import LightView, emissive_lights, views_for
 from ..scene import Camera, Scene
 
@@ -35,6 +35,7 @@ from ..scene import Camera, Scene
 # a camera move reads them instead of redrawing them; a scene with more faces shares one RSM and solves
 # at every update. 256 MB holds 75 faces at 256^2 texels (3 RGBA32F + depth: 52 bytes a texel).
 RSM_KEEP_BYTES = 256 * 2**20
+SEED_STRIDE = 1_000_003  # between the seeds of successive refinement gathers (a prime: no overlap pattern)
 RSM_BYTES_PER_TEXEL = 3 * 16 + 4
 
 
@@ -201,9 +202,14 @@ class DirectMethod:
         self._products = declare.allocate(self.backend, [ports[n] for n in self.products if n != "albedo"], size)
         for name, texture in self._products.items():
             setattr(self, name, texture)
-        # Per noisy product: the filter's output and scratch (the output then becomes the product).
-        self._filtered = {n: (self.backend.texture(size), self.backend.texture(size))
-                          for n in self.NOISY if self.gi.denoise}
+        # Per noisy product (NOISY), three roles over its textures: `raw`, the gather's target; `mean`, the
+        # average of this camera's gathers so far (the first gather's raw texture becomes it: no copy);
+        # `shown` (+ scratch), the mean filtered when GIConfig.denoise. The attribute is what is shown.
+        be = self.backend
+        self._noisy = {n: {"raw": be.texture(size), "mean": self._products[n],
+                           **({"shown": be.texture(size), "scratch": be.texture(size)} if self.gi.denoise else {})}
+                       for n in self.NOISY}
+        self.samples = 0  # gathers averaged into the noisy products since the last update
 
     def camera(self) -> Camera:
         """The current camera in the uploaded geometry's (re-centred) frame."""
@@ -273,6 +279,7 @@ class DirectMethod:
             else:  # one RSM for every face: each is drawn, solved and gathered in turn
                 with self.timed(timings, "solve"):
                     self.begin_solve(timings)
+                    self._bind_gather_targets()
                     self.clear_products()
                     for view in views:
                         self._draw_rsm(view, 0, timings)
@@ -281,7 +288,7 @@ class DirectMethod:
                     self.finish_solve(timings)
                 with self.timed(timings, "gather"):
                     self.gather_pixels(timings)
-                    self.filter_products(timings)
+                    self._average_and_show(timings, first=True)
             self._solved_for = key if keep else None
             self.solves += 1 if solve or not keep else 0
         return timings
@@ -309,27 +316,59 @@ class DirectMethod:
             self.solve_view(view, timings)
         self.finish_solve(timings)
 
-    def _gather(self, views: list[LightView], timings: dict[str, float], slots) -> None:
+    def _gather(self, views: list[LightView], timings: dict[str, float], slots, first: bool = True) -> None:
+        self._bind_gather_targets()
         self.clear_products()
         for view, slot in zip(views, slots, strict=True):
             self.rsm, self.rsm_target = self._rsm_slot(slot)
             self._gather_view(view, timings)
         self.gather_pixels(timings)
-        self.filter_products(timings)
+        self._average_and_show(timings, first)
 
-    def filter_products(self, timings: dict[str, float]) -> None:
-        """The noisy products filtered along their surfaces (GIConfig.denoise): each filtered into its
-        spare texture, which then becomes the product (and the old one the spare)."""
-        if not self._filtered:
-            return
+    def _bind_gather_targets(self) -> None:
+        """The noisy products' attributes point at their raw textures while a gather writes them."""
+        for name, roles in self._noisy.items():
+            setattr(self, name, roles["raw"])
+
+    def _average_and_show(self, timings: dict[str, float], first: bool) -> None:
+        """After a gather: the first one's raw texture becomes the mean (roles swap), a later one is
+        averaged in (accumulate); the mean is filtered into `shown` (GIConfig.denoise) and shown."""
+        self.samples = 1 if first else self.samples + 1
         iterations = denoise.iterations_for(max(self.gbuf["position"].size))
-        with self.step(timings, denoise.DECL):
-            for name, (out, scratch) in self._filtered.items():
-                noisy = self._products[name]
-                denoise.run(self.backend, self.gbuf, noisy, out, scratch, denoise.Params(iterations=iterations))
-                self._products[name] = out
-                self._filtered[name] = (noisy, scratch)
-                setattr(self, name, out)
+        for name, roles in self._noisy.items():
+            if first:
+                roles["raw"], roles["mean"] = roles["mean"], roles["raw"]
+            else:
+                with self.step(timings, accumulate.DECL):
+                    accumulate.run(self.backend, roles["raw"], roles["mean"], 1.0 / self.samples)
+            shown = roles["mean"]
+            if self.gi.denoise:
+                with self.step(timings, denoise.DECL):
+                    denoise.run(self.backend, self.gbuf, roles["mean"], roles["shown"], roles["scratch"],
+                                denoise.Params(iterations=iterations))
+                shown = roles["shown"]
+            self._products[name] = shown
+            setattr(self, name, shown)
+
+    def refine(self) -> dict[str, float]:
+        """One more gather of the noisy products, with the next seed, averaged into them: progressive
+        refinement while nothing changes (the light field, the G-buffer and the camera are kept). Returns
+        timings (empty when not profiling); `samples` grows only when a gather ran: not for a method
+        without noisy products, nor when the last update could not keep its light field (a gather then
+        needs a solve first)."""
+        if not self._noisy or self._solved_for is None or self._solved_for != self.light_key():
+            return {}
+        views = self.light_views()
+        base = self.gi
+        # Far apart, so no sample's seeds (seed + 6 x light + face in the rsm gather) meet another's.
+        self.gi = replace(base, seed=(base.seed + SEED_STRIDE * self.samples) % 2**31)
+        timings: dict[str, float] = {}
+        try:
+            with self.timed(timings, "total"), self.timed(timings, "gather"):
+                self._gather(views, timings, range(len(views)), first=False)
+        finally:
+            self.gi = base
+        return timings
 
     def _gather_view(self, view: LightView, timings: dict[str, float]) -> None:
         with self.step(timings, direct_light.DECL):

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from .. import registry
 from ..grid import Grid
-from ..passes import declare, denoise, rsm_gather, voxel_view, voxelize
+from ..passes import accumulate, declare, denoise, rsm_gather, voxel_view, voxelize
 from ..passes.light_views import LightView
 from ..passes.voxelize import Voxelizer
 from .direct import OneBounceMethod
@@ -21,7 +21,8 @@ from .direct import OneBounceMethod
 
 class RsmMethod(OneBounceMethod):
     spec = registry.get("rsm")
-    PASSES = declare.extend(OneBounceMethod.PASSES, setup=(voxelize.DECL,), gather=(rsm_gather.DECL, denoise.DECL))
+    PASSES = declare.extend(OneBounceMethod.PASSES, setup=(voxelize.DECL,),
+                            gather=(rsm_gather.DECL, accumulate.DECL, denoise.DECL))
     NOISY = ("indirect",)
 
     def set_scene(self, scene) -> None:

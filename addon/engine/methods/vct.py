@@ -19,7 +19,7 @@ from __future__ import annotations
 from .. import registry
 from ..config import VctConfig
 from ..grid import Grid
-from ..passes import atlas, declare, denoise, vct_gather, vct_inject, vct_pyramid, voxelize, zero
+from ..passes import accumulate, atlas, declare, denoise, vct_gather, vct_inject, vct_pyramid, voxelize, zero
 from ..passes.atlas import Atlas
 from ..passes.light_views import LightView
 from ..passes.vct_inject import DIRECTIONS
@@ -31,7 +31,7 @@ class VctMethod(OneBounceMethod):
     spec = registry.get("vct")
     PASSES = declare.extend(OneBounceMethod.PASSES, setup=(voxelize.DECL,),
                             solve=(vct_inject.DECL, vct_pyramid.DECL, vct_gather.BOUNCE_DECL, vct_pyramid.DECL),
-                            gather=(vct_gather.PIXELS_DECL, vct_gather.GLOSSY_DECL, denoise.DECL))
+                            gather=(vct_gather.PIXELS_DECL, vct_gather.GLOSSY_DECL, accumulate.DECL, denoise.DECL))
     NOISY = ("indirect", "ao", "glossy")
 
     def __init__(self, backend, gi, rsm_config, vct_config: VctConfig | None = None):
