@@ -179,6 +179,8 @@ def format_scene(sc: dict) -> str:
     out += [f"- note: {n}" for n in sc.get("notes", [])]
     if sc.get("notes"):
         out.append("")
+    out.append("`noise`: the method's own, rel_rmse of its product at seed 1 against seed 0 (0: no stochastic "
+               "gather); the reference's, the same between two Cycles seeds: ")
     out.append("Noise floor of the reference (seed 1 against seed 0, same spp): " + "; ".join(
         f"{p}: rel_rmse {_num(m['rel_rmse'])}, rel_rmse_8 {_num(m['rel_rmse_8'])}, bias {_num(m['bias'], '{:.4f}')}"
         for p, m in sc["noise_floor"].items()) + ".\n")
@@ -189,15 +191,16 @@ def format_scene(sc: dict) -> str:
     if sc["runs"]:
         out.append("| method | setting | product | " + " | ".join(f"{p} ms" for p in passes)
                    + " | total ms" + (UPDATE_HEADER if updates else "")
-                   + " | rel_rmse | rel_rmse_8 | bias | Cycles time to same rel_rmse_8 | speed-up |")
-        out.append("| --- " * (9 + len(passes) + 4 * updates) + "|")
+                   + " | rel_rmse | rel_rmse_8 | bias | noise | Cycles time to same rel_rmse_8 | speed-up |")
+        out.append("| --- " * (10 + len(passes) + 4 * updates) + "|")
         for r in sc["runs"]:
             m = r["metrics"]
             t, x = format_speedup(r["speedup"])
             cells = [r["method"], r["setting"], r["product"],
                      *(_num(r["timings_ms"].get(p), "{:.2f}") for p in passes), f"{r['total_ms']:.2f}",
                      *(format_update_cells(r.get("update_ms")) if updates else []),
-                     _num(m["rel_rmse"]), _num(m["rel_rmse_8"]), _num(m["bias"], "{:.4f}"), t, x]
+                     _num(m["rel_rmse"]), _num(m["rel_rmse_8"]), _num(m["bias"], "{:.4f}"),
+                     _num(r.get("noise")), t, x]
             out.append("| " + " | ".join(cells) + " |")
         out.append("")
     for product, curve in sc["curve"].items():
@@ -423,9 +426,10 @@ def _run_row(opt: Options, blend: Path, scene: str, method: str, setting: dict, 
     label = setting_label(setting)
     run_dir = opt.cache / "runs" / scene / f"{method}-{label.replace(' ', '').replace(',', '_')}"
     run_dir.mkdir(parents=True, exist_ok=True)
-    st = render_file(blend, run_dir, make_configs(method, setting, opt.res, opt.bounces), repeat=repeat,
-                     profile_updates=opt.update_costs)
+    settings = make_configs(method, setting, opt.res, opt.bounces)
+    st = render_file(blend, run_dir, settings, repeat=repeat, profile_updates=opt.update_costs)
     m = _compare(run_dir / f"{product}.exr", ref_dir / f"{product}.exr")
+    noise = _seed_noise(blend, run_dir, settings, product)
     if m["rel_rmse_8"] is None:
         speed = {"cycles_time_s": float("nan"), "speedup": float("nan"), "bound": "=", "extrapolated_speedup": None}
         notes.append(f"{method} {label}: {m['note']}")
@@ -441,7 +445,24 @@ def _run_row(opt: Options, blend: Path, scene: str, method: str, setting: dict, 
             "default": is_default_row(method, setting, opt.res, opt.bounces), "product": product,
             "config": st["config"], "image_size": st["image_size"], "triangles": st["triangles"],
             "timings_ms": st["timings_ms"], "total_ms": st["total_ms"], "runs": st["runs"],
-            "update_ms": st.get("update_ms"), "metrics": m, "speedup": speed, "renderer": st["renderer"]}
+            "update_ms": st.get("update_ms"), "metrics": m, "noise": noise, "speedup": speed,
+            "renderer": st["renderer"]}
+
+
+def _seed_noise(blend: Path, run_dir: Path, settings: dict, product: str) -> float:
+    """The method's own noise, measured as Cycles' noise floor is: rel_rmse of the product rendered with
+    seed + 1 against the seed's (masked by coverage); 0 for a method without a stochastic gather."""
+    from dataclasses import replace
+
+    from ..engine import methods as method_registry
+    from .pipeline import render_file
+
+    if not method_registry.get(settings["gi"].method).NOISY:
+        return 0.0
+    other = run_dir / "seed+1"
+    other.mkdir(exist_ok=True)
+    render_file(blend, other, {**settings, "gi": replace(settings["gi"], seed=settings["gi"].seed + 1)}, repeat=1)
+    return _compare(other / f"{product}.exr", run_dir / f"{product}.exr")["rel_rmse"]
 
 
 def _finite(x):
@@ -464,6 +485,7 @@ def results_json(result: dict) -> dict:
                 "image_size": r["image_size"], "triangles": r["triangles"], "timings_ms": r["timings_ms"],
                 "total_ms": r["total_ms"], "runs": r["runs"], "update_ms": r["update_ms"],
                 "rel_rmse": m["rel_rmse"], "rel_rmse_8": m["rel_rmse_8"], "bias": m["bias"],
+                "noise": r.get("noise"),
                 "speedup": {k: _finite(v) for k, v in r["speedup"].items()},
             })
     scenes = [{k: sc[k] for k in ("name", "source", "size", "ref_spp", "ref_time_s", "noise_floor", "curve", "notes")}

@@ -84,7 +84,8 @@ def _fake_result():
                       "config": {"gi": {"method": "direct", "resolution": 48}, "rsm": {"resolution": 256}},
                       "update_ms": None,
                       "timings_ms": {"gbuffer": 0.4, "rsm": 2.7, "total": 3.1}, "total_ms": 3.1, "runs": 2,
-                      "metrics": metric, "speedup": {"cycles_time_s": 0.006, "speedup": 1.9, "bound": "<"}}],
+                      "metrics": metric, "noise": 0.0,
+                      "speedup": {"cycles_time_s": 0.006, "speedup": 1.9, "bound": "<"}}],
         }],
     }
 
@@ -95,7 +96,7 @@ def test_report_formatting_and_merge_keep_hand_written_text():
     assert "`python -m addon bench --scenes cornell --res 48 --out X`" in block
     assert "Some CPU (2 cores)" in block and "llvmpipe" in block and "sponza (not found)" in block
     assert "| gbuffer ms | rsm ms | total ms |" in block  # passes in run order, total last
-    row = "| direct | resolution 256 | direct | 0.40 | 2.70 | 3.10 | 0.3 | 0.06 | 0.9970 | <= 6.0 ms | <= 1.9x |"
+    row = "| direct | resolution 256 | direct | 0.40 | 2.70 | 3.10 | 0.3 | 0.06 | 0.9970 | 0 | <= 6.0 ms | <= 1.9x |"
     assert row in block
     assert "| 1 | 6.0 ms | 0.16 | 0.05 | 0.9900 |" in block
     assert "](cornell.png)" in block
@@ -132,7 +133,7 @@ def test_update_cells_and_columns():
     assert "| total ms | update full ms | update lights ms | update camera ms | camera/full | rel_rmse |" in block
     assert "| 3.10 | 3.00 | 2.00 | 1.50 | 50 % | 0.3 | 0.06 |" in block
     assert "Update costs (`update ... ms`): medians of 2 updates" in block
-    assert "\n" + "| --- " * 15 + "|\n" in block  # 9 fixed + 2 passes + 4 update columns
+    assert "\n" + "| --- " * 16 + "|\n" in block  # 10 fixed + 2 passes + 4 update columns
 
 
 def test_results_json_has_one_record_per_run():
@@ -157,7 +158,7 @@ def test_results_json_has_one_record_per_run():
         "default": True, "product": "direct", "config": run["config"], "image_size": [48, 48], "triangles": 34,
         "timings_ms": {"gbuffer": 0.4, "rsm": 2.7, "total": 3.1}, "total_ms": 3.1, "runs": 2,
         "update_ms": {"full": 3.0, "lights": 2.0, "camera": 1.5},
-        "rel_rmse": 0.3, "rel_rmse_8": 0.06, "bias": 0.997,
+        "rel_rmse": 0.3, "rel_rmse_8": 0.06, "bias": 0.997, "noise": 0.0,
         "speedup": {"cycles_time_s": 0.006, "speedup": 1.9, "bound": "<"},
     }
     assert second["setting"] == {"rsm.resolution": 512} and second["update_ms"] is None
