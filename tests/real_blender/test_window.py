@@ -45,18 +45,32 @@ def test_overlay_draws_in_a_real_window(shots, method):
     assert entry["error"] is None, entry  # 4.3 stopped lpv and vct here with a GPUTexture TypeError
     assert entry["gpu_runs"] >= 1 and method in entry["status"], entry
     off, on = crop(result["off"]), crop(entry["shot"])
+    if os.environ.get("BOUNCE_SCREENSHOTS"):  # kept before the checks, so a failure can be looked at
+        import matplotlib.pyplot as plt
+
+        out = Path(os.environ["BOUNCE_SCREENSHOTS"])
+        plt.imsave(out / f"real_{method}.png", np.clip(on, 0, 1))
+        plt.imsave(out / "real_off.png", np.clip(off, 0, 1))
     added = on - off
     # The overlay only adds light ((ONE, ONE) blending): no pixel darkens beyond 8-bit rounding, and
     # a large part of the box brightens visibly (more than 4/255 on screen).
     assert added.min() > -2.5 / 255, added.min()
     brighter = (added.max(axis=2) > 4 / 255).mean()
     assert brighter > 0.05, brighter
-    if os.environ.get("BOUNCE_SCREENSHOTS"):
-        import matplotlib.pyplot as plt
 
-        out = Path(os.environ["BOUNCE_SCREENSHOTS"])
-        plt.imsave(out / f"real_{method}.png", np.clip(on, 0, 1))
-        plt.imsave(out / "real_off.png", np.clip(off, 0, 1))
+
+@pytest.mark.parametrize("method", METHODS)
+def test_still_overlay_refines_on_its_own(shots, method):
+    # Progressive refinement in a real window: nothing changes, yet the stochastic methods (rsm, vct)
+    # keep averaging gathers (each redraw asks for the next) and the panel's status says how many.
+    from addon.engine import methods
+
+    entry = shots[0]["methods"][method]
+    if methods.get(method).NOISY:
+        assert entry["samples_later"] > entry["on"]["samples"] >= 1, entry
+        assert f"{entry['samples_later']} sample(s)" in entry["status_later"], entry["status_later"]
+    else:  # deterministic: one gather is all there is
+        assert entry["samples_later"] == entry["on"]["samples"] == 1, entry
 
 
 @pytest.mark.parametrize("method", METHODS)

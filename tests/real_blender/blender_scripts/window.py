@@ -55,6 +55,9 @@ def steps():
     space.region_3d.view_perspective = "CAMERA"
     space.shading.type = "SOLID"
     space.overlay.show_overlays = False  # gizmos and grid off: only the scene and Bounce's light
+    # Blender's viewport anti-aliasing converges over redraws; the overlay's progressive refinement keeps
+    # asking for redraws, so shots with and without it would differ at every edge: compare without AA.
+    bpy.context.preferences.system.viewport_aa = "OFF"
     window = bpy.context.window_manager.windows[0]
     result["window"] = [window.width, window.height]
     result["area"] = [area.x, area.y, area.width, area.height]
@@ -82,7 +85,12 @@ def steps():
             redraw()
             yield 1.0  # the updated frame reaches the screen
             entry[phase] = {"shot": shot(f"{method}_{phase}"), "status": live.status(), "error": live.STATE.error,
-                            "gpu_runs": viewport.gpu_runs - runs, "wait_s": round(time.perf_counter() - t0, 2)}
+                            "gpu_runs": viewport.gpu_runs - runs, "wait_s": round(time.perf_counter() - t0, 2),
+                            "samples": live.STATE.samples}
+            if phase == "on":  # still: the overlay keeps refining on its own (its redraws ask for more)
+                yield 3.0
+                entry["samples_later"] = live.STATE.samples
+                entry["status_later"] = live.status()
         spot.location.x -= 0.25
         settings.enabled = False
         redraw()
