@@ -420,6 +420,7 @@ class SceneCache:
                 self._dirty.add(u.id.original.name)
             elif isinstance(u.id, bpy.types.Image):
                 self.images.pop(u.id.original.name, None)
+                world_capture.forget()  # the world's map may read it
 
     def _capture_world(self, world, out: Scene) -> None:
         """The world's light into out.world_color (constant) or out.world_map (a map, with its mean as

@@ -1,12 +1,15 @@
 """The world's radiance as an equirectangular map (engine/world.py's layout), for worlds that are not a
 constant colour: an environment texture (HDRI), a Sky Texture, any node tree.
 
-Bounce does not evaluate node trees itself: Cycles renders the world alone, from a panoramic
-equirectangular camera at the origin, MAP_ROWS x MAP_COLS pixels, one sample per pixel (camera rays see
-only the background: no noise but the filter, which is narrowed). That costs about 1.5 s on this
-project's 2-core CPU machine (most of it Cycles' scene sync), so the map is cached by a fingerprint of
-the world's node tree and rendered again only when that changes. A constant background (no link into
-its Color) needs no render: capture.world_color gives it.
+The common case, an HDRI (an Environment Texture of a float image in a linear colour space, its
+vector unlinked, straight into the Background's Color), is read directly: every image pixel is binned
+into the map by its direction, weighted by its solid angle, so a small bright sun keeps its energy
+(tens of milliseconds). Any other node tree (a Sky Texture, mixes, mappings) Bounce does not evaluate
+itself: Cycles renders the world alone, from a panoramic equirectangular camera at the origin, MAP_ROWS
+x MAP_COLS pixels, one sample per pixel (camera rays see only the background: no noise but the filter,
+which is narrowed). That costs about 1.5 s on this project's 2-core CPU machine (most of it Cycles'
+scene sync), so the map is cached by a fingerprint of the world's node tree and made again only when
+that changes. A constant background (no link into its Color) needs no map: capture.world_color gives it.
 
 Cycles' equirectangular camera, rotated to look along +x with +z up, puts longitude increasing to the
 left: its columns are read reversed to match world.py's layout (tests/blender/test_world_capture.py
@@ -28,20 +31,65 @@ MAP_ROWS, MAP_COLS = 32, 64
 _cache: dict[str, np.ndarray] = {}
 
 
+def _background(world):
+    out = next((n for n in world.node_tree.nodes if n.type == "OUTPUT_WORLD" and n.is_active_output), None)
+    link = out.inputs["Surface"].links[0] if out is not None and out.inputs["Surface"].is_linked else None
+    return link.from_node if link is not None else None
+
+
+def _direct_hdri(world):
+    """(image, strength) when the world is an HDRI this module reads itself (module docstring), else None."""
+    bg = _background(world)
+    if bg is None or bg.type != "BACKGROUND" or not bg.inputs["Color"].is_linked or bg.inputs["Strength"].is_linked:
+        return None
+    tex = bg.inputs["Color"].links[0].from_node
+    image = getattr(tex, "image", None)
+    if (tex.type != "TEX_ENVIRONMENT" or tex.projection != "EQUIRECTANGULAR" or tex.inputs["Vector"].is_linked
+            or image is None or not image.is_float or image.colorspace_settings.name not in LINEAR_SPACES):
+        return None
+    return image, float(bg.inputs["Strength"].default_value)
+
+
+LINEAR_SPACES = {"Linear Rec.709", "Linear", "Non-Color", "Linear CIE-XYZ E", "Linear Rec.2020"}
+
+
+def _binned(image, strength: float) -> np.ndarray:
+    """The HDRI's pixels binned into the map by direction (Cycles' equirectangular mapping: u = 0.5 -
+    atan2(y, x) / 2 pi, v = 0.5 + atan2(z, hypot(x, y)) / pi, row 0 = bottom), each weighted by its
+    solid angle: the map texel's radiance is the mean over the image pixels it holds."""
+    w, h = image.size
+    px = np.empty(w * h * 4, np.float32)
+    image.pixels.foreach_get(px)
+    rgb = px.reshape(h, w, 4)[..., :3].astype(np.float64) * strength
+    v = (np.arange(h) + 0.5) / h                              # row 0 = bottom
+    lat = (v - 0.5) * np.pi
+    u = (np.arange(w) + 0.5) / w
+    lon = (0.5 - u) * 2 * np.pi                                 # atan2(y, x) of each column
+    weight = np.repeat(np.cos(lat)[:, None], w, axis=1)         # solid angle per pixel, up to a constant
+    # world.py's layout: row 0 = up, column c at longitude 2 pi (c + 0.5) / MAP_COLS - pi
+    rows = np.clip(((np.pi / 2 - lat) / np.pi * MAP_ROWS).astype(int), 0, MAP_ROWS - 1)
+    cols = np.clip(((lon + np.pi) / (2 * np.pi) * MAP_COLS).astype(int) % MAP_COLS, 0, MAP_COLS - 1)
+    index = (rows[:, None] * MAP_COLS + cols[None, :]).ravel()
+    total = np.zeros((MAP_ROWS * MAP_COLS, 3))
+    for c in range(3):
+        total[:, c] = np.bincount(index, weights=(rgb[..., c] * weight).ravel(), minlength=MAP_ROWS * MAP_COLS)
+    norm = np.bincount(index, weights=weight.ravel(), minlength=MAP_ROWS * MAP_COLS)
+    out = total / np.maximum(norm, 1e-300)[:, None]
+    return np.maximum(out, 0.0).reshape(MAP_ROWS, MAP_COLS, 3).astype(np.float32)
+
+
 def needs_map(world) -> bool:
     """Whether the world's light varies with direction (its Background's Color is linked)."""
     if world is None or not compat.uses_nodes(world):
         return False
-    out = next((n for n in world.node_tree.nodes if n.type == "OUTPUT_WORLD" and n.is_active_output), None)
-    link = out.inputs["Surface"].links[0] if out is not None and out.inputs["Surface"].is_linked else None
-    node = link.from_node if link is not None else None
+    node = _background(world)
     return node is not None and (node.type != "BACKGROUND" or node.inputs["Color"].is_linked)
 
 
 def fingerprint(world) -> str:
     """Changes whenever anything in the world's node tree that can change its light changes: node
     types, input values, properties (a Sky Texture's sun is a node property), links, image names."""
-    parts = [world.name]
+    parts = [bpy.data.filepath, world.name]
     tree = world.node_tree
     for node in sorted(tree.nodes, key=lambda n: n.name):
         parts.append(f"{node.name}:{node.bl_idname}")
@@ -53,6 +101,8 @@ def fingerprint(world) -> str:
                 parts.append(f"{prop.identifier}={value}")
             elif hasattr(value, "__len__") and not isinstance(value, bpy.types.bpy_struct) and len(value) <= 16:
                 parts.append(f"{prop.identifier}={tuple(value)}")
+            elif isinstance(value, bpy.types.Image):  # a replaced or reloaded HDRI, not only a renamed one
+                parts.append(f"{prop.identifier}=IM:{value.name}:{value.filepath}:{tuple(value.size)}")
             elif isinstance(value, bpy.types.ID):
                 parts.append(f"{prop.identifier}=ID:{value.name}")
         for sock in node.inputs:
@@ -64,12 +114,19 @@ def fingerprint(world) -> str:
     return "|".join(parts)
 
 
+def forget() -> None:
+    """Drop the cached map: an image was edited in place (capture.SceneCache.note calls this on an
+    Image update, which the fingerprint cannot see)."""
+    _cache.clear()
+
+
 def world_map(world) -> np.ndarray:
     """The world's radiance map (MAP_ROWS, MAP_COLS, 3) float32 W/m^2/sr, cached by fingerprint."""
     key = fingerprint(world)
     if key not in _cache:
         _cache.clear()  # one world at a time: a new fingerprint replaces the old map
-        _cache[key] = _render(world)
+        hdri = _direct_hdri(world)
+        _cache[key] = _binned(*hdri) if hdri is not None else _render(world)
     return _cache[key]
 
 
