@@ -105,7 +105,7 @@ def test_lpv_second_bounce_on_cornell(tmp_path):
     - bounces=1 against the same reference: rel_rmse 0.481, rel_rmse_8 0.405, bias 0.664.
     - the second bounce raises our mean by 1.29x; Cycles' by 1.40x (2-bounce / 1-bounce reference).
     (On one grid, far_field=False: 0.378 / 1.153 and 0.331 / 0.859, the L1 transfer's on-axis excess
-    lifting both; session 4, plain trilinear re-injection, no offsets: 0.318 / 1.022 and 0.348 / 0.811.)
+    lifting both.)
     The reference's own noise (seed 0 vs seed 1): rel_rmse_8 0.024, bias 0.995. The bounds sit a little
     outside the 2-bounce figures and exclude the 1-bounce ones, so a missing or halved second bounce
     fails (bias, ratio), as does one that adds error (rel_rmse_8).

@@ -23,10 +23,8 @@ if HERE not in sys.path:
     sys.path.insert(0, HERE)
 
 # Known defects of `lpv` at its defaults (improved transport, geometry volume with surface offsets, 32
-# cells, far field), measured on llvmpipe, 48 px (session 5: the thin wall between rooms no longer leaks,
-# 0.040 -> 0.0049 of the lit room); "one grid": session 5's figure without the far field (session 6); the
-# classic variant's figures (before the default changed) in brackets. Static and strict, so a fix shows
-# up as XPASS.
+# cells, far field), measured on llvmpipe, 48 px; "one grid": the figure without the far field; the
+# classic variant's figures in brackets. Static and strict, so a fix shows up as XPASS.
 LPV = "lpv (improved, geometry volume): "
 KNOWN_DEFECTS = {
     "test_one_triangle[lpv]": "indirect 0.12 where the exact answer is 0: the emitter's own VPLs light it "
@@ -39,8 +37,7 @@ KNOWN_DEFECTS = {
     "test_camera_inside_closed_block[lpv]": "indirect 0.059 inside a closed block: leaks through one-cell walls "
                                             "(one grid 0.058; classic 0.89; 0.12 before exact voxel areas)",
     "test_light_inside_closed_box_stays_inside[lpv]": "indirect 0.10 x P/(6 pi) outside a closed box: leaks "
-                                                      "through walls (one grid 0.096; 0.14 before session 5; "
-                                                      "classic 0.92)",
+                                                      "through walls (one grid 0.096; classic 0.92)",
     "test_two_hundred_lights[lpv]": "indirect 0.018 on geometry that cannot receive a bounce: self-illumination "
                                     "(one grid 0.021; classic 0.15)",
     "test_million_triangle_floor[lpv]": "indirect up to 0.023 on a lone floor that cannot light itself "
