@@ -83,7 +83,7 @@ def _fake_result():
                       "default": True, "product": "direct", "image_size": [48, 48], "triangles": 34,
                       "config": {"gi": {"method": "direct", "resolution": 48}, "rsm": {"resolution": 256}},
                       "update_ms": None,
-                      "timings_ms": {"gbuffer": 0.4, "rsm": 2.7, "total": 3.1}, "total_ms": 3.1, "runs": 2,
+                      "timings_ms": {"gbuffer": 0.4, "rsm": 2.7, "solve": 2.7, "total": 3.1}, "total_ms": 3.1, "runs": 2,
                       "metrics": metric, "noise": 0.0,
                       "speedup": {"cycles_time_s": 0.006, "speedup": 1.9, "bound": "<"}}],
         }],
@@ -95,7 +95,8 @@ def test_report_formatting_and_merge_keep_hand_written_text():
     assert block.startswith(bench.MARK_BEGIN) and block.rstrip().endswith(bench.MARK_END)
     assert "`python -m addon bench --scenes cornell --res 48 --out X`" in block
     assert "Some CPU (2 cores)" in block and "llvmpipe" in block and "sponza (not found)" in block
-    assert "| gbuffer ms | rsm ms | total ms |" in block  # passes in run order, total last
+    # passes in run order, total last; "solve" sums passes already shown, so it is no column
+    assert "| gbuffer ms | rsm ms | total ms |" in block
     row = "| direct | resolution 256 | direct | 0.40 | 2.70 | 3.10 | 0.3 | 0.06 | 0.9970 | 0 | <= 6.0 ms | <= 1.9x |"
     assert row in block
     assert "| 1 | 6.0 ms | 0.16 | 0.05 | 0.9900 |" in block
@@ -156,7 +157,7 @@ def test_results_json_has_one_record_per_run():
     assert first == {
         "scene": "cornell", "method": "direct", "setting": {"rsm.resolution": 256}, "label": "resolution 256",
         "default": True, "product": "direct", "config": run["config"], "image_size": [48, 48], "triangles": 34,
-        "timings_ms": {"gbuffer": 0.4, "rsm": 2.7, "total": 3.1}, "total_ms": 3.1, "runs": 2,
+        "timings_ms": {"gbuffer": 0.4, "rsm": 2.7, "solve": 2.7, "total": 3.1}, "total_ms": 3.1, "runs": 2,
         "update_ms": {"full": 3.0, "lights": 2.0, "camera": 1.5},
         "rel_rmse": 0.3, "rel_rmse_8": 0.06, "bias": 0.997, "noise": 0.0,
         "speedup": {"cycles_time_s": 0.006, "speedup": 1.9, "bound": "<"},
