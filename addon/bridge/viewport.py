@@ -268,7 +268,9 @@ def _draw(context, settings) -> None:
         state.samples = samples
         state.info = (f"{gi.method}, {width} x {height} px ({quality}): {state.last_update_ms:.1f} ms"
                       + (f", {samples} sample(s)" if overlay.method.NOISY else ""))
-    if overlay.method.NOISY and quality == "full" and overlay.method.samples < MAX_SAMPLES:
+    # Ask for the next refinement only after progress: a method that cannot refine (its light field not
+    # kept) would otherwise redraw forever.
+    if (computed or refined) and overlay.method.NOISY and quality == "full" and overlay.method.samples < MAX_SAMPLES:
         live.redraw_soon()
     view_mode, state.note = shown_view(overlay.method, settings.view_mode)
     with _restored_gpu_state(), framebuffer.bind():

@@ -164,6 +164,20 @@ def test_still_view_refines_progressively(cornell):
     assert bpy.app.timers.is_registered(live._redraw_once)  # the next refinement is asked for
 
 
+def test_a_method_that_cannot_refine_stops_asking_for_redraws(cornell, monkeypatch):
+    # Refinement needs the kept light field; where it cannot run, the still view must go quiet instead of
+    # redrawing forever.
+    from bounce.addon.bridge import live, viewport
+    from bounce.addon.engine.methods.direct import DirectMethod
+
+    draw_offscreen(viewport, cornell)
+    monkeypatch.setattr(DirectMethod, "refine", lambda self: {})
+    if bpy.app.timers.is_registered(live._redraw_once):
+        bpy.app.timers.unregister(live._redraw_once)
+    draw_offscreen(viewport, cornell)
+    assert not bpy.app.timers.is_registered(live._redraw_once)
+
+
 def test_navigating_gives_preview_then_full_quality(cornell):
     from bounce.addon.bridge import live, viewport
 
