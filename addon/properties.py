@@ -75,9 +75,9 @@ QUALITY_PRESETS = {
     "HIGH": (256, 256, "voxel"),
 }
 QUALITY_LABELS = {
-    "DRAFT": ("Draft", "64 VPLs, no visibility: Cornell rel_rmse_8 0.19, 41 ms on a CPU rasteriser"),
-    "BALANCED": ("Balanced", "256 VPLs, no visibility (the defaults): rel_rmse_8 0.19, less noise, 54 ms"),
-    "HIGH": ("High", "256 VPLs, voxel visibility: rel_rmse_8 0.073, 0.9 s on a CPU rasteriser"),
+    "DRAFT": ("Draft", "64 VPLs, no visibility: Cornell rel_rmse_8 0.19, noisier, about a third of Balanced's time"),
+    "BALANCED": ("Balanced", "256 VPLs, no visibility (the defaults): Cornell rel_rmse_8 0.19"),
+    "HIGH": ("High", "256 VPLs, voxel visibility: Cornell rel_rmse_8 0.073, about 9x Balanced's time"),
 }
 
 
