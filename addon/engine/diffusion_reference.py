@@ -1,0 +1,199 @@
+"""numpy twin of the `diffusion` transport (Mavridis et al., seeds 000): cells, emitters, one gather step,
+re-emission, reconstruction.
+
+The one numpy reference of the method: tests/unit/test_diffusion_reference.py checks it against closed
+forms, tests/gpu/test_diffusion.py checks the GPU passes against it. It mirrors
+- passes/diffusion_cells.py (gpu_shaders/diffusion/cells.comp.glsl): `cells`;
+- passes/diffusion_propagate.py (diffusion/emit.comp.glsl, diffusion/propagate.comp.glsl): `emit`,
+  `face_fluxes`, `step`;
+- passes/diffusion_lookup.py (diffusion/lookup.comp.glsl): `lookup`.
+docs/DIFFUSION.md derives the equations. float64 here, fp32 on the GPU.
+
+Conventions (as lpv_reference): one colour channel at a time; a field is an array (z, y, x, 4) of the L1
+SH (order 1, y, z, x) of the radiant intensity, W/sr, of the light in a cell by direction of travel; its
+flux is 2 sqrt(pi) c0 (W). Directions d are listed in AXES (+x -x +y -y +z -z). A cell's surface is a
+two-sided plane with unit normal n (the `plus` side is the one n points to); flux absorbed on each side
+is in W, areas in cells^2 (x h^2 for m^2).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import sh
+
+AXES = ((0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0), (2, 1.0), (2, -1.0))
+DIRECTIONS = np.array([np.eye(3)[axis] * sign for axis, sign in AXES])  # (6, 3)
+FLUX_PER_C0 = 2.0 * np.sqrt(np.pi)  # W per unit of c0
+FACE_SOLID_ANGLE_SR = 2.0 * np.pi / 3.0  # a face of a cube seen from its centre: 4 pi / 6
+# The paper's transfer L_j = T_d <L_i, T_d> normalised (DIGESTS.md, 000): the flux <L_i, T_d> through a
+# face leaves the receiving cell as a uniform intensity over that face's cone, flux / (2 pi / 3) W/sr.
+TRANSFER_NORM = 1.0 / FACE_SOLID_ANGLE_SR  # 3 / (2 pi)
+# L1 projection of the face cone's indicator T_d: c0 = Y00 x 2 pi / 3 = sqrt(pi) / 3; band 1 = Y1 x the
+# cone's projected solid angle, the integral of w.d over it, 2 sqrt(2) atan(1 / sqrt(2)) (a unit square
+# seen from half a unit: form factor 0.554 x pi).
+CONE_C0 = sh.Y00 * FACE_SOLID_ANGLE_SR
+CONE_C1 = sh.Y1 * 2.0 * np.sqrt(2.0) * np.arctan(1.0 / np.sqrt(2.0))
+_SLOT = (3, 1, 2)  # the coefficient index of axis x, y, z in (1, y, z, x)
+SIDE_EPSILON = 1e-3  # |d.n| below this: a face parallel to the surface feeds both sides half and half
+
+
+def cone(d: np.ndarray) -> np.ndarray:
+    """T_d in L1 SH for a unit direction (..., 3)."""
+    d = np.asarray(d, np.float64)
+    return np.concatenate([np.full((*d.shape[:-1], 1), CONE_C0), CONE_C1 * d[..., [1, 2, 0]]], axis=-1)
+
+
+CONES = cone(DIRECTIONS)  # (6, 4)
+
+
+def flux_w(field: np.ndarray) -> float:
+    return FLUX_PER_C0 * float(np.sum(field[..., 0], dtype=np.float64))
+
+
+# -- cells ---------------------------------------------------------------------------------------------
+def cells(occupied: np.ndarray, vox_normal: np.ndarray, vox_projected: np.ndarray) -> dict[str, np.ndarray]:
+    """What the transport needs of the voxels, per cell (arrays (z, y, x, ...)):
+    - `normal` (3): the surface's plane, unit: the voxels' mean normal, or where it cancels (both faces of
+      a thin wall in one cell) the axis along which the surfaces project the most; 0 in empty cells;
+    - `block` (3): per axis the share of a face's inflow the surface absorbs, min(1, projected area);
+    - `open` (6, bool): the faces light may leave through: every face of an empty cell, and of an
+      occupied one those to empty cells or out of the grid (a surface's light goes into open space: two
+      coplanar cells of a floor do not light each other);
+    - `area` (cells^2): each side's receiving area, sum over axes of block x (1 where the normal has a
+      component along the axis, else 1/2): the flux a uniform radiance L puts on a side is pi L x area
+      x h^2, so the lookup's flux / area is exact in a uniform field whatever the cell holds.
+    occupied (z, y, x) bool; vox_normal (z, y, x, 3 or 4): unit or 0; vox_projected (z, y, x, 3 or 4)."""
+    occ = np.asarray(occupied, bool)
+    mean = np.asarray(vox_normal, np.float64)[..., :3]
+    proj = np.asarray(vox_projected, np.float64)[..., :3]
+    has_mean = np.linalg.norm(mean, axis=-1, keepdims=True) > 0.5
+    major = np.eye(3)[np.argmax(proj, axis=-1)]
+    normal = np.where(occ[..., None], np.where(has_mean, mean, major), 0.0)
+    block = np.where(occ[..., None], np.minimum(1.0, proj), 0.0)
+    share = np.where(np.abs(normal) > SIDE_EPSILON, 1.0, 0.5)
+    area = np.sum(block * share, axis=-1)
+    open_faces = np.ones((*occ.shape, 6), bool)
+    padded = np.pad(occ, 1)
+    for f, (axis, sign) in enumerate(AXES):
+        shift = [slice(1, -1)] * 3
+        zyx = 2 - axis
+        shift[zyx] = slice(1 + int(sign), padded.shape[zyx] - 1 + int(sign))
+        open_faces[..., f] = ~occ | ~padded[tuple(shift)]
+    return {"normal": normal, "block": block, "open": open_faces, "area": area, "occupied": occ}
+
+
+# -- emitters ------------------------------------------------------------------------------------------
+def emit(flux_plus: np.ndarray, flux_minus: np.ndarray, normal: np.ndarray, occupied: np.ndarray,
+         albedo: np.ndarray | float = 1.0) -> np.ndarray:
+    """The field of Lambertian emitters (z, y, x, 4): each side of a cell's plane reflects albedo x its
+    flux (W) as a clamped-cosine lobe about its normal, albedo x flux / pi x cosine_lobe(+-n) (flux
+    exactly albedo x flux); an empty cell (a VPL whose surface fell in no occupied cell) emits it
+    isotropically."""
+    fp = np.asarray(flux_plus, np.float64) * albedo
+    fm = np.asarray(flux_minus, np.float64) * albedo
+    lobes = (fp[..., None] * sh.cosine_lobe_l1(normal) + fm[..., None] * sh.cosine_lobe_l1(-np.asarray(normal)))
+    iso = np.zeros_like(lobes)
+    iso[..., 0] = (fp + fm) / FLUX_PER_C0
+    return np.where(np.asarray(occupied)[..., None], lobes / np.pi, iso)
+
+
+# -- one step ------------------------------------------------------------------------------------------
+def face_fluxes(field: np.ndarray, open_faces: np.ndarray) -> np.ndarray:
+    """(z, y, x, 6) W leaving each cell through each face: the field's flux through the face's cone,
+    <L, T_d> (exact for the L1 intensity), clamped at 0 and kept only on open faces, then scaled so
+    the faces carry the cell's whole flux, max(0, 2 sqrt(pi) c0): the L1 lobe is negative behind
+    itself, and a clamp alone would add light; the scale moves it to the faces it can leave by."""
+    raw = np.maximum(field @ CONES.T, 0.0) * open_faces
+    total = np.maximum(FLUX_PER_C0 * field[..., 0], 0.0)
+    s = raw.sum(axis=-1, keepdims=True)
+    return np.where(s > 0.0, raw * (total[..., None] / np.where(s > 0.0, s, 1.0)), 0.0)
+
+
+def inflow(out: np.ndarray) -> np.ndarray:
+    """(z, y, x, 6): a[j, d] = the flux neighbour j - d sends through face d into j (0 from outside)."""
+    a = np.zeros_like(out)
+    for f, (axis, sign) in enumerate(AXES):
+        zyx = 2 - axis
+        src = [slice(None)] * 3
+        dst = [slice(None)] * 3
+        if sign > 0:
+            src[zyx], dst[zyx] = slice(0, -1), slice(1, None)
+        else:
+            src[zyx], dst[zyx] = slice(1, None), slice(0, -1)
+        a[tuple(dst) + (f,)] = out[tuple(src) + (f,)]
+    return a
+
+
+def side_weights(normal: np.ndarray) -> np.ndarray:
+    """(z, y, x, 6): the share of the inflow through face d (travelling along d) that lands on the plus
+    side: 1 when it travels against n, 0 along n, 1/2 parallel to the plane."""
+    dn = normal @ DIRECTIONS.T
+    return np.where(dn < -SIDE_EPSILON, 1.0, np.where(dn > SIDE_EPSILON, 0.0, 0.5))
+
+
+def step(field: np.ndarray, cell: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One gather step: (next field, flux absorbed on the plus side, on the minus side), W.
+
+    Each cell gathers its neighbours' face fluxes a_d (`face_fluxes`, `inflow`). An occupied cell's
+    surface absorbs block[axis(d)] x a_d, split between its sides (`side_weights`); the rest, and all of
+    an empty cell's inflow, is carried on: the next field is TRANSFER_NORM x sum_d carried_d T_d
+    (flux sum_d carried_d: nothing is gained). Absorbed light is not re-emitted within the step: each
+    bounce is its own propagation (`emit` makes the next one's emitters)."""
+    a = inflow(face_fluxes(field, cell["open"]))
+    axis_of_face = np.array([axis for axis, _ in AXES])
+    absorbed = a * cell["block"][..., axis_of_face]
+    carried = a - absorbed
+    plus = side_weights(cell["normal"])
+    return TRANSFER_NORM * carried @ CONES, np.sum(absorbed * plus, -1), np.sum(absorbed * (1.0 - plus), -1)
+
+
+def propagate(field: np.ndarray, cell: dict, steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """`steps` steps from emitters `field`: (field left in flight, absorbed plus, absorbed minus)."""
+    plus = np.zeros(field.shape[:-1])
+    minus = np.zeros(field.shape[:-1])
+    for _ in range(steps):
+        field, p, m = step(field, cell)
+        plus += p
+        minus += m
+    return field, plus, minus
+
+
+# -- reconstruction ------------------------------------------------------------------------------------
+def lookup(points_cells: np.ndarray, normals: np.ndarray, cell: dict, flux_plus: np.ndarray,
+           flux_minus: np.ndarray, cell_area_m2: float) -> np.ndarray:
+    """Irradiance / pi (Cycles' Diffuse Indirect) at points (n, 3) in grid coordinates (cells) with unit
+    normals (n, 3). Over the 8 cells whose centres surround the point, each occupied one (in the grid)
+    gives the irradiance of its side facing n, flux / (area x h^2), weighted by its trilinear weight
+    times |n . n_cell| (the surface it holds faces the point's way: a wall's cell does not light the
+    floor beside it) and renormalised; where those weights are all 0 but a neighbour is occupied the
+    trilinear weights alone; where none is, 0 (no surface near: no light known)."""
+    p = np.asarray(points_cells, np.float64) - 0.5
+    base = np.floor(p).astype(int)
+    frac = p - base
+    dims_zyx = np.array(cell["occupied"].shape)
+    num = np.zeros(len(p))
+    den = np.zeros(len(p))
+    num_t = np.zeros(len(p))
+    den_t = np.zeros(len(p))
+    for k in range(8):
+        o = np.array([k & 1, (k >> 1) & 1, k >> 2])
+        c = base + o
+        t = np.prod(np.where(o, frac, 1.0 - frac), axis=1)
+        inside = np.all((c >= 0) & (c < dims_zyx[::-1]), axis=1)
+        cz = np.clip(c, 0, dims_zyx[::-1] - 1)
+        idx = (cz[:, 2], cz[:, 1], cz[:, 0])
+        occ = inside & cell["occupied"][idx]
+        n_c = cell["normal"][idx]
+        dn = np.sum(normals * n_c, axis=1)
+        area = np.maximum(cell["area"][idx], 1e-6) * cell_area_m2
+        e = np.where(dn >= 0.0, flux_plus[idx], flux_minus[idx]) / area
+        w = np.where(occ, t * np.abs(dn), 0.0)
+        num += w * e
+        den += w
+        wt = np.where(occ, t, 0.0)
+        num_t += wt * e
+        den_t += wt
+    value = np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0),
+                     np.where(den_t > 0.0, num_t / np.where(den_t > 0.0, den_t, 1.0), 0.0))
+    return value / np.pi

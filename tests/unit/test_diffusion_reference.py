@@ -1,0 +1,209 @@
+"""The `diffusion` transport's numpy twin (addon/engine/diffusion_reference.py) against closed forms.
+
+A field's flux is 2 sqrt(pi) c0 summed over its cells (W), linear in the coefficients, so what the
+step conserves it conserves to float64 rounding: tolerances of 1e-12 relative say "exact". The GPU
+passes are checked against this twin in tests/gpu/test_diffusion.py.
+"""
+
+import numpy as np
+import pytest
+
+from addon.engine import diffusion_reference as ref
+from addon.engine import sh
+
+DIMS_ZYX = (6, 7, 8)
+
+
+def empty_cells(dims=DIMS_ZYX):
+    return ref.cells(np.zeros(dims, bool), np.zeros((*dims, 3)), np.zeros((*dims, 3)))
+
+
+def test_the_face_cones_partition_the_sphere():
+    # The six face cones of a cube seen from its centre cover the sphere once: their L1 projections sum
+    # to that of 1, (2 sqrt(pi), 0, 0, 0), exactly (c0 = sqrt(pi) / 3 each, band 1 cancels in pairs).
+    np.testing.assert_allclose(ref.CONES.sum(axis=0), [ref.FLUX_PER_C0, 0, 0, 0], rtol=0, atol=1e-14)
+    # The cone's band-1 coefficient against a quadrature of the indicator (midpoint rule over a
+    # discontinuous function: 2048 x 4096 directions resolve the cone's edge to ~1e-4).
+    dirs, w = sh.sphere_quadrature(1024, 2048)
+    inside = (dirs[:, 0] > np.abs(dirs[:, 1])) & (dirs[:, 0] > np.abs(dirs[:, 2]))
+    np.testing.assert_allclose(sh.project(inside.astype(float), dirs, w), ref.CONES[0], rtol=0, atol=2e-4)
+
+
+def test_a_uniform_isotropic_field_is_unchanged_by_a_step():
+    # The digest's check of the normalisation 3 / (2 pi): an isotropic intensity c0 sends <L, T_d> =
+    # c0 sqrt(pi) / 3 through each face; each arrives as 3 / (2 pi) x that x T_d, and the six cones sum
+    # to (2 sqrt(pi), 0, 0, 0): c0 exactly.
+    # Cells next to the grid's edge miss the inflow from outside, so only the interior is compared.
+    field = np.zeros((*DIMS_ZYX, 4))
+    field[..., 0] = 1.7
+    nxt, plus, minus = ref.step(field, empty_cells())
+    # Band 1 cancels between opposite faces to 3e-17 (the cones' x, y, z terms in float64).
+    np.testing.assert_allclose(nxt[1:-1, 1:-1, 1:-1], field[1:-1, 1:-1, 1:-1], rtol=1e-14, atol=1e-15)
+    assert not plus.any() and not minus.any()  # no surface: nothing absorbed
+
+
+def random_cells(rng, dims=DIMS_ZYX, share=0.3):
+    occ = rng.random(dims) < share
+    normal = rng.normal(size=(*dims, 3))
+    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+    normal[rng.random(dims) < 0.2] = 0.0  # thin walls: the mean normal cancels
+    proj = rng.random((*dims, 3)) * 1.5
+    return ref.cells(occ, normal, proj)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_a_step_never_adds_light(seed):
+    # Fields with strong band 1 (|c1| up to 3 c0: negative lobes the clamp must not turn into light):
+    # the flux carried on plus the flux absorbed is at most the flux of the cells with positive c0 (the
+    # rest may leave the grid, never exceed it); with no open boundary (light kept inside by a closed
+    # shell of surfaces) it is equal, to rounding.
+    rng = np.random.default_rng(seed)
+    field = rng.normal(size=(*DIMS_ZYX, 4))
+    field[..., 0] = np.abs(field[..., 0])
+    cell = random_cells(rng)
+    nxt, plus, minus = ref.step(field, cell)
+    before = ref.flux_w(field)
+    after = ref.flux_w(nxt) + plus.sum() + minus.sum()
+    assert after <= before * (1 + 1e-12)
+    assert np.all(plus >= 0) and np.all(minus >= 0)
+    # Every face's outflow is >= 0, so the next field's flux per cell is too.
+    assert np.all(nxt[..., 0] >= -1e-15)
+
+
+def test_a_closed_box_keeps_all_of_its_light():
+    # A shell of fully blocking cells (projected area 1 on every axis) around an empty interior: all the
+    # interior sends into the shell is absorbed, the rest stays inside, so the field's flux plus the
+    # absorbed flux stays the emitters' to rounding, step after step.
+    dims = (6, 6, 6)
+    occ = np.ones(dims, bool)
+    occ[1:-1, 1:-1, 1:-1] = False
+    cell = ref.cells(occ, np.zeros((*dims, 3)), np.ones((*dims, 3)))
+    rng = np.random.default_rng(7)
+    field = np.zeros((*dims, 4))
+    field[1:-1, 1:-1, 1:-1] = rng.normal(size=(4, 4, 4, 4))
+    field[1:-1, 1:-1, 1:-1, 0] = np.abs(field[1:-1, 1:-1, 1:-1, 0]) + 2.0
+    total = ref.flux_w(field)
+    absorbed = 0.0
+    for _ in range(4):
+        field, plus, minus = ref.step(field, cell)
+        absorbed += plus.sum() + minus.sum()
+        assert ref.flux_w(field) + absorbed == pytest.approx(total, rel=1e-12)
+
+
+@pytest.mark.parametrize("cancelled_normal", [False, True])
+def test_a_one_cell_wall_stops_light(cancelled_normal):
+    # A wall one cell thick across the whole grid at x = 4 (projected area 1 along x). Its normal is +x,
+    # or (cancelled_normal) 0: both faces of a thin wall in one cell, whose mean normal cancels; the
+    # cells then take the axis it projects the most along. An isotropic emitter at x = 1: after 40 steps
+    # not a bit of light is beyond the wall (exactly 0: the wall absorbs all it gets along x, passes on
+    # nothing along y and z since its neighbours there are wall too), and everything the wall absorbed is
+    # on its side facing the emitter (the minus side of a +x normal).
+    dims = (8, 8, 9)
+    occ = np.zeros(dims, bool)
+    occ[:, :, 4] = True
+    normal = np.zeros((*dims, 3))
+    if not cancelled_normal:
+        normal[:, :, 4] = (1.0, 0.0, 0.0)
+    proj = np.zeros((*dims, 3))
+    proj[:, :, 4] = (1.0, 0.0, 0.0)
+    cell = ref.cells(occ, normal, proj)
+    field = np.zeros((*dims, 4))
+    field[4, 4, 1, 0] = 1.0
+    total = ref.flux_w(field)
+    left, plus, minus = ref.propagate(field, cell, 40)
+    assert not left[:, :, 5:].any()
+    assert plus.sum() == 0.0
+    # Most of the rest leaves the 8 x 8 cross-section sideways; a fifth reaches the wall (measured 0.25).
+    assert 0.2 * total < minus.sum() <= total
+
+
+def test_emitters_carry_albedo_times_their_flux():
+    # A plane's two sides each a clamped-cosine lobe of flux albedo x side flux; an empty cell (a VPL
+    # whose surface fell outside every occupied cell) emits its flux isotropically.
+    n = np.array([[0.48, -0.6, 0.64], [0.0, 0.0, 0.0]])
+    occ = np.array([True, False])
+    field = ref.emit(np.array([3.0, 1.0]), np.array([2.0, 0.5]), n, occ, albedo=np.array([0.5, 1.0]))
+    assert ref.FLUX_PER_C0 * field[0, 0] == pytest.approx(0.5 * 5.0, rel=1e-14)
+    assert ref.FLUX_PER_C0 * field[1, 0] == pytest.approx(1.5, rel=1e-14)
+    np.testing.assert_allclose(field[1, 1:], 0.0)
+    # The lobe is the clamped cosine about n: band 1 = (3 - 2) x 0.5 / pi x 2 pi / 3 x Y1 x n (y, z, x).
+    np.testing.assert_allclose(field[0, 1:], 0.5 * 1.0 / np.pi * sh.BAND_FACTORS[1] * sh.Y1 * n[0, [1, 2, 0]],
+                               rtol=1e-14)
+
+
+def test_an_emitter_against_a_floor_sends_its_light_up_only():
+    # A floor of occupied cells: each floor cell's open faces are the one up and (with no cell below the
+    # grid) the one down, and its lobe about +z sends nothing down: all its flux goes into the cell above.
+    dims = (3, 3, 3)
+    occ = np.zeros(dims, bool)
+    occ[0] = True
+    normal = np.zeros((*dims, 3))
+    normal[0] = (0.0, 0.0, 1.0)
+    cell = ref.cells(occ, normal, np.where(occ[..., None], [0.0, 0.0, 1.0], 0.0))
+    assert cell["open"][0, 1, 1].tolist() == [False, False, False, False, True, True]
+    field = ref.emit(np.where(occ, 1.0, 0.0), np.zeros(dims), normal, occ)
+    out = ref.face_fluxes(field, cell["open"])
+    np.testing.assert_allclose(out[0, 1, 1], [0, 0, 0, 0, 1.0, 0], rtol=1e-14, atol=1e-15)
+
+
+def lookup_cells(occupied, normal_z=1.0):
+    dims = occupied.shape
+    normal = np.zeros((*dims, 3))
+    normal[occupied] = (0.0, 0.0, normal_z)
+    return ref.cells(occupied, normal, np.where(occupied[..., None], [0.0, 0.0, 1.0], 0.0))
+
+
+def test_the_lookup_renormalises_over_occupied_cells():
+    # Cells with the same irradiance on their plus side, E = flux / (area h^2) = 2 / (1 x 0.25) = 8 W/m^2,
+    # read anywhere between them with any subset of the 8 corners occupied: E / pi exactly (the weights
+    # are renormalised over the occupied ones); a point whose corners are all empty reads 0 (the defined
+    # fallback: no surface near).
+    rng = np.random.default_rng(3)
+    dims = (2, 2, 2)
+    points = rng.random((20, 3)) + 0.5  # between the 8 cell centres
+    normals = np.tile([0.0, 0.0, 1.0], (20, 1))
+    for k in range(1, 256, 17):
+        occ = np.array([(k >> i) & 1 for i in range(8)], bool).reshape(dims)
+        cell = lookup_cells(occ)
+        value = ref.lookup(points, normals, cell, np.where(occ, 2.0, 0.0), np.zeros(dims), 0.25)
+        np.testing.assert_allclose(value, 8.0 / np.pi, rtol=1e-14)
+    none = lookup_cells(np.zeros(dims, bool))
+    assert not ref.lookup(points, normals, none, np.zeros(dims), np.zeros(dims), 0.25).any()
+
+
+def test_the_lookup_reads_the_side_facing_the_normal():
+    # One occupied cell, 3 W on its plus side (normal +z), 1 W on its minus side: a point facing +z
+    # reads 3 / (1 x 1) / pi, facing -z 1 / pi; a point facing +x (perpendicular to the cell's plane:
+    # weight |n.n_cell| = 0) falls back to the trilinear weight alone and reads the plus side (ties).
+    occ = np.zeros((1, 1, 1), bool)
+    occ[0, 0, 0] = True
+    cell = lookup_cells(occ)
+    pts = np.array([[0.5, 0.5, 0.5]] * 3)
+    nrm = np.array([[0, 0, 1.0], [0, 0, -1.0], [1.0, 0, 0]])
+    value = ref.lookup(pts, nrm, cell, np.full((1, 1, 1), 3.0), np.full((1, 1, 1), 1.0), 1.0)
+    np.testing.assert_allclose(value, np.array([3.0, 1.0, 3.0]) / np.pi, rtol=1e-14)
+
+
+def test_a_uniform_radiance_gives_its_irradiance_on_any_surface():
+    # The receiving area is chosen so a uniform radiance L (W/m^2/sr) reads back E / pi = L whatever the
+    # cell holds: a face's one-way inflow from L is pi L h^2, of which `block` is absorbed; here a cell
+    # with projected areas (0.7, 0.3, 0) and normal in the xy plane: sides get pi L h^2 (0.7 + 0.3) each.
+    occ = np.zeros((3, 3, 3), bool)
+    occ[1, 1, 1] = True
+    normal = np.zeros((3, 3, 3, 3))
+    normal[1, 1, 1] = (0.8, 0.6, 0.0)
+    proj = np.zeros((3, 3, 3, 3))
+    proj[1, 1, 1] = (0.7, 0.3, 0.0)
+    cell = ref.cells(occ, normal, proj)
+    h, radiance = 0.5, 2.0
+    # Intensity of an isotropic radiance L in a cell: each face's cone carries the face's one-way flux
+    # pi L h^2, so c0 = 6 pi L h^2 / (2 sqrt(pi)).
+    field = np.zeros((3, 3, 3, 4))
+    field[..., 0] = 6.0 * np.pi * radiance * h * h / ref.FLUX_PER_C0
+    field[1, 1, 1] = 0.0
+    _, plus, minus = ref.step(field, cell)
+    assert cell["area"][1, 1, 1] == pytest.approx(1.0)
+    assert plus[1, 1, 1] == pytest.approx(minus[1, 1, 1], rel=1e-12)
+    points = np.array([[1.5, 1.5, 1.5]] * 2)
+    value = ref.lookup(points, np.array([[0.8, 0.6, 0.0], [-0.8, -0.6, 0.0]]), cell, plus, minus, h * h)
+    np.testing.assert_allclose(value, radiance, rtol=1e-12)
