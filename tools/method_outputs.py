@@ -3,9 +3,8 @@ that a change to the engine's structure changes no output (tests/blender/test_me
 
     .venv/bin/python tools/method_outputs.py OUT.npz
 
-tests/data/method_outputs.npz was written by this tool's cases before the method interface moved to a
-solve and a gather; the test renders them again and compares. A change that is meant to change images
-regenerates the file with this command and says so in its commit.
+tests/data/method_outputs.npz holds this tool's cases; the test renders them again and compares. A change that is
+meant to change images regenerates the file with this command and says so in its commit.
 """
 
 from __future__ import annotations

@@ -9,7 +9,7 @@ const int MAX_CONE_STEPS = 96;
 // the cone (1.2 t for 6 cones) reach back behind the origin and meet the back of the gatherer's own
 // surface, opaque and dark (a closed box of radiance 1 read 0.31 straight up; 0.9 with a cap of 0.25).
 // 0.15 rather than 0.25: blocks that straddle a thin wall blend the far room in (the hard-case thin
-// wall leaked 1.8 % at 0.25, 0.8 % at 0.15; cornell rel_rmse_8 0.172 -> 0.163, gather time x1.4).
+// wall leaked 1.8 % at 0.25, 0.8 % at 0.15; cornell rel_rmse_8 0.163 against 0.172, gather time x1.4).
 // The cone is then sampled narrower than it is wide: an estimate of its mean radiance from its core.
 const float SIDE_CAP = 0.15;
 #define START_CELLS 0.5

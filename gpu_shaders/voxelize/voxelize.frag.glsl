@@ -6,8 +6,8 @@
 // this slab (a tilted surface spans two slabs per pixel: weighing each 1 gave the slab it barely
 // touches a whole cell of opacity, a dark occluder in front of its lit VPLs in VCT, and the Cornell
 // box's surfaces 27 % too much area). Conservative rasterization also emits the pixels a triangle only
-// grazes: before the clipping each weighed a whole pixel (min(triangle area, 1)), so meshes of many
-// small triangles counted every edge twice and more.
+// grazes: unclipped, each would weigh a whole pixel (min(triangle area, 1)), and meshes of many small
+// triangles would count every edge twice and more.
 
 // Area (pixel units) of triangle (p0, p1, p2) inside the square [lo, lo + 1]^2: Sutherland-Hodgman
 // against the four sides (at most 7 corners), then the shoelace formula.

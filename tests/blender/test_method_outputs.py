@@ -1,8 +1,8 @@
 """No output changes: every method at tools/method_outputs.py's settings gives the images recorded in
-tests/data/method_outputs.npz (written by those settings before the method interface was split into a
-solve and a gather). The same passes on the same inputs in the same order on the same rasteriser: equal
-bit for bit; 1e-6 relative is the allowance for a pass order that changes float summation, and any
-change beyond it is an output change that must regenerate the file (the tool's docstring says how)."""
+tests/data/method_outputs.npz (the tool's record of them). The same passes on the same inputs in the
+same order on the same rasteriser: equal bit for bit; 1e-6 relative is the allowance for a pass order
+that changes float summation, and any change beyond it is an output change that must regenerate the
+file (the tool's docstring says how)."""
 
 import importlib.util
 from pathlib import Path

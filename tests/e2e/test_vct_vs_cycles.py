@@ -50,8 +50,7 @@ def test_vct_on_cornell_one_and_two_bounces(tmp_path):
     e1 = metrics.compare(one, refs[1], mask)
     print(f"vct 1 bounce, 64 cells, 16 cones: {e1}, total {t1['total']:.0f} ms")
     # Measured (llvmpipe): rel_rmse 0.58 (per-pixel noise of the jittered cones), rel_rmse_8 0.146,
-    # bias 0.971 (0.150 / 0.925 before the voxelizer weighed fragments by their exact coverage;
-    # isotropic radiance, before the jitter: 1.13 / 0.80). rsm without visibility scores 0.19 / 1.14.
+    # bias 0.971 (isotropic radiance and fixed cones: 1.13 / 0.80). rsm without visibility scores 0.19 / 1.14.
     assert e1["rel_rmse_8"] <= 0.18
     assert 0.88 <= e1["bias"] <= 1.0
 
@@ -64,8 +63,7 @@ def test_vct_on_cornell_one_and_two_bounces(tmp_path):
     print(f"vct 2 bounces, 32 cells: {e2}, total {t2['total']:.0f} ms; 1 bounce vs the 2-bounce reference: "
           f"{e1_vs_2}")
     assert np.isfinite(two).all() and (two >= 0).all()
-    # Measured: rel_rmse_8 0.139, bias 1.003 against Cycles at diffuse_bounces = 2 (0.136 / 0.924
-    # before the voxelizer weighed fragments by their exact coverage); one bounce reads bias 0.67
+    # Measured: rel_rmse_8 0.139, bias 1.003 against Cycles at diffuse_bounces = 2; one bounce reads bias 0.67
     # against that reference, outside the band, so a missing second bounce fails here. Bias bounds:
     # the 0.9..1.1 widened below by 0.05.
     assert e2["rel_rmse_8"] <= 0.18

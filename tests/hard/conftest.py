@@ -28,14 +28,14 @@ if HERE not in sys.path:
 LPV = "lpv (improved, geometry volume): "
 KNOWN_DEFECTS = {
     "test_one_triangle[lpv]": "indirect 0.12 where the exact answer is 0: the emitter's own VPLs light it "
-                              "(one grid 0.11; 0.17 before surface offsets; classic 1.25)",
+                              "(one grid 0.11; 0.17 without surface offsets; classic 1.25)",
     "test_km_terrain_under_sun[lpv]": "indirect 0.023 of direct on a flat terrain that cannot light itself "
-                                      "(one grid 0.018; 0.0095 before surface offsets; classic 0.23)",
+                                      "(one grid 0.018; 0.0095 without surface offsets; classic 0.23)",
     "test_white_closed_box_conserves_flux[lpv]": "indirect flux 0.88 P in a closed white box (exact P, bound "
                                                  "0.9..1.02): it under-reads (one grid over-read, 1.06: "
                                                  "each step at a wall gains a little; classic 0.80)",
     "test_camera_inside_closed_block[lpv]": "indirect 0.059 inside a closed block: leaks through one-cell walls "
-                                            "(one grid 0.058; classic 0.89; 0.12 before exact voxel areas)",
+                                            "(one grid 0.058; classic 0.89)",
     "test_light_inside_closed_box_stays_inside[lpv]": "indirect 0.10 x P/(6 pi) outside a closed box: leaks "
                                                       "through walls (one grid 0.096; classic 0.92)",
     "test_two_hundred_lights[lpv]": "indirect 0.018 on geometry that cannot receive a bounce: self-illumination "
@@ -68,12 +68,12 @@ CLASSES_KNOWN_DEFECTS = {
 # both faces of a wall thinner than a cell, and a cone passing near it reads the far face's light.
 VCT = "vct: "
 VCT_KNOWN_DEFECTS = {
-    "test_camera_inside_closed_block[vct]": "indirect up to 0.095 inside a closed block (exact 0; 0.054 before "
-                                            "exact voxel areas): its walls are one cell thick, so their lit outer "
-                                            "faces share voxels with the inner faces the cones pass",
-    "test_light_inside_closed_box_stays_inside[vct]": "indirect outside up to 0.22 x P/(6 pi) (exact 0; 0.029 "
-                                                      "before exact voxel areas): the box's one-cell walls hold "
-                                                      "its lit inner faces, now with their exact, partial opacity",
+    "test_camera_inside_closed_block[vct]": "indirect up to 0.095 inside a closed block (exact 0): its walls are "
+                                            "one cell thick, so their lit outer faces share voxels with the inner "
+                                            "faces the cones pass",
+    "test_light_inside_closed_box_stays_inside[vct]": "indirect outside up to 0.22 x P/(6 pi) (exact 0): the box's "
+                                                      "one-cell walls hold its lit inner faces with their exact, "
+                                                      "partial opacity",
 }
 
 

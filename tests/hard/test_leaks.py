@@ -51,7 +51,7 @@ def test_thin_wall_between_rooms(gl, figures, name):
 
 
 @pytest.mark.parametrize("name", methods_with_known_leaks(voxel_reason=(
-    "measured indirect outside up to 3e-5 x P/(6 pi) (0.021 before the grid padding change), against an "
+    "measured indirect outside up to 3e-5 x P/(6 pi), against an "
     "exact 0: 16 cm cells over the 10 m ground, the box's floor 50 cm up; VPLs on the inner floor one cell "
     "above it reach the ground under the box where the march skips the cells next to its ends")))
 def test_light_inside_closed_box_stays_inside(gl, figures, name):
