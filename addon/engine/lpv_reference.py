@@ -1,7 +1,7 @@
 """numpy twin of the LPV transport: injection, propagation through the geometry volume, lookup.
 
 The one numpy reference of the `lpv` method's transport: tests/gpu/test_lpv.py checks the GPU passes
-against it, tools/lpv_sh_order.py and tools/lpv_barrel.py build their models on it. It mirrors
+against it (docs/LPV.md's SH-order and vault studies were built on it). It mirrors
 - passes/lpv_inject.py (gpu_shaders/lpv/inject.vert.glsl): `inject`;
 - passes/lpv_propagate.py (lpv/blocking.comp.glsl, lpv/propagate.comp.glsl, lpv/transfer.glsl):
   `transfer_matrices`, `path_weight`, `gpu_improved_transfer`, `blocking`, `pass_through`, `step`,
