@@ -1,0 +1,300 @@
+"""Choosing a method and its settings for the scene at hand: scene features, an error and time model
+fitted on the benchmark's results, and the choice for an error or a time budget.
+
+Every benchmark row (a method at one of its registry settings, `registry.MethodSpec.bench`) has been
+measured against Cycles on every benchmark scene. How wrong a row is on a new scene depends on the
+scene: a method that leaks light through thin walls is worse in enclosed rooms, an L1 grid is worse
+under a sun than under a spot, a gather of point VPLs is worse near glowing panels. The model says so
+with a few numbers per scene (`FEATURES`, all computed from the engine's Scene, no Blender):
+
+    log rel_rmse_8(row, scene) = a_row + b_method . x(scene)
+    log ms(row, scene)         = c_row + d_method . (log10 triangles, log10 pixels)
+
+a_row, c_row: one intercept per row (how good and how fast the row is on the mean scene); b_method,
+d_method: slopes shared by a method's rows (how the method's error and time move with the scene),
+fitted by ridge least squares on standardised features, so a dozen scenes cannot make a slope
+explode. The model's own uncertainty is measured, not assumed: `margin` is a quantile of its
+leave-one-scene-out error ratios, and a row counts as meeting a budget E when its predicted error
+times the margin is at most E (tools/fit_choice.py fits, evaluates and writes the model;
+benchmarks/choice/REPORT.md its figures).
+
+Blender-free (numpy only); the bridge captures the scene and calls `scene_features` and `choose`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from . import world
+from .area_light import split_area_light
+from .config import RsmConfig
+from .errors import ConfigError
+from .passes.light_views import emissive_lights, views_for
+from .scene import Scene
+
+MODEL_PATH = Path(__file__).resolve().parent / "data" / "choice_model.json"
+
+# The scene's description the model reads. Shares are of the light entering the scene's bounds (see
+# light_shares); enclosure is the share of directions from points inside the bounds that meet geometry.
+FEATURES = ("enclosure", "sun_share", "world_share", "shaped_share", "glossy_share", "log_triangles",
+            "aspect", "bounces")
+# Time goes with what every update rasterizes and gathers: triangles, pixels, and light faces (each an
+# RSM and, for most methods, a gather pass of its own).
+TIME_FEATURES = ("log_triangles", "log_pixels", "log_light_faces")
+
+ENCLOSURE_DIRECTIONS = 64  # per point, a Fibonacci sphere
+# Where the enclosure is looked at from: the bounds' centre and the eight points halfway from it to the
+# corners (a camera may stand outside the geometry, as Cornell's does; a wall may hold the centre).
+ENCLOSURE_POINTS = np.array([[0, 0, 0], *[[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]]) * 0.25
+GLOSSY_ROUGHNESS = 0.5     # a lobe narrower than this shows as a reflection, not as diffuse light
+GLOSSY_F0 = 0.1            # ... when it reflects at least this much (dielectrics reflect 0.04)
+
+
+# -- features -------------------------------------------------------------------------------------------
+
+def fibonacci_directions(n: int) -> np.ndarray:
+    """(n, 3) unit vectors spread evenly over the sphere (the golden-angle spiral)."""
+    i = np.arange(n) + 0.5
+    z = 1.0 - 2.0 * i / n
+    r = np.sqrt(np.maximum(1.0 - z * z, 0.0))
+    phi = i * math.pi * (3.0 - math.sqrt(5.0))
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
+
+
+def rays_hit(origin: np.ndarray, directions: np.ndarray, triangles: np.ndarray, chunk: int = 4096) -> np.ndarray:
+    """(n,) bool: does the ray from `origin` along each direction meet any triangle (Moller-Trumbore,
+    both faces, t > 0)? Triangles are taken in chunks so a million of them stay within memory."""
+    hit = np.zeros(len(directions), bool)
+    d = directions[:, None, :]
+    for start in range(0, len(triangles), chunk):
+        tri = triangles[start:start + chunk].astype(np.float64)
+        v0, e1, e2 = tri[:, 0], tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+        p = np.cross(d, e2[None])                       # (rays, tris, 3)
+        det = np.einsum("rtk,tk->rt", p, e1)
+        ok = np.abs(det) > 1e-12
+        inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+        s = origin[None, :] - v0                         # (tris, 3)
+        u = np.einsum("rtk,tk->rt", p, s) * inv
+        q = np.cross(s, e1)                              # (tris, 3)
+        v = np.einsum("rk,tk->rt", directions, q) * inv
+        t = np.einsum("tk,tk->t", e2, q)[None, :] * inv
+        hit |= np.any(ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 1e-6), axis=1)
+    return hit
+
+
+def light_shares(scene: Scene) -> dict[str, float]:
+    """Each kind's share of the power that enters the scene's bounds, in W (Cycles' units):
+    lamps (point, spot, area) their power, a spot the share of the sphere its cone covers; a sun its
+    irradiance over the bounds' area seen from it; the world pi L over the bounds' surface (a uniform
+    radiance L gives irradiance pi L on every face); glowing triangles pi x radiance x area on both
+    faces. Returns fractions of the total (all 0 when nothing emits)."""
+    lo, hi = scene.bounds_m()
+    size = np.maximum(hi - lo, 1e-6)
+    faces = np.array([size[1] * size[2], size[0] * size[2], size[0] * size[1]])
+    power = {"lamp": 0.0, "sun": 0.0, "world": 0.0, "shaped": 0.0}
+    for light in scene.lights:
+        if light.kind == "SUN":
+            power["sun"] += light.sun_strength * float(np.mean(light.color)) * float(
+                np.abs(np.asarray(light.direction, float)) @ faces)
+        elif light.kind == "SPOT":
+            cone = (1.0 - math.cos(min(light.spot_size_rad, 2 * math.pi) / 2.0)) / 2.0
+            power["lamp"] += light.power_w * float(np.mean(light.color)) * cone
+        elif light.kind == "AREA":
+            power["shaped"] += light.power_w * float(np.mean(light.color))
+        else:
+            power["lamp"] += light.power_w * float(np.mean(light.color))
+    world = scene.world_map if scene.world_map is not None else scene.world_color
+    power["world"] = math.pi * float(np.mean(world)) * 2.0 * float(faces.sum())
+    if scene.triangle_count:
+        e1 = scene.positions_m[:, 1] - scene.positions_m[:, 0]
+        e2 = scene.positions_m[:, 2] - scene.positions_m[:, 0]
+        area = 0.5 * np.linalg.norm(np.cross(e1, e2), axis=1)
+        power["shaped"] += 2.0 * math.pi * float(np.sum(np.mean(scene.emission, axis=1) * area))
+    total = sum(power.values())
+    return {k: (v / total if total > 0 else 0.0) for k, v in power.items()}
+
+
+def light_faces(scene: Scene, rsm: RsmConfig) -> int:
+    """How many light views (RSM faces) an update renders: the lamps (area lights in patches), the
+    glowing meshes' lamps and the world's suns, as DirectMethod.light_views makes them."""
+    lo, hi = scene.bounds_m()
+    lights = []
+    for light in scene.lights:
+        lights += split_area_light(light, rsm.area_patches) if light.kind == "AREA" else [light]
+    if scene.triangle_count:
+        lights += emissive_lights(scene.positions_m, scene.emission, float((hi - lo).max()))
+    world_map = scene.world_map
+    if world_map is None and np.any(np.asarray(scene.world_color) > 0):
+        world_map = world.constant_map(np.asarray(scene.world_color, np.float32))
+    if world_map is not None and rsm.world_suns:
+        lights += world.world_suns(world_map, rsm.world_suns)
+    return sum(len(views_for(light, i, (lo, hi), rsm.resolution)) for i, light in enumerate(lights))
+
+
+def scene_features(scene: Scene, bounces: int = 1, pixels: int = 128 * 128,
+                   rsm: RsmConfig | None = None) -> dict[str, float]:
+    """The numbers of FEATURES and TIME_FEATURES for `scene` (light faces at `rsm`, default settings
+    when None)."""
+    lo, hi = scene.bounds_m()
+    size = np.maximum(hi - lo, 1e-9)
+    n = scene.triangle_count
+    enclosure = 0.0
+    if n:
+        dirs = fibonacci_directions(ENCLOSURE_DIRECTIONS)
+        points = (lo + hi) / 2.0 + ENCLOSURE_POINTS * size
+        enclosure = float(np.mean([rays_hit(p, dirs, scene.positions_m) for p in points]))
+    shares = light_shares(scene)
+    glossy = 0.0
+    if n:
+        e1 = scene.positions_m[:, 1] - scene.positions_m[:, 0]
+        e2 = scene.positions_m[:, 2] - scene.positions_m[:, 0]
+        area = 0.5 * np.linalg.norm(np.cross(e1, e2), axis=1)
+        shiny = (scene.glossy_roughness() < GLOSSY_ROUGHNESS) & (scene.specular_f0().max(axis=1) >= GLOSSY_F0)
+        glossy = float(area[shiny].sum() / max(area.sum(), 1e-30))
+    return {"enclosure": enclosure, "sun_share": shares["sun"], "world_share": shares["world"],
+            "shaped_share": shares["shaped"], "glossy_share": glossy, "log_triangles": math.log10(max(n, 1)),
+            "aspect": float(size.min() / size.max()), "bounces": float(bounces),
+            "log_pixels": math.log10(max(pixels, 1)),
+            "log_light_faces": math.log10(max(light_faces(scene, rsm or RsmConfig()), 1))}
+
+
+# -- the model ------------------------------------------------------------------------------------------
+
+def row_key(method: str, setting: dict) -> str:
+    """A row's name: the method and its settings, sorted ("lpv grid_cells=16 variant=improved")."""
+    return " ".join([method, *(f"{k.split('.')[-1]}={setting[k]}" for k in sorted(setting))])
+
+
+def _ridge(x: np.ndarray, y: np.ndarray, penalised: np.ndarray, lam: float) -> np.ndarray:
+    """argmin |x w - y|^2 + lam |w[penalised]|^2 (normal equations; the intercept columns are free)."""
+    a = x.T @ x + lam * np.diag(penalised.astype(float))
+    return np.linalg.lstsq(a, x.T @ y, rcond=None)[0]
+
+
+@dataclass
+class Model:
+    """Fitted intercepts per row and slopes per method for error and time; feature scaling; margin."""
+
+    rows: dict[str, dict]                       # key -> {"method", "setting", "a", "c"}
+    slopes: dict[str, list[float]]              # method -> b (over FEATURES, standardised)
+    time_slopes: dict[str, list[float]]         # method -> d (over TIME_FEATURES, standardised)
+    mean: dict[str, float]
+    scale: dict[str, float]
+    margin: float = 1.0                          # predicted error x margin <= budget counts as meeting it
+    ridge: float = 1.0
+    scenes: dict[str, dict] = field(default_factory=dict)  # the features of the scenes fitted on
+
+    def _x(self, features: dict, names) -> np.ndarray:
+        return np.array([(features[k] - self.mean[k]) / self.scale[k] for k in names])
+
+    def predict(self, key: str, features: dict) -> tuple[float, float]:
+        """(rel_rmse_8, ms) the model expects of row `key` on a scene with these features."""
+        row = self.rows[key]
+        err = row["a"] + float(np.dot(self.slopes[row["method"]], self._x(features, FEATURES)))
+        ms = row["c"] + float(np.dot(self.time_slopes[row["method"]], self._x(features, TIME_FEATURES)))
+        return math.exp(err), math.exp(ms)
+
+    def to_json(self) -> dict:
+        return {"rows": self.rows, "slopes": self.slopes, "time_slopes": self.time_slopes, "mean": self.mean,
+                "scale": self.scale, "margin": self.margin, "ridge": self.ridge, "scenes": self.scenes,
+                "features": list(FEATURES), "time_features": list(TIME_FEATURES)}
+
+    @classmethod
+    def from_json(cls, data: dict) -> Model:
+        if data.get("features") != list(FEATURES) or data.get("time_features") != list(TIME_FEATURES):
+            raise ConfigError("the choice model was fitted on other features: re-run tools/fit_choice.py")
+        return cls(rows=data["rows"], slopes=data["slopes"], time_slopes=data["time_slopes"], mean=data["mean"],
+                   scale=data["scale"], margin=data["margin"], ridge=data["ridge"], scenes=data["scenes"])
+
+
+def load(path: Path = MODEL_PATH) -> Model:
+    if not path.is_file():
+        raise ConfigError(f"no choice model at {path}: run tools/fit_choice.py")
+    return Model.from_json(json.loads(path.read_text()))
+
+
+def fit(records: list[dict], features: dict[str, dict], ridge: float = 1.0) -> Model:
+    """Fit on benchmark records ({"scene", "method", "setting", "rel_rmse_8", "total_ms"}; rows without
+    an error are skipped) and the features of their scenes. Margin 1 (set by the evaluation)."""
+    recs = [r for r in records if r.get("rel_rmse_8") and r["scene"] in features and r.get("total_ms")]
+    if not recs:
+        raise ConfigError("no benchmark records with errors to fit on")
+    names = sorted({k for k in (*FEATURES, *TIME_FEATURES)})
+    table = np.array([[features[s][k] for k in names] for s in sorted(features)])
+    mean = {k: float(table[:, i].mean()) for i, k in enumerate(names)}
+    scale = {k: float(table[:, i].std()) or 1.0 for i, k in enumerate(names)}
+    keys = sorted({row_key(r["method"], r["setting"]) for r in recs})
+    methods = sorted({r["method"] for r in recs})
+    model = Model(rows={}, slopes={}, time_slopes={}, mean=mean, scale=scale, ridge=ridge,
+                  scenes={s: features[s] for s in sorted({r["scene"] for r in recs})})
+
+    def solve(names_used, target):
+        nk, nf = len(keys), len(names_used)
+        x = np.zeros((len(recs), nk + len(methods) * nf))
+        for i, r in enumerate(recs):
+            x[i, keys.index(row_key(r["method"], r["setting"]))] = 1.0
+            m = methods.index(r["method"])
+            x[i, nk + m * nf: nk + (m + 1) * nf] = model._x(features[r["scene"]], names_used)
+        y = np.array([math.log(target(r)) for r in recs])
+        penalised = np.r_[np.zeros(nk), np.ones(len(methods) * nf)]
+        w = _ridge(x, y, penalised, ridge)
+        return w[:nk], {m: w[nk + i * nf: nk + (i + 1) * nf].tolist() for i, m in enumerate(methods)}
+
+    a, model.slopes = solve(FEATURES, lambda r: r["rel_rmse_8"])
+    c, model.time_slopes = solve(TIME_FEATURES, lambda r: r["total_ms"])
+    for i, key in enumerate(keys):
+        r = next(r for r in recs if row_key(r["method"], r["setting"]) == key)
+        model.rows[key] = {"method": r["method"], "setting": r["setting"], "a": float(a[i]), "c": float(c[i])}
+    return model
+
+
+# -- the choice -----------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Choice:
+    key: str
+    method: str
+    setting: dict
+    predicted_rel_rmse_8: float   # the model's expectation
+    predicted_ms: float
+    meets_budget: bool
+    why: str
+
+
+def choose(model: Model, features: dict, error_budget: float | None = None,
+           time_budget_ms: float | None = None, methods: tuple[str, ...] | None = None) -> Choice:
+    """The fastest row whose predicted error x margin is within `error_budget`, or the least error
+    among the rows predicted within `time_budget_ms` (exactly one budget). When no row meets it: the
+    row closest to it (least error, or least time), with meets_budget False and why saying so."""
+    if (error_budget is None) == (time_budget_ms is None):
+        raise ConfigError("give exactly one of an error budget and a time budget")
+    preds = [(k, *model.predict(k, features)) for k, row in model.rows.items()
+             if methods is None or row["method"] in methods]
+    if not preds:
+        raise ConfigError("the choice model has no row of the methods allowed")
+    if error_budget is not None:
+        ok = [p for p in preds if p[1] * model.margin <= error_budget]
+        if ok:
+            k, err, ms = min(ok, key=lambda p: p[2])
+            why = (f"fastest of {len(ok)} settings expected within rel_rmse_8 {error_budget:g} "
+                   f"(x{model.margin:.2f} margin): {err:.3f}, ~{ms:.0f} ms")
+        else:
+            k, err, ms = min(preds, key=lambda p: p[1])
+            why = f"no setting is expected within rel_rmse_8 {error_budget:g}: the most accurate, {err:.3f}"
+        met = bool(ok)
+    else:
+        ok = [p for p in preds if p[2] <= time_budget_ms]
+        if ok:
+            k, err, ms = min(ok, key=lambda p: p[1])
+            why = f"least expected error of {len(ok)} settings within {time_budget_ms:g} ms: {err:.3f}, ~{ms:.0f} ms"
+        else:
+            k, err, ms = min(preds, key=lambda p: p[2])
+            why = f"no setting is expected within {time_budget_ms:g} ms: the fastest, ~{ms:.0f} ms"
+        met = bool(ok)
+    row = model.rows[k]
+    return Choice(k, row["method"], dict(row["setting"]), err, ms, met, why)

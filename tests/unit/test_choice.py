@@ -1,0 +1,155 @@
+"""The method-choice model (addon/engine/choice.py): its scene features on scenes with known answers,
+the fit on data made by a known model, and the choice for error and time budgets."""
+
+import math
+
+import numpy as np
+import pytest
+
+from addon.engine import choice
+from addon.engine.config import RsmConfig
+from addon.engine.errors import ConfigError
+from addon.engine.scene import Light, Scene
+
+
+def quad(a, b, c, d):
+    return [[a, b, c], [a, c, d]]
+
+
+def closed_box(lo=-1.0, hi=1.0):
+    """The six faces of the cube [lo, hi]^3 as 12 triangles."""
+    p = np.array([[x, y, z] for x in (lo, hi) for y in (lo, hi) for z in (lo, hi)], float)
+    faces = [(0, 1, 3, 2), (4, 5, 7, 6), (0, 1, 5, 4), (2, 3, 7, 6), (0, 2, 6, 4), (1, 3, 7, 5)]
+    return np.array([t for f in faces for t in quad(*p[list(f)])], np.float32)
+
+
+def scene_of(triangles, lights=(), emission=None, world=(0.0, 0.0, 0.0)):
+    n = len(triangles)
+    return Scene(positions_m=triangles, normals=np.zeros_like(triangles), albedo=np.full((n, 3), 0.5, np.float32),
+                 emission=np.zeros((n, 3), np.float32) if emission is None else emission, lights=list(lights),
+                 world_color=np.array(world, np.float32))
+
+
+def test_fibonacci_directions_are_unit_and_balanced():
+    # The spiral's points are unit vectors whose mean is the origin up to the spiral's O(1/n) imbalance.
+    d = choice.fibonacci_directions(64)
+    assert np.allclose(np.linalg.norm(d, axis=1), 1.0, atol=1e-12)
+    assert np.linalg.norm(d.mean(axis=0)) < 1.0 / 64
+
+
+def test_rays_from_inside_a_closed_box_all_hit_and_a_floor_takes_half():
+    # Exact answers: every ray from the centre of a closed cube meets a face; from above an infinite-like
+    # floor exactly the downward half (the spiral has 32 points with z < 0 of 64).
+    dirs = choice.fibonacci_directions(64)
+    assert choice.rays_hit(np.zeros(3), dirs, closed_box()).all()
+    floor = np.array(quad(*np.array([[-1e4, -1e4, 0], [1e4, -1e4, 0], [1e4, 1e4, 0], [-1e4, 1e4, 0]])), np.float32)
+    hit = choice.rays_hit(np.array([0.0, 0.0, 1.0]), dirs, floor)
+    assert hit.sum() == 32 and np.all(hit == (dirs[:, 2] < 0))
+
+
+def test_rays_hit_is_the_same_in_any_chunking():
+    dirs = choice.fibonacci_directions(64)
+    tris = closed_box()[:7]  # an open box: some rays escape
+    assert np.array_equal(choice.rays_hit(np.zeros(3), dirs, tris, chunk=2), choice.rays_hit(np.zeros(3), dirs, tris))
+
+
+def test_enclosure_of_a_closed_box_is_one_and_of_a_lone_triangle_small():
+    box = choice.scene_features(scene_of(closed_box(), [Light("POINT", np.zeros(3), np.array([0, 0, -1.0]),
+                                                               np.ones(3), power_w=10.0)]))
+    assert box["enclosure"] == 1.0
+    tri = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], np.float32)
+    lone = choice.scene_features(scene_of(tri))
+    assert lone["enclosure"] <= 0.5  # at most the half of the sphere below the plane, from points on it
+
+
+def test_light_shares_name_the_only_source():
+    point = Light("POINT", np.zeros(3), np.array([0, 0, -1.0]), np.ones(3), power_w=100.0)
+    shares = choice.light_shares(scene_of(closed_box(), [point]))
+    assert shares == {"lamp": 1.0, "sun": 0.0, "world": 0.0, "shaped": 0.0}
+    world = choice.light_shares(scene_of(closed_box(), world=(0.05, 0.05, 0.05)))
+    assert world["world"] == 1.0
+    glow = np.zeros((12, 3), np.float32)
+    glow[0] = 1.0
+    assert choice.light_shares(scene_of(closed_box(), emission=glow))["shaped"] == 1.0
+
+
+def test_light_faces_count_what_light_views_render():
+    # A point light: six cube faces; a sun: one; a 2 x 2 area light: 4 patches x 5 faces (the one
+    # behind the emitter dropped).
+    box = closed_box()
+    point = Light("POINT", np.zeros(3), np.array([0, 0, -1.0]), np.ones(3), power_w=10.0)
+    sun = Light("SUN", np.zeros(3), np.array([0, 0, -1.0]), np.ones(3), sun_strength=1.0)
+    area = Light("AREA", np.array([0, 0, 0.9]), np.array([0, 0, -1.0]), np.ones(3), power_w=10.0,
+                 size_x_m=0.5, size_y_m=0.5)
+    rsm = RsmConfig(area_patches=2, world_suns=0)
+    assert choice.light_faces(scene_of(box, [point]), rsm) == 6
+    assert choice.light_faces(scene_of(box, [sun]), rsm) == 1
+    assert choice.light_faces(scene_of(box, [area]), rsm) == 4 * 5
+
+
+def synthetic(rows, scenes, a, b, c):
+    """Records made by the model's own form with known a (per row), b (one slope per feature) and c."""
+    recs = []
+    for s, f in scenes.items():
+        x = np.array([f[k] for k in choice.FEATURES])
+        for k, (method, setting) in rows.items():
+            recs.append({"scene": s, "method": method, "setting": setting,
+                         "rel_rmse_8": math.exp(a[k] + b @ x), "total_ms": math.exp(c[k])})
+    return recs
+
+
+def features(rng):
+    f = {k: float(rng.uniform(0, 1)) for k in choice.FEATURES}
+    f.update({k: float(rng.uniform(1, 3)) for k in choice.TIME_FEATURES})
+    return f
+
+
+def test_fit_recovers_a_noiseless_model():
+    # Records generated by log err = a_row + b . x with one method: with a negligible ridge the fit
+    # reproduces every record's error (the design has more records than unknowns) to 1e-6 relative.
+    rng = np.random.default_rng(1)
+    scenes = {f"s{i}": features(rng) for i in range(12)}
+    rows = {"m x=1": ("m", {"g.x": 1}), "m x=2": ("m", {"g.x": 2}), "m x=3": ("m", {"g.x": 3})}
+    a = {"m x=1": -1.0, "m x=2": -2.0, "m x=3": -3.0}
+    c = {"m x=1": 1.0, "m x=2": 2.0, "m x=3": 3.0}
+    b = rng.normal(0, 0.5, len(choice.FEATURES))
+    recs = synthetic(rows, scenes, a, b, c)
+    model = choice.fit(recs, scenes, ridge=1e-9)
+    for r in recs:
+        err, ms = model.predict(choice.row_key(r["method"], r["setting"]), scenes[r["scene"]])
+        assert err == pytest.approx(r["rel_rmse_8"], rel=1e-6)
+        assert ms == pytest.approx(r["total_ms"], rel=1e-6)
+
+
+def test_choose_the_fastest_within_an_error_budget_and_the_best_within_a_time_budget():
+    rng = np.random.default_rng(2)
+    scenes = {f"s{i}": features(rng) for i in range(6)}
+    rows = {"m x=1": ("m", {"g.x": 1}), "m x=2": ("m", {"g.x": 2}), "m x=3": ("m", {"g.x": 3})}
+    # errors 0.3, 0.15, 0.05 on every scene; times 10, 100, 1000 ms
+    a = {"m x=1": math.log(0.3), "m x=2": math.log(0.15), "m x=3": math.log(0.05)}
+    c = {"m x=1": math.log(10), "m x=2": math.log(100), "m x=3": math.log(1000)}
+    model = choice.fit(synthetic(rows, scenes, a, np.zeros(len(choice.FEATURES)), c), scenes, ridge=1e-9)
+    f = scenes["s0"]
+    assert choice.choose(model, f, error_budget=0.2).key == "m x=2"
+    assert choice.choose(model, f, error_budget=0.4).key == "m x=1"
+    assert choice.choose(model, f, time_budget_ms=500).key == "m x=2"
+    model.margin = 1.5  # 0.15 x 1.5 > 0.2: only the slow row is expected within 0.2
+    assert choice.choose(model, f, error_budget=0.2).key == "m x=3"
+    miss = choice.choose(model, f, error_budget=0.01)
+    assert miss.key == "m x=3" and not miss.meets_budget and "no setting" in miss.why
+    with pytest.raises(ConfigError):
+        choice.choose(model, f)
+    with pytest.raises(ConfigError):
+        choice.choose(model, f, error_budget=0.1, time_budget_ms=10)
+
+
+def test_model_round_trips_through_json():
+    rng = np.random.default_rng(3)
+    scenes = {f"s{i}": features(rng) for i in range(4)}
+    rows = {"m x=1": ("m", {"g.x": 1}), "n y=2": ("n", {"h.y": 2})}
+    recs = synthetic(rows, scenes, {"m x=1": -1.0, "n y=2": -2.0}, np.ones(len(choice.FEATURES)) * 0.1,
+                     {"m x=1": 1.0, "n y=2": 2.0})
+    model = choice.fit(recs, scenes)
+    again = choice.Model.from_json(model.to_json())
+    for k in model.rows:
+        assert again.predict(k, scenes["s1"]) == model.predict(k, scenes["s1"])
