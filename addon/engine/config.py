@@ -143,6 +143,21 @@ class VctConfig(_Validated):
 
 
 @dataclass(frozen=True)
+class DiffusionConfig(_Validated):
+    """Volume diffusion (method `diffusion`, paper 000): docs/DIFFUSION.md derives the transport."""
+
+    grid_cells: int = _num(32, 8, 256, "diffusion cells along the scene's longest side")
+    # Light moves at most one cell per step, and this transport scatters it sideways at every cell, so
+    # a bounce that crosses a room of Y cells needs several times Y steps to settle (docs/DIFFUSION.md,
+    # "Steps"): what is still in flight after the last step is lost.
+    steps_per_bounce: int = _num(0, 0, 4096, "propagation steps per bounce (0: span_multiple x the grid's longest "
+                                 "side)")
+    span_multiple: float = _num(2.0, 0.25, 16.0, "with steps_per_bounce 0: steps per bounce as a multiple of the "
+                                "grid's longest side (1: the paper's rule)")
+    max_steps: int = _num(512, 1, 8192, "cap on the steps of all bounces together")
+
+
+@dataclass(frozen=True)
 class GIConfig(_Validated):
     """What to compute and at which output resolution."""
 
@@ -166,7 +181,8 @@ class GIConfig(_Validated):
 
 # Settings group -> its config class: the Blender property groups (scene.bounce.<group>), the command
 # line's flags and the registry's `reads` use these names.
-GROUPS: dict[str, type] = {"gi": GIConfig, "rsm": RsmConfig, "lpv": LpvConfig, "vct": VctConfig}
+GROUPS: dict[str, type] = {"gi": GIConfig, "rsm": RsmConfig, "lpv": LpvConfig, "vct": VctConfig,
+                           "diffusion": DiffusionConfig}
 
 
 def settings(**configs) -> dict[str, Any]:

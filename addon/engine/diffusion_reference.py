@@ -84,6 +84,37 @@ def cells(occupied: np.ndarray, vox_normal: np.ndarray, vox_projected: np.ndarra
 
 
 # -- emitters ------------------------------------------------------------------------------------------
+def inject(grid, positions_m: np.ndarray, normals: np.ndarray, flux_w: np.ndarray, cell: dict):
+    """(flux on the plus side, on the minus side) per cell (z, y, x) from VPLs (n, 3) m, unit normals,
+    flux (n,) W: each in the cell holding it, or half a cell behind it (-0.5 h n) when that one is
+    occupied and its own is not, on the side of the cell's plane its normal faces (plus on ties and in
+    empty cells); VPLs outside the grid are dropped."""
+    occ = cell["occupied"]
+    dims = np.array(grid.dims)
+    g = (np.asarray(positions_m, np.float64) - grid.origin_m) / grid.cell_size_m
+    plus = np.zeros(occ.shape)
+    minus = np.zeros(occ.shape)
+
+    def occupied_at(c):
+        inside = np.all((c >= 0) & (c < dims), axis=1)
+        cc = np.clip(c, 0, dims - 1)
+        return inside & occ[cc[:, 2], cc[:, 1], cc[:, 0]], inside
+
+    c = np.floor(g).astype(int)
+    here, inside = occupied_at(c)
+    behind = np.floor(g - 0.5 * np.asarray(normals)).astype(int)
+    there, inside_behind = occupied_at(behind)
+    use_behind = ~here & there
+    c = np.where(use_behind[:, None], behind, c)
+    inside = np.where(use_behind, inside_behind, inside)
+    cc = np.clip(c, 0, dims - 1)
+    n_cell = cell["normal"][cc[:, 2], cc[:, 1], cc[:, 0]]
+    on_plus = np.sum(normals * n_cell, axis=1) >= 0.0
+    for side, sel in ((plus, inside & on_plus), (minus, inside & ~on_plus)):
+        np.add.at(side, (c[sel, 2], c[sel, 1], c[sel, 0]), np.asarray(flux_w)[sel])
+    return plus, minus
+
+
 def emit(flux_plus: np.ndarray, flux_minus: np.ndarray, normal: np.ndarray, occupied: np.ndarray,
          albedo: np.ndarray | float = 1.0) -> np.ndarray:
     """The field of Lambertian emitters (z, y, x, 4): each side of a cell's plane reflects albedo x its

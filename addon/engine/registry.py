@@ -84,6 +84,12 @@ METHODS: tuple[MethodSpec, ...] = (
         # filtered injection (four points per VPL: no flicker as lights move, slower).
         bench=({"vct.voxel_cells": 64}, {"vct.voxel_cells": 64, "vct.gather_scale": 2}, {"vct.voxel_cells": 128},
                {"vct.voxel_cells": 64, "vct.filtered_injection": True})),
+    MethodSpec(
+        name="diffusion", summary="occupancy-aware SH diffusion through the voxels, re-emitted at surfaces (paper 000)",
+        module="diffusion", class_name="DiffusionMethod", products=("direct", "indirect", "albedo"), max_bounces=8,
+        reads=(*_IMAGE, "gi.bounces", *_LIGHT_VIEWS, "diffusion.*"),
+        # Three grids at the default steps (docs/DIFFUSION.md), and the paper's step rule at 32 cells.
+        bench=({"diffusion.grid_cells": 16}, {}, {"diffusion.grid_cells": 64}, {"diffusion.span_multiple": 1.0})),
 )
 
 NAMES: tuple[str, ...] = tuple(m.name for m in METHODS)

@@ -22,6 +22,9 @@ CASES = {
     "lpv-2-bounces": ("lpv", {"bounces": 2}, {"grid_cells": 16}, {}, False),
     "vct": ("vct", {}, {}, {"voxel_cells": 16, "diffuse_cones": 6}, True),
     "vct-2-bounces": ("vct", {"bounces": 2}, {}, {"voxel_cells": 16, "diffuse_cones": 6}, True),
+    # diffusion (16 cells, _method): its light field does not depend on the camera, bounces included.
+    "diffusion": ("diffusion", {}, {}, {}, True),
+    "diffusion-2-bounces": ("diffusion", {"bounces": 2}, {}, {}, True),
 }
 
 
@@ -46,12 +49,12 @@ def cornell_scene():
 
 def _method(gl, case):
     from addon.engine import methods
-    from addon.engine.config import GIConfig, LpvConfig, RsmConfig, VctConfig
+    from addon.engine.config import DiffusionConfig, GIConfig, LpvConfig, RsmConfig, VctConfig
 
     name, gi, lpv, vct, _ = CASES[case]
     return methods.create(gl, {"gi": GIConfig(method=name, resolution=32, **gi),
                                "rsm": RsmConfig(resolution=64, vpl_samples=16), "lpv": LpvConfig(**lpv),
-                               "vct": VctConfig(**vct)})
+                               "vct": VctConfig(**vct), "diffusion": DiffusionConfig(grid_cells=16)})
 
 
 def _fresh_images(gl, case, scene):

@@ -47,9 +47,11 @@ def test_register_unregister_twice_leaves_nothing_behind(bounce, fresh_blend):
     before = _handler_counts()
     assert "load_post" in before and "depsgraph_update_post" in before
     classes = _all_classes(bounce)
-    # 5 property groups (gi, rsm, lpv, vct, settings), 2 operators (report_renderer, bake),
-    # 3 panels (main, its viewport sub-panel, the sidebar tab)
-    assert len(classes) == 10
+    # a property group per settings group (config.GROUPS) and one for them all, 2 operators
+    # (report_renderer, bake), 3 panels (main, its viewport sub-panel, the sidebar tab)
+    from addon.engine import config
+
+    assert len(classes) == len(config.GROUPS) + 1 + 2 + 3
     for _ in range(2):
         bounce.register()
         try:

@@ -6,7 +6,7 @@ import pytest
 from addon.cli import build_parser
 from addon.commands import _settings
 from addon.engine import config
-from addon.engine.config import GIConfig, LpvConfig, RsmConfig, VctConfig
+from addon.engine.config import DiffusionConfig, GIConfig, LpvConfig, RsmConfig, VctConfig
 
 CONFIG_COMMANDS = ("render", "bake")  # the commands that build all four configs
 
@@ -32,7 +32,7 @@ def other_value(setting):
 
 
 def test_the_schema_covers_the_four_configs():
-    assert set(_settings.CONFIGS) == {GIConfig, RsmConfig, LpvConfig, VctConfig}
+    assert set(_settings.CONFIGS) == {GIConfig, RsmConfig, LpvConfig, VctConfig, DiffusionConfig}
 
 
 @pytest.mark.parametrize("field", every_field(), ids=lambda f: f"{f[0].__name__}.{f[1]}")
@@ -85,7 +85,7 @@ def test_help_shows_choices_defaults_and_ranges(capsys):
         build_parser().parse_args(["render", "--help"])
     text = " ".join(capsys.readouterr().out.split())  # argparse wraps lines
     assert "--grid-cells INT, --grid INT" in text
-    assert "range [8, 256] (default: 32; LpvConfig.grid_cells)" in text
+    assert "range [8, 256] (default: 32; LpvConfig.grid_cells, DiffusionConfig.grid_cells)" in text
     assert "--visibility {none,voxel}" in text and "one of none, voxel (default: none;" in text
     assert f"(default: {GIConfig().method}; GIConfig.method)" in text
     assert "--far-field, --no-far-field" in text and "(default: on; LpvConfig.far_field)" in text

@@ -1,0 +1,105 @@
+"""Method `diffusion`: occupancy-aware volume diffusion (Mavridis, Gaitatzes, Papaioannou; seeds 000).
+
+Passes: those of `direct` (G-buffer, per light face: rsm, direct_light); once per geometry change the
+shared voxelizer (voxelize) and diffusion_cells (each cell's plane, absorption and open faces); per RSM
+face diffusion_inject (its VPLs' flux onto the sides of their cells' planes); once per update, for each
+bounce: diffusion_emit (the sides' flux as Lambertian L1 SH lobes about their normals: the injected
+direct light, then each bounce's absorbed flux times albedo), steps x diffusion_propagate (gather form,
+ping-pong, absorbed flux accumulated per side), and the bounce added to the light field
+(diffusion_propagate.add); the gather: diffusion_lookup -> `indirect` (Cycles' Diffuse Indirect). The
+light field does not depend on the camera: a camera move re-runs only the lookup.
+docs/DIFFUSION.md derives the transport and measures it; diffusion_reference.py is its numpy twin.
+
+Products: direct, indirect, albedo.
+"""
+
+from __future__ import annotations
+
+from .. import registry
+from ..config import DiffusionConfig
+from ..grid import Grid
+from ..passes import (
+    atlas,
+    declare,
+    diffusion_cells,
+    diffusion_inject,
+    diffusion_lookup,
+    diffusion_propagate,
+    voxelize,
+    zero,
+)
+from ..passes.light_views import LightView
+from ..passes.voxelize import Voxelizer
+from .direct import OneBounceMethod
+
+
+def steps_per_bounce(config: DiffusionConfig, grid: Grid, bounces: int) -> int:
+    """Steps each bounce propagates: steps_per_bounce, or span_multiple x the grid's longest side (light
+    moves one cell per step: the paper's rule is n bounces across Y cells in n x Y steps), all bounces
+    together at most max_steps (and each at least one)."""
+    per_bounce = config.steps_per_bounce or max(1, round(config.span_multiple * max(grid.dims)))
+    return max(1, min(per_bounce, config.max_steps // bounces))
+
+
+class DiffusionMethod(OneBounceMethod):
+    spec = registry.get("diffusion")
+    PASSES = declare.extend(OneBounceMethod.PASSES, setup=(voxelize.DECL, diffusion_cells.DECL),
+                            solve=(diffusion_inject.DECL, diffusion_inject.EMIT_DECL, diffusion_propagate.DECL),
+                            gather=(diffusion_lookup.DECL,))
+
+    def __init__(self, backend, gi, rsm_config, diffusion_config: DiffusionConfig | None = None):
+        super().__init__(backend, gi, rsm_config)
+        self.diffusion_config = diffusion_config if diffusion_config is not None else DiffusionConfig()
+        self.grid: Grid | None = None
+
+    def set_scene(self, scene) -> None:
+        """Upload the scene; while the grid (fitted to the bounds) stays, the voxelizer redraws only the
+        slabs the changed triangles reach (as vct's)."""
+        super().set_scene(scene)
+        be = self.backend
+        grid = Grid.fit(*self.bounds_m, max_cells=self.diffusion_config.grid_cells)
+        if grid.same_cells(self.grid):
+            self.voxelizer.update(self.scene)
+        else:
+            self.grid = grid
+            self.voxelizer = Voxelizer(be, grid)
+            self.voxelizer.set_scene(self.scene)
+            self.cells = diffusion_cells.textures(be, grid)
+            self.atlas, self.injected, self._inject_target = diffusion_inject.atlas_target(be, grid)
+            self.snapshots = [{f"sh_{c}": be.texture(grid.dims) for c in "rgb"} for _ in range(2)]
+            self.absorbed = diffusion_propagate.sides(be, grid)  # one bounce's
+            self.accumulated = diffusion_propagate.sides(be, grid) if self.gi.bounces > 1 else self.absorbed
+            self._points = atlas.texel_points(be, self.rsm_config.resolution, diffusion_inject.SPEC)
+        self.voxels = self.voxelizer.run()
+        diffusion_cells.run(be, self.voxels, self.cells, self.grid)
+
+    def begin_solve(self, timings: dict[str, float]) -> None:
+        zero.images(self.backend, list(self.injected.values()))
+
+    def solve_view(self, view: LightView, timings: dict[str, float]) -> None:
+        with self.step(timings, diffusion_inject.DECL):
+            diffusion_inject.run(self.backend, self._inject_target, self._points, self.rsm, self.grid, self.atlas,
+                                 self.cells["cell_normal"])
+
+    def finish_solve(self, timings: dict[str, float]) -> None:
+        """Each bounce: emitters (the injected light, then the last bounce's absorbed flux x albedo), its
+        propagation into `absorbed`, added to `accumulated` (the same volumes with one bounce)."""
+        be, grid = self.backend, self.grid
+        steps = steps_per_bounce(self.diffusion_config, grid, self.gi.bounces)
+        for bounce in range(1, self.gi.bounces + 1):
+            with self.step(timings, diffusion_inject.EMIT_DECL):
+                if bounce == 1:
+                    diffusion_inject.emit(be, self.injected, self.cells, self.snapshots[0], grid, atlas=self.atlas)
+                else:
+                    diffusion_inject.emit(be, self.absorbed, self.cells, self.snapshots[0], grid,
+                                          vox_albedo=self.voxels["vox_albedo"])
+            with self.step(timings, diffusion_propagate.DECL):
+                for i in range(steps):
+                    diffusion_propagate.run(be, self.snapshots[i % 2], self.snapshots[(i + 1) % 2], self.absorbed,
+                                            self.cells, grid, first_step=i == 0)
+                if self.accumulated is not self.absorbed:
+                    diffusion_propagate.add(be, self.absorbed, self.accumulated, grid, first=bounce == 1)
+
+    def gather_pixels(self, timings: dict[str, float]) -> None:
+        with self.step(timings, diffusion_lookup.DECL):
+            diffusion_lookup.run(self.backend, self.gbuf, self.cells, self.accumulated, self.indirect, self.grid)

@@ -1,0 +1,82 @@
+"""Diffusion injection and emitters: the cells' direct light as Lambertian L1 SH lobes about their planes.
+
+`run` (per RSM face): additive point splats of the face's VPLs (flux phi, W) into two RGBA32F atlases
+of the grid's layers (passes/atlas.py, the splat the LPV and VCT injections use): `flux_plus` and
+`flux_minus`, the flux each side of a cell's plane receives from its VPLs, the VPL in the cell holding
+its surface (or half a cell behind it when that one is empty), on the side its normal faces.
+`emit` (once per bounce): the flux on each side -> the snapshot `sh_r/g/b` (RGBA32F 3D, L1 SH of
+radiant intensity W/sr by direction of travel): flux / pi x the clamped-cosine lobe about that side's
+normal, times the voxels' albedo for later bounces (whose flux is what the surfaces absorbed); an empty
+cell emits isotropically. Twin: diffusion_reference.inject / emit.
+"""
+
+from __future__ import annotations
+
+from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
+from ..grid import Grid
+from .atlas import Atlas, splat, splat_spec
+from .declare import RSM, VOX_ALBEDO, PassDecl, Port
+from .diffusion_cells import CELL_BLOCK, CELL_NORMAL
+
+INJECTED = Port("diffusion", "injected", "RGBA32F", "atlas",
+                "VPL flux (W) on each side of a cell's plane, by layer tile")
+SNAPSHOT = Port("diffusion", "snapshots", "RGBA32F", "grid", "L1 SH of radiant intensity (W/sr) in each cell")
+
+SPEC = splat_spec("diffusion_inject", "diffusion/inject.vert.glsl", "diffusion/inject.frag.glsl",
+                  varyings=(Var("v_plus", "vec4"), Var("v_minus", "vec4")),
+                  outputs=(Var("out_plus", "vec4"), Var("out_minus", "vec4")),
+                  samplers=(Sampler("cell_normal", "3D"),))
+
+DECL = PassDecl("diffusion_inject", "solve", (*RSM, CELL_NORMAL), (INJECTED,),
+                "each face's VPLs splatted by side of their cell's plane")
+
+
+def _emit_spec(atlas: bool) -> ShaderSpec:
+    dim = "2D" if atlas else "3D"
+    samplers = (Sampler("flux_plus", dim), Sampler("flux_minus", dim), Sampler("cell_normal", "3D"),
+                Sampler("cell_block", "3D"))
+    uniforms = (Var("dims", "ivec3"),)
+    if atlas:
+        uniforms += (Var("tiles_x", "int"),)
+    else:
+        samplers += (Sampler("vox_albedo", "3D"),)
+    return ShaderSpec(name="diffusion_emit" + ("_atlas" if atlas else "_albedo"), compute="diffusion/emit.comp.glsl",
+                      local_size=(4, 4, 4), samplers=samplers,
+                      images=tuple(Image(f"sh_{c}", "3D", "RGBA32F", "write") for c in "rgb"), uniforms=uniforms,
+                      defines=(("ATLAS", "1"),) if atlas else (("ALBEDO", "1"),))
+
+
+# From the injection atlases (the first bounce: VPL flux is reflected light already), or from a bounce's
+# absorbed flux times the voxels' albedo (the next bounce).
+EMIT_SPECS = {True: _emit_spec(True), False: _emit_spec(False)}
+EMIT_DECL = PassDecl("diffusion_emit", "solve", (INJECTED, CELL_NORMAL, CELL_BLOCK, VOX_ALBEDO), (SNAPSHOT,),
+                     "each side's flux as a Lambertian lobe about its normal (x albedo for later bounces)")
+
+
+def atlas_target(backend: Backend, grid: Grid) -> tuple[Atlas, dict, object]:
+    """(Atlas, its textures keyed flux_plus / flux_minus, the framebuffer with them attached)."""
+    atlas = Atlas.for_grid(grid)
+    textures = {k: backend.texture(atlas.size) for k in ("flux_plus", "flux_minus")}
+    return atlas, textures, backend.target([textures["flux_plus"], textures["flux_minus"]])
+
+
+def run(backend: Backend, target, points, rsm: dict, grid: Grid, atlas: Atlas, cell_normal) -> None:
+    """Add one RSM face's VPLs to the atlases behind `target` (cleared by the caller per update)."""
+    splat(backend, SPEC, target, points, rsm, grid, atlas, {"cell_normal": cell_normal})
+
+
+def emit(backend: Backend, flux: dict, cells: dict, snapshot: dict, grid: Grid, atlas: Atlas | None = None,
+         vox_albedo=None) -> None:
+    """snapshot (sh_r/g/b) := the emitters of `flux` (flux_plus / flux_minus): the injection atlases
+    (`atlas` given), or volumes of absorbed flux re-emitted times `vox_albedo`. Every cell written."""
+    spec = EMIT_SPECS[atlas is not None]
+    samplers = {"flux_plus": flux["flux_plus"], "flux_minus": flux["flux_minus"], **cells}
+    uniforms = {"dims": grid.dims}
+    if atlas is not None:
+        uniforms["tiles_x"] = atlas.tiles_x
+    else:
+        samplers["vox_albedo"] = vox_albedo
+    backend.dispatch(backend.program(spec), group_count(grid.dims, spec.local_size), uniforms=uniforms,
+                     samplers=samplers, images=snapshot)
+
+

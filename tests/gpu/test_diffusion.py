@@ -1,0 +1,240 @@
+"""The `diffusion` passes (cells, inject, emit, propagate, add, lookup) against their numpy twin,
+addon/engine/diffusion_reference.py, whose own closed-form checks are tests/unit/test_diffusion_reference.py.
+
+The GPU computes in fp32 what the twin computes in float64: sums of a few dozen products of numbers of
+order 1, so 1e-5 relative to the largest value compared is several times the rounding seen and far
+below any error of the equations (a wrong face, side or weight changes values by > 1e-2 relative).
+Volumes read back as (z, y, x, 4) arrays.
+"""
+
+import numpy as np
+import pytest
+
+from addon.engine import diffusion_reference as ref
+from addon.engine import sh
+from addon.engine.grid import Grid
+from addon.engine.passes import atlas as atlas_pass
+from addon.engine.passes import diffusion_cells, diffusion_inject, diffusion_lookup, diffusion_propagate
+
+pytestmark = pytest.mark.gpu
+
+GRID = Grid(np.array([-1.0, 0.5, 0.0]), 0.5, (6, 5, 4))
+RTOL = 1e-5
+
+
+def zyx(grid, channels=4):
+    return (*reversed(grid.dims), channels)
+
+
+def random_voxels(rng, grid, share=0.35):
+    """Voxelizer-like volumes (z, y, x, 4): occupancy in albedo's alpha, unit or cancelled mean normals,
+    projected areas up to 1.5 cells^2 (more than a cell's cross-section: the clamp to 1 is exercised)."""
+    occ = rng.random(zyx(grid, 0)[:3]) < share
+    albedo = np.zeros(zyx(grid), np.float32)
+    albedo[..., :3] = rng.uniform(0.1, 0.9, zyx(grid, 3))
+    albedo[..., 3] = occ
+    normal = rng.normal(size=zyx(grid, 3))
+    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+    normal[rng.random(occ.shape) < 0.25] = 0.0
+    proj = rng.uniform(0.0, 1.5, zyx(grid, 3))
+    normal[~occ] = 0.0
+    proj[~occ] = 0.0
+    albedo[~occ] = 0.0
+    pad = np.zeros((*occ.shape, 1))
+    return {"vox_albedo": albedo, "vox_normal": np.concatenate([normal, pad + 1.0], -1).astype(np.float32),
+            "vox_projected": np.concatenate([proj, pad], -1).astype(np.float32)}
+
+
+def gpu_cells(gl, voxels, grid=GRID):
+    textures = {k: gl.texture(grid.dims, "RGBA32F", v) for k, v in voxels.items()}
+    cells = diffusion_cells.textures(gl, grid)
+    diffusion_cells.run(gl, textures, cells, grid)
+    return textures, cells
+
+
+def ref_cells(voxels):
+    return ref.cells(voxels["vox_albedo"][..., 3] > 0, voxels["vox_normal"], voxels["vox_projected"])
+
+
+def open_mask(cell):
+    return np.sum(cell["open"] * (1 << np.arange(6)), axis=-1)
+
+
+def test_cells_are_the_twins(gl):
+    rng = np.random.default_rng(1)
+    voxels = random_voxels(rng, GRID)
+    _, cells = gpu_cells(gl, voxels)
+    want = ref_cells(voxels)
+    normal, block = gl.read(cells["cell_normal"]), gl.read(cells["cell_block"])
+    assert want["occupied"].any() and (~want["occupied"]).any()
+    np.testing.assert_allclose(normal[..., :3], want["normal"], rtol=0, atol=1e-6)
+    np.testing.assert_allclose(normal[..., 3], want["area"], rtol=0, atol=1e-6)
+    np.testing.assert_allclose(block[..., :3], want["block"], rtol=0, atol=1e-7)
+    # w: 0 empty, else 1 + the open-face mask, exactly (small integers in fp32).
+    np.testing.assert_array_equal(block[..., 3], np.where(want["occupied"], 1 + open_mask(want), 0))
+
+
+def random_fields(rng, grid, emitters=10):
+    """Per channel, cells holding sums of clamped-cosine lobes (realizable, as the method's fields are)
+    plus some cone-shaped carried light."""
+    out = []
+    for _ in range(3):
+        v = np.zeros(zyx(grid))
+        for _ in range(emitters):
+            z, y, x = (rng.integers(0, n) for n in zyx(grid, 0)[:3])
+            n = rng.normal(size=3)
+            v[z, y, x] += rng.uniform(0.1, 2.0) * sh.cosine_lobe_l1(n / np.linalg.norm(n)) / np.pi
+            v[z, y, x] += rng.uniform(0.0, 1.0) * ref.CONES[rng.integers(6)]
+        out.append(v.astype(np.float32))
+    return out
+
+
+def sh_volumes(gl, grid, data=None):
+    d = data or [None] * 3
+    return {f"sh_{c}": gl.texture(grid.dims, "RGBA32F", x) for c, x in zip("rgb", d, strict=True)}
+
+
+def test_propagation_steps_are_the_twins(gl):
+    # Two steps through random cells: the next fields, and the absorbed flux written by the first step
+    # and added by the second (stale contents in the accumulation are overwritten by the first).
+    rng = np.random.default_rng(2)
+    voxels = random_voxels(rng, GRID)
+    _, cells = gpu_cells(gl, voxels)
+    fields = random_fields(rng, GRID)
+    sets = [sh_volumes(gl, GRID, fields), sh_volumes(gl, GRID)]
+    stale = np.full(zyx(GRID), 5.0, np.float32)
+    absorbed = {k: gl.texture(GRID.dims, "RGBA32F", stale) for k in ("flux_plus", "flux_minus")}
+    cell = ref_cells(voxels)
+    want = [np.asarray(f, np.float64) for f in fields]
+    plus, minus = np.zeros((3, *zyx(GRID, 0)[:3])), np.zeros((3, *zyx(GRID, 0)[:3]))
+    for i in range(2):
+        diffusion_propagate.run(gl, sets[i % 2], sets[(i + 1) % 2], absorbed, cells, GRID, first_step=i == 0)
+        for ch in range(3):
+            want[ch], p, m = ref.step(want[ch], cell)
+            plus[ch] += p
+            minus[ch] += m
+        got = [gl.read(sets[(i + 1) % 2][f"sh_{c}"]) for c in "rgb"]
+        for ch in range(3):
+            np.testing.assert_allclose(got[ch], want[ch], rtol=0, atol=RTOL * np.abs(want[ch]).max())
+    got_plus, got_minus = gl.read(absorbed["flux_plus"]), gl.read(absorbed["flux_minus"])
+    assert plus.sum() > 0 and minus.sum() > 0  # both sides are exercised
+    for ch in range(3):
+        np.testing.assert_allclose(got_plus[..., ch], plus[ch], rtol=0, atol=RTOL * plus.max())
+        np.testing.assert_allclose(got_minus[..., ch], minus[ch], rtol=0, atol=RTOL * minus.max())
+
+
+def test_emitters_are_the_twins(gl):
+    # From the injection atlas (no albedo: the VPLs' flux is reflected light already) and from absorbed
+    # flux volumes times the voxels' albedo; empty cells emit isotropically; every cell is written.
+    rng = np.random.default_rng(3)
+    voxels = random_voxels(rng, GRID)
+    textures, cells = gpu_cells(gl, voxels)
+    cell = ref_cells(voxels)
+    fp, fm = (rng.uniform(0.0, 2.0, zyx(GRID)).astype(np.float32) for _ in range(2))
+    atlas, injected, _ = diffusion_inject.atlas_target(gl, GRID)
+    assert atlas.tiles_x == 2  # 4 layers as 2 x 2 tiles: the tiling is exercised
+    tiles = {}
+    for name, vol in (("flux_plus", fp), ("flux_minus", fm)):
+        a = np.zeros((atlas.size[1], atlas.size[0], 4), np.float32)
+        nx, ny, _ = GRID.dims
+        for z in range(GRID.dims[2]):
+            tx, ty = z % atlas.tiles_x, z // atlas.tiles_x
+            a[ty * ny:(ty + 1) * ny, tx * nx:(tx + 1) * nx] = vol[z]
+        tiles[name] = gl.texture(atlas.size, "RGBA32F", a)
+    volumes = {"flux_plus": gl.texture(GRID.dims, "RGBA32F", fp), "flux_minus": gl.texture(GRID.dims, "RGBA32F", fm)}
+    for source, albedo in ((tiles, None), (volumes, voxels["vox_albedo"])):
+        out = sh_volumes(gl, GRID, [np.full(zyx(GRID), 9.0, np.float32)] * 3)
+        if albedo is None:
+            diffusion_inject.emit(gl, source, cells, out, GRID, atlas=atlas)
+        else:
+            diffusion_inject.emit(gl, source, cells, out, GRID, vox_albedo=textures["vox_albedo"])
+        for ch, c in enumerate("rgb"):
+            a = 1.0 if albedo is None else albedo[..., ch]
+            want = ref.emit(fp[..., ch], fm[..., ch], cell["normal"], cell["occupied"], a)
+            np.testing.assert_allclose(gl.read(out[f"sh_{c}"]), want, rtol=0, atol=RTOL * np.abs(want).max())
+
+
+def test_injection_is_the_twins(gl):
+    # 60 VPLs over a grid whose cells are half occupied: each in its cell or half a cell behind it, on
+    # the side of the plane its normal faces; VPLs outside the grid and empty texels add nothing.
+    rng = np.random.default_rng(4)
+    voxels = random_voxels(rng, GRID, share=0.5)
+    _, cells = gpu_cells(gl, voxels)
+    cell = ref_cells(voxels)
+    res, count = 8, 60
+    n = rng.normal(size=(count, 3))
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    p = GRID.origin_m + rng.uniform(-0.05, 1.05, size=(count, 3)) * GRID.extent_m
+    f = rng.uniform(0.1, 2.0, size=(count, 3))
+    pos, nrm, phi = (np.zeros((res, res, 4), np.float32) for _ in range(3))
+    texels = rng.choice(res * res, count, replace=False)
+    for k, t in enumerate(texels):
+        pos.reshape(-1, 4)[t] = [*p[k], 1.0]
+        nrm.reshape(-1, 4)[t] = [*n[k], 0.01]
+        phi.reshape(-1, 4)[t, :3] = f[k]
+    rsm = {k: gl.texture((res, res), "RGBA32F", a) for k, a in (("position", pos), ("normal", nrm), ("flux", phi))}
+    atlas, injected, target = diffusion_inject.atlas_target(gl, GRID)
+    gl.clear(target)
+    diffusion_inject.run(gl, target, atlas_pass.texel_points(gl, res, diffusion_inject.SPEC), rsm, GRID, atlas,
+                         cells["cell_normal"])
+    # Read through emit's atlas path into volumes: the same per-cell sums, then compare the lobes' flux
+    # per side via the twin's emitters.
+    out = sh_volumes(gl, GRID)
+    diffusion_inject.emit(gl, injected, cells, out, GRID, atlas=atlas)
+    p32, n32 = pos.reshape(-1, 4)[texels, :3].astype(np.float64), nrm.reshape(-1, 4)[texels, :3].astype(np.float64)
+    for ch, c in enumerate("rgb"):
+        plus, minus = ref.inject(GRID, p32, n32, f[:, ch], cell)
+        want = ref.emit(plus, minus, cell["normal"], cell["occupied"])
+        np.testing.assert_allclose(gl.read(out[f"sh_{c}"]), want, rtol=0, atol=RTOL * np.abs(want).max())
+    # Both rules ran: some VPLs in an occupied cell of their own, some moved half a cell behind.
+    cell_of = np.floor((p32 - GRID.origin_m) / GRID.cell_size_m).astype(int)
+    behind = np.floor((p32 - 0.5 * GRID.cell_size_m * n32 - GRID.origin_m) / GRID.cell_size_m).astype(int)
+    dims = np.array(GRID.dims)
+
+    def occupied(c):
+        inside = np.all((c >= 0) & (c < dims), axis=1)
+        c = np.clip(c, 0, dims - 1)
+        return inside & cell["occupied"][c[:, 2], c[:, 1], c[:, 0]]
+
+    assert occupied(cell_of).any() and (~occupied(cell_of) & occupied(behind)).any()
+
+
+def test_add_sums_bounces(gl):
+    rng = np.random.default_rng(5)
+    a, b = (rng.random(zyx(GRID)).astype(np.float32) for _ in range(2))
+    bounce = {k: gl.texture(GRID.dims, "RGBA32F", a) for k in ("flux_plus", "flux_minus")}
+    total = {k: gl.texture(GRID.dims, "RGBA32F", b) for k in ("flux_plus", "flux_minus")}
+    diffusion_propagate.add(gl, bounce, total, GRID, first=True)
+    np.testing.assert_array_equal(gl.read(total["flux_plus"]), a)
+    diffusion_propagate.add(gl, bounce, total, GRID, first=False)
+    np.testing.assert_allclose(gl.read(total["flux_minus"]), 2 * a, rtol=1e-7)
+
+
+def test_lookup_is_the_twins(gl):
+    # Points spread over the grid (some near no occupied cell: the 0 fallback; some whose normals are
+    # perpendicular to every neighbour's plane: the trilinear fallback) with random normals.
+    rng = np.random.default_rng(6)
+    voxels = random_voxels(rng, GRID, share=0.3)
+    _, cells = gpu_cells(gl, voxels)
+    cell = ref_cells(voxels)
+    fp, fm = (rng.uniform(0.0, 2.0, zyx(GRID)).astype(np.float32) for _ in range(2))
+    total = {"flux_plus": gl.texture(GRID.dims, "RGBA32F", fp), "flux_minus": gl.texture(GRID.dims, "RGBA32F", fm)}
+    w, h = 16, 8
+    pts = GRID.origin_m + rng.uniform(0.0, 1.0, size=(h * w, 3)) * GRID.extent_m
+    nrm = rng.normal(size=(h * w, 3))
+    nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+    pos = np.concatenate([pts, np.ones((h * w, 1))], 1).reshape(h, w, 4).astype(np.float32)
+    pos[0, :3, 3] = 0.0  # no geometry: written 0
+    gbuf = {"position": gl.texture((w, h), "RGBA32F", pos),
+            "normal": gl.texture((w, h), "RGBA32F", np.concatenate([nrm, np.zeros((h * w, 1))], 1)
+                                 .reshape(h, w, 4).astype(np.float32))}
+    indirect = gl.texture((w, h), "RGBA32F", np.full((h, w, 4), 3.0, np.float32))
+    diffusion_lookup.run(gl, gbuf, cells, total, indirect, GRID)
+    got = gl.read(indirect).reshape(-1, 4)
+    g = (pos.reshape(-1, 4)[:, :3].astype(np.float64) - GRID.origin_m) / GRID.cell_size_m
+    n64 = nrm.astype(np.float32).astype(np.float64)
+    for ch in range(3):
+        want = ref.lookup(g, n64, cell, fp[..., ch], fm[..., ch], GRID.cell_size_m ** 2)
+        want[:3] = 0.0
+        np.testing.assert_allclose(got[:, ch], want, rtol=0, atol=RTOL * want.max())
+    assert (got[3:, 0] == 0).any() and (got[3:, 0] > 0).any()  # both the fallback and the lookup ran
