@@ -121,6 +121,14 @@ class BOUNCE_PG_settings(bpy.types.PropertyGroup):
             name="Quality", description="Sets RSM resolution and VPL samples",
             items=[(k, *QUALITY_LABELS[k]) for k in QUALITY_PRESETS], default="BALANCED",
             update=_apply_quality),
+        "error_budget": FloatProperty(
+            name="Error Budget", description="Choose for Budget picks the fastest setting expected within this "
+            "relative error of a path tracer's indirect light (rel_rmse_8)", default=0.2, min=0.01, max=2.0,
+            subtype="FACTOR"),
+        # Written by Choose for Budget: the row it chose (the panel shows the note while the settings
+        # still are that row) and its line ("rsm (...): ~8 % from a path tracer").
+        "choice_row": StringProperty(name="Chosen Setting", default=""),
+        "choice_note": StringProperty(name="Choice", default=""),
         # Read-only: written by the live overlay outside Blender data (a draw callback may not write).
         "last_update_ms": FloatProperty(name="Last Update (ms)", description="Time of the last overlay update",
                                         get=lambda _self: _live_state().STATE.last_update_ms, precision=1),
@@ -142,6 +150,14 @@ def to_config(settings) -> dict:
     """scene.bounce -> {group: config} (config.settings' form); raises ConfigError as the engine would."""
     return {attr: cls(**{name: _from_blender(getattr(getattr(settings, attr), name)) for name in config.limits(cls)})
             for attr, cls in CONFIGS.items()}
+
+
+def set_from_config(settings, configs: dict) -> None:
+    """{group: config} -> scene.bounce: every field of every group (the inverse of to_config)."""
+    for attr, cfg in configs.items():
+        group = getattr(settings, attr)
+        for name, value in cfg.to_dict().items():
+            setattr(group, name, value)
 
 
 def register() -> None:

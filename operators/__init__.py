@@ -4,8 +4,9 @@ import bpy
 
 from .about import BOUNCE_OT_report_renderer
 from .bake import BOUNCE_OT_bake
+from .choose import BOUNCE_OT_choose
 
-classes = (BOUNCE_OT_report_renderer, BOUNCE_OT_bake)
+classes = (BOUNCE_OT_report_renderer, BOUNCE_OT_bake, BOUNCE_OT_choose)
 
 # Blender's own helper: registers in order, unregisters in reverse.
 register, unregister = bpy.utils.register_classes_factory(classes)

@@ -4,8 +4,21 @@ from __future__ import annotations
 
 import bpy
 
-from ..addon.engine import registry
-from ..addon.properties import CONFIGS
+from ..addon.engine import choice, registry
+from ..addon.engine.errors import BounceError
+from ..addon.properties import CONFIGS, to_config
+
+_model = []  # the choice model, loaded on the first draw that needs it
+
+
+def _still_chosen(settings) -> bool:
+    """Whether the settings are still the row Choose for Budget set (else its note no longer holds)."""
+    try:
+        if not _model:
+            _model.append(choice.load())
+        return choice.row_for(_model[0], to_config(settings)) == settings.choice_row
+    except BounceError:
+        return False
 
 
 class BOUNCE_PT_main(bpy.types.Panel):
@@ -37,6 +50,12 @@ class BOUNCE_PT_main(bpy.types.Panel):
                 column = settings_column.column(heading=attr.upper())
                 for name in names:
                     column.prop(group, name)
+        # Choosing serves bakes too: never greyed with the overlay.
+        row = layout.row(align=True)
+        row.prop(settings, "error_budget")
+        row.operator("bounce.choose", text="", icon="AUTO")
+        if settings.choice_note and _still_chosen(settings):
+            layout.label(text=settings.choice_note, icon="INFO")
         layout.operator("bounce.report_renderer", icon="INFO")
         box = layout.box()
         box.label(text="Bake (selected objects)", icon="RENDER_STILL")

@@ -39,7 +39,7 @@ PIP_PLATFORMS = {
 # What a zip holds: root file -> itself, package folder -> its files with these suffixes (no caches, no
 # data a user may have saved inside). The wheels are added from wheels/ by the manifest's list.
 ALLOWED_FILES = ("__init__.py", "blender_manifest.toml")
-ALLOWED_DIRS = {"addon": (".py",), "operators": (".py",), "panels": (".py",), "gpu_shaders": (".glsl",)}
+ALLOWED_DIRS = {"addon": (".py", ".json"), "operators": (".py",), "panels": (".py",), "gpu_shaders": (".glsl",)}
 
 _WHEELS_BLOCK = re.compile(r"^wheels = \[.*?^\]", re.MULTILINE | re.DOTALL)
 

@@ -24,7 +24,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-from ..engine import methods
+from ..engine import choice, methods
 from ..engine.config import settings as complete_settings
 from ..engine.errors import ConfigError, SceneError
 from ..engine.lightmap import PASSES, TARGETS, check_choice, dilate, output_path, safe_name, shard, uv_problems
@@ -168,8 +168,10 @@ def _default_camera(size: int) -> Camera:
 class Baker:
     """The scene captured and uploaded once; then bake_image / bake_vertex_colors per object."""
 
-    def __init__(self, backend, depsgraph, settings: dict, size: int = 512):
-        """settings: {group: config} (config.settings' form; missing groups take their defaults)."""
+    def __init__(self, backend, depsgraph, settings: dict, size: int = 512, budget: dict | None = None):
+        """settings: {group: config} (config.settings' form; missing groups take their defaults).
+        budget ({"error_budget": E} or {"time_budget_ms": T}): the method chosen for the scene
+        (engine/choice.py); `settings` and `decided` say what was run and why."""
         t0 = time.perf_counter()
         define_light_switch()
         self.depsgraph = depsgraph
@@ -177,7 +179,9 @@ class Baker:
         if scene.camera is None:
             scene.camera = _default_camera(size)  # only the G-buffer size is taken from it
         self.scene = scene
-        self.method = methods.create(backend, settings)
+        self.settings, self.decided = choice.decide(scene, complete_settings(**settings), size * size,
+                                                    **(budget or {}))
+        self.method = methods.create(backend, self.settings)
         self.method.set_scene(scene)
         self.texels = TexelBaker(self.method)
         self.setup_ms = (time.perf_counter() - t0) * 1e3
@@ -317,12 +321,13 @@ IMAGE_SIZE_TEXELS = 512  # a lightmap's side when none is given
 def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size: int | None = None,
               settings: dict | None = None, pass_name: str = "indirect",
               target: str = "image", overwrite: bool = False, shard_index: int = 0, shard_count: int = 1,
-              save_blend: Path | None = None, margin: int = 16, progress: bool = True, backend=None) -> dict:
+              save_blend: Path | None = None, margin: int = 16, progress: bool = True, backend=None,
+              budget: dict | None = None) -> dict:
     """Bake the objects of `blend` (see module docstring) into out_dir; returns the summary written to
     out_dir/bake.json. Per-object problems are recorded, never raised; bad arguments raise BounceError.
     size: the lightmap side (IMAGE_SIZE_TEXELS when None). settings: {group: config} (config.settings'
-    form; defaults for missing groups). A bake that yields no light is recorded under "warnings" and
-    told on stderr."""
+    form; defaults for missing groups). budget: the method chosen for the scene (Baker). A bake that
+    yields no light is recorded under "warnings" and told on stderr."""
     from .pipeline import backend as default_backend
     from .pipeline import open_blend
 
@@ -347,7 +352,8 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
     t0 = time.perf_counter()
     be = backend or default_backend()
     say(f"bake: capturing the scene, method {gi.method} setup")
-    baker = Baker(be, bpy.context.evaluated_depsgraph_get(), settings, size)
+    baker = Baker(be, bpy.context.evaluated_depsgraph_get(), settings, size, budget)
+    settings, gi = baker.settings, baker.settings["gi"]
     results = _bake_objects(baker, names, out_dir, size, pass_name, target, overwrite, margin, progress)
     saved = None
     if save_blend is not None and target == "vertex-colors":
@@ -361,6 +367,7 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
         "config": {group: config.to_dict() for group, config in settings.items()}, "renderer": be.renderer,
         "setup_ms": round(baker.setup_ms, 2), "total_ms": round((time.perf_counter() - t0) * 1e3, 2),
         "shard": [shard_index, shard_count], "saved_blend": saved, "solves": baker.method.solves,
+        **{k: v for k, v in baker.decided.items() if k != "features"},
         "scene_warnings": list(baker.scene.warnings), "warnings": warnings,
         "objects": {r.name: r.to_dict() for r in results},
     }

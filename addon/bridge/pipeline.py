@@ -16,7 +16,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-from ..engine import methods, registry
+from ..engine import choice, methods, registry
 from ..engine.backends.moderngl_backend import ModernGLBackend
 from ..engine.config import settings as complete_settings
 from ..engine.errors import SceneError
@@ -87,13 +87,17 @@ def update_costs(method, repeat: int) -> dict[str, float]:
 
 
 def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
-                progress: Callable[[str], None] = lambda step: None, profile_updates: bool = False) -> dict:
+                progress: Callable[[str], None] = lambda step: None, profile_updates: bool = False,
+                budget: dict | None = None) -> dict:
     """Render `blend` with {group: config} settings (config.settings' form; missing groups take their
     defaults); write <product>.exr for each product and stats.json; return stats.
 
     The timing is the median of `repeat` full updates after one warm-up (programs compiled, geometry
     uploaded): what a user waits for when a light moves. `progress(step)` is told each step. With
     profile_updates, stats["update_ms"] holds `update_costs` (full, lights, camera) over `repeat` runs.
+    budget ({"error_budget": E} or {"time_budget_ms": T}): the method and its settings are chosen for the
+    captured scene (engine/choice.py) and stats["choice"] says which and why; every render's stats carry
+    the choice model's `estimated_rel_rmse_8` where it knows the settings.
     """
     settings = complete_settings(**settings)
     gi = settings["gi"]
@@ -105,6 +109,10 @@ def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
         raise SceneError(f"{blend}: the scene has no camera")
     width, height = image_size(scene, gi.resolution)
     captured = SceneCache().update(bpy.context.evaluated_depsgraph_get(), width, height)
+    if budget:
+        progress("choosing the method for the budget")
+    settings, decided = choice.decide(captured, settings, width * height, **(budget or {}))
+    gi = settings["gi"]
     progress(f"method {gi.method}: uploading {captured.triangle_count} triangles, warm-up run (compiles shaders)")
     be = backend()
     method = methods.create(be, settings)
@@ -147,6 +155,8 @@ def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
         "samples": gi.samples,
         "refine_ms": refine_ms,  # the gathers after the first, all together
         **({"update_ms": update_ms} if update_ms is not None else {}),
+        **{k: v for k, v in decided.items() if k != "features"},
+        "scene_features": decided.get("features"),
         "renderer": be.renderer,
         "blender_version": bpy.app.version_string,
         "notes": notes,

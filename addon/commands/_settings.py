@@ -16,7 +16,7 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
-from ..engine import config
+from ..engine import choice, config
 from ..engine.config import GIConfig, LpvConfig, RsmConfig, VctConfig
 from ..engine.errors import ConfigError
 
@@ -35,6 +35,10 @@ _ALIASES = {
     (VctConfig, "diffuse_cones"): ("--cones",),
     (VctConfig, "offset_cells"): ("--cone-offset",),
 }
+
+# `--method auto`: the method and its settings chosen for a budget (engine/choice.py) after the scene
+# is captured; the configs are built with the default method until then.
+_EXTRA_CHOICES = {(GIConfig, "method"): (choice.AUTO,)}
 
 _GIVEN = "_settings_given"  # namespace attribute: the dests the user typed a flag for
 
@@ -97,7 +101,10 @@ def _setting(fields: list[tuple[type, str]]) -> Setting:
     bounds = {}
     if "min" in first:  # the range every field accepts
         bounds = {"lo": max(lim["min"] for lim in limits), "hi": min(lim["max"] for lim in limits)}
-    return Setting(flags, tuple(fields), first["default"], first["doc"], choices=first.get("choices"), **bounds)
+    choices = first.get("choices")
+    if choices is not None:
+        choices = (*choices, *_EXTRA_CHOICES.get((cls, name), ()))
+    return Setting(flags, tuple(fields), first["default"], first["doc"], choices=choices, **bounds)
 
 
 def _schema() -> tuple[Setting, ...]:
@@ -183,13 +190,44 @@ def flag_name(cls: type, name: str) -> str:
 
 def configs(args, **overrides) -> dict:
     """{group: config} (config.settings' form) from parsed args; overrides: {dest: value} replacing
-    parsed values."""
+    parsed values. `--method auto` builds the default method's configs (budget() says what to choose)."""
     values = {cls: {} for cls in CONFIGS}
     for setting in SETTINGS:
         value = overrides.get(setting.dest, getattr(args, setting.dest))
+        if (GIConfig, "method") in setting.fields and value == choice.AUTO:
+            value = GIConfig().method
         for cls, name in setting.fields:
             values[cls][name] = value
     return {group: cls(**values[cls]) for group, cls in config.GROUPS.items()}
+
+
+def add_budget_flags(parser) -> None:
+    """--error-budget / --time-budget, read with --method auto (engine/choice.py)."""
+    group = parser.add_argument_group("choice (with --method auto)", "the method and settings chosen for the scene")
+    group.add_argument("--error-budget", type=float, metavar="E",
+                       help="choose the fastest setting expected within rel_rmse_8 E of a path tracer (0 < E <= 2)")
+    group.add_argument("--time-budget", type=float, metavar="MS",
+                       help="choose the most accurate setting expected within MS milliseconds per update")
+
+
+def budget(args) -> dict | None:
+    """The budget of `--method auto` ({"error_budget": E} or {"time_budget_ms": T}), None without auto;
+    ConfigError naming the flags when they do not go together."""
+    auto = getattr(args, "method", None) == choice.AUTO
+    error, time_ms = getattr(args, "error_budget", None), getattr(args, "time_budget", None)
+    if not auto:
+        if error is not None or time_ms is not None:
+            raise ConfigError("--error-budget and --time-budget choose a method: give them with --method auto")
+        return None
+    if (error is None) == (time_ms is None):
+        raise ConfigError("--method auto needs exactly one of --error-budget E and --time-budget MS")
+    if error is not None:
+        if not 0.0 < error <= 2.0:  # also refuses NaN
+            raise ConfigError(f"--error-budget {error:g}: out of range (0, 2]")
+        return {"error_budget": error}
+    if not 0.0 < time_ms < float("inf"):
+        raise ConfigError(f"--time-budget {time_ms:g}: must be a positive number of milliseconds")
+    return {"time_budget_ms": time_ms}
 
 
 def in_flag_terms(message: str) -> str:

@@ -15,7 +15,7 @@ from ..engine.config import GIConfig
 from ..engine.errors import ConfigError, SceneError
 from ..engine.lightmap import PASSES, TARGETS, check_choice, parse_shard, safe_name
 from ._args import existing_blend
-from ._settings import add_config_flags, check_bounces, configs, given
+from ._settings import add_budget_flags, add_config_flags, budget, check_bounces, configs, given
 
 NAME = "bake"
 HELP = ("bake direct/indirect light per texel (DIR/<object>_<pass>.exr) or per mesh corner (colour attribute "
@@ -39,6 +39,7 @@ def add_arguments(p) -> None:
     p.add_argument("--margin", type=int, default=16, help="texels of seam dilation around UV islands")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     add_config_flags(p)
+    add_budget_flags(p)
 
 
 def _objects(text: str | None) -> list[str] | None:
@@ -77,9 +78,11 @@ def run(args) -> int:
     _check_target(args)
     index, count = parse_shard(args.shard)
     volume = args.target == "volume"
+    chosen_for = budget(args)
     settings = configs(args, **({"method": VOLUME_METHOD} if volume else {}))
     gi = settings["gi"]
-    check_bounces(gi)
+    if chosen_for is None:
+        check_bounces(gi)
     if not volume:
         _check_pass(gi, args.pass_name)
     if args.size is not None and not 8 <= args.size <= 8192:
@@ -105,7 +108,7 @@ def run(args) -> int:
             out.mkdir(parents=True, exist_ok=True)
         summary = bake_file(blend, file_out, objects, args.size, settings, args.pass_name, args.target,
                             args.overwrite, index, count, Path(args.save_blend) if args.save_blend else None,
-                            args.margin, progress=not args.quiet)
+                            args.margin, progress=not args.quiet, budget=chosen_for)
         files[str(blend)] = str(file_out / "bake.json")
         failed += [f"{blend.name}:{n}" for n, r in summary["objects"].items() if r["status"] == "error"]
     if len(blends) > 1:

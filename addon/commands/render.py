@@ -9,7 +9,7 @@ from __future__ import annotations
 import json
 
 from ._args import add_quiet, existing_blend, output_dir, progress
-from ._settings import add_config_flags, check_bounces, configs
+from ._settings import add_budget_flags, add_config_flags, budget, check_bounces, configs
 
 NAME = "render"
 HELP = "render a .blend with a Bounce method: DIR/direct.exr, DIR/indirect.exr (indirect methods), stats.json"
@@ -24,18 +24,25 @@ def add_arguments(p) -> None:
                         "everything): stats.json update_ms = {full, lights, camera}, medians of --repeat")
     add_quiet(p)
     add_config_flags(p)
+    add_budget_flags(p)
 
 
 def run(args) -> int:
     settings = configs(args)
-    check_bounces(settings["gi"])
+    chosen_for = budget(args)
+    if chosen_for is None:
+        check_bounces(settings["gi"])
     blend = existing_blend(args.blend)
     out = output_dir(args.out)
     from ..bridge.pipeline import render_file  # imports bpy: only when actually rendering
 
     stats = render_file(blend, out, settings, repeat=max(1, args.repeat), progress=progress(args.quiet),
-                        profile_updates=args.profile_updates)
+                        profile_updates=args.profile_updates, budget=chosen_for)
     summary = {"out": str(out), "total_ms": round(stats["total_ms"], 2), "notes": stats["notes"]}
+    if "choice" in stats:
+        summary["choice"] = {k: stats["choice"][k] for k in ("method", "setting", "why")}
+    if stats.get("estimated_rel_rmse_8") is not None:
+        summary["estimated_rel_rmse_8"] = round(stats["estimated_rel_rmse_8"], 3)
     if "update_ms" in stats:
         summary["update_ms"] = {k: round(v, 2) for k, v in stats["update_ms"].items()}
     print(json.dumps(summary))

@@ -48,6 +48,9 @@ FEATURES = ("enclosure", "sun_share", "world_share", "shaped_share", "glossy_sha
 TIME_FEATURES = ("log_triangles", "log_pixels", "log_light_faces")
 
 ENCLOSURE_DIRECTIONS = 64  # per point, a Fibonacci sphere
+# The largest triangles alone decide whether a direction is closed (walls, floors, roofs), and a ray
+# cast against a million of them costs seconds in numpy: the enclosure looks at this many, largest first.
+ENCLOSURE_MAX_TRIANGLES = 20000
 # Where the enclosure is looked at from: the bounds' centre and the eight points halfway from it to the
 # corners (a camera may stand outside the geometry, as Cornell's does; a wall may hold the centre).
 ENCLOSURE_POINTS = np.array([[0, 0, 0], *[[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]]) * 0.25
@@ -144,16 +147,18 @@ def scene_features(scene: Scene, bounces: int = 1, pixels: int = 128 * 128,
     size = np.maximum(hi - lo, 1e-9)
     n = scene.triangle_count
     enclosure = 0.0
-    if n:
-        dirs = fibonacci_directions(ENCLOSURE_DIRECTIONS)
-        points = (lo + hi) / 2.0 + ENCLOSURE_POINTS * size
-        enclosure = float(np.mean([rays_hit(p, dirs, scene.positions_m) for p in points]))
-    shares = light_shares(scene)
-    glossy = 0.0
+    area = np.zeros(0)
     if n:
         e1 = scene.positions_m[:, 1] - scene.positions_m[:, 0]
         e2 = scene.positions_m[:, 2] - scene.positions_m[:, 0]
         area = 0.5 * np.linalg.norm(np.cross(e1, e2), axis=1)
+        largest = scene.positions_m[np.argsort(area)[::-1][:ENCLOSURE_MAX_TRIANGLES]]
+        dirs = fibonacci_directions(ENCLOSURE_DIRECTIONS)
+        points = (lo + hi) / 2.0 + ENCLOSURE_POINTS * size
+        enclosure = float(np.mean([rays_hit(p, dirs, largest) for p in points]))
+    shares = light_shares(scene)
+    glossy = 0.0
+    if n:
         shiny = (scene.glossy_roughness() < GLOSSY_ROUGHNESS) & (scene.specular_f0().max(axis=1) >= GLOSSY_F0)
         glossy = float(area[shiny].sum() / max(area.sum(), 1e-30))
     return {"enclosure": enclosure, "sun_share": shares["sun"], "world_share": shares["world"],
@@ -298,3 +303,73 @@ def choose(model: Model, features: dict, error_budget: float | None = None,
         met = bool(ok)
     row = model.rows[k]
     return Choice(k, row["method"], dict(row["setting"]), err, ms, met, why)
+
+
+# -- applying it ----------------------------------------------------------------------------------------
+
+AUTO = "auto"  # the command line's and the panel's name for "choose the method for a budget"
+
+
+def apply_row(settings: dict, method: str, setting: dict) -> dict:
+    """{group: config} with gi.method = method and each "group.field" of the row's setting replaced
+    (the other fields, the image's size, seed and bounces, stay the caller's)."""
+    from dataclasses import replace
+
+    out = dict(settings)
+    out["gi"] = replace(out["gi"], method=method)
+    for key, value in setting.items():
+        group, name = key.split(".")
+        out[group] = replace(out[group], **{name: value})
+    return out
+
+
+def row_for(model: Model, settings: dict) -> str | None:
+    """The model's row that `settings` are (the method's defaults with the row's setting, judged on the
+    groups the method reads), or None: the model knows no such setting."""
+    from . import registry
+    from .config import settings as complete
+
+    method = settings["gi"].method
+    groups = {r.split(".")[0] for r in registry.get(method).reads}
+    for key, row in model.rows.items():
+        if row["method"] != method:
+            continue
+        candidate = apply_row(complete(gi=settings["gi"]), method, row["setting"])
+        if all(candidate[g] == settings[g] for g in groups):
+            return key
+    return None
+
+
+def decide(scene: Scene, settings: dict, pixels: int, error_budget: float | None = None,
+           time_budget_ms: float | None = None, model: Model | None = None) -> tuple[dict, dict]:
+    """The settings to run and what stats.json / bake.json say of them: with a budget, the choice
+    (settings replaced by its row) and why; always the model's estimate of the error where it knows
+    the setting (`estimated_rel_rmse_8`, None where it does not, with the reason)."""
+    budget = error_budget is not None or time_budget_ms is not None
+    if model is None:
+        try:
+            model = load()
+        except ConfigError as exc:
+            if budget:
+                raise
+            return settings, {"estimated_rel_rmse_8": None, "estimate_note": str(exc)}
+    feats = scene_features(scene, settings["gi"].bounces, pixels, settings["rsm"])
+    info: dict = {"features": feats}
+    if budget:
+        from . import registry
+
+        able = tuple(m for m in registry.NAMES if registry.get(m).max_bounces >= settings["gi"].bounces)
+        c = choose(model, feats, error_budget, time_budget_ms, methods=able)
+        settings = apply_row(settings, c.method, c.setting)
+        info["choice"] = {"method": c.method, "setting": c.setting, "row": c.key,
+                          "predicted_rel_rmse_8": c.predicted_rel_rmse_8, "predicted_ms": c.predicted_ms,
+                          "meets_budget": c.meets_budget, "why": c.why,
+                          "budget": {"rel_rmse_8": error_budget} if error_budget is not None
+                          else {"ms": time_budget_ms}}
+    key = row_for(model, settings)
+    if key is None:
+        info.update(estimated_rel_rmse_8=None,
+                    estimate_note="the choice model has no benchmark row with these settings")
+    else:
+        info.update(estimated_rel_rmse_8=model.predict(key, feats)[0], estimate_row=key)
+    return settings, info

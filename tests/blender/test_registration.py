@@ -47,11 +47,11 @@ def test_register_unregister_twice_leaves_nothing_behind(bounce, fresh_blend):
     before = _handler_counts()
     assert "load_post" in before and "depsgraph_update_post" in before
     classes = _all_classes(bounce)
-    # a property group per settings group (config.GROUPS) and one for them all, 2 operators
-    # (report_renderer, bake), 3 panels (main, its viewport sub-panel, the sidebar tab)
+    # a property group per settings group (config.GROUPS) and one for them all, 3 operators
+    # (report_renderer, bake, choose), 3 panels (main, its viewport sub-panel, the sidebar tab)
     from addon.engine import config
 
-    assert len(classes) == len(config.GROUPS) + 1 + 2 + 3
+    assert len(classes) == len(config.GROUPS) + 1 + 3 + 3
     for _ in range(2):
         bounce.register()
         try:
@@ -185,7 +185,7 @@ class _RecordingLayout:
     def column(self, **_kwargs):
         return _RecordingLayout(self.drawn, self.greyed, self)
 
-    box = column
+    box = row = column
 
     def label(self, **_kwargs):
         pass
@@ -216,13 +216,14 @@ def test_panel_draws_what_the_method_reads(registered):
         bpy.context.scene.bounce.gi.method = spec.name
         expected = [name for group, cls in config.GROUPS.items() for name in config.limits(cls)
                     if spec.reads_setting(group, name)]
-        assert drawn_settings() == ["enabled", *expected, "bounce.report_renderer", "bounce.bake"], spec.name
+        assert drawn_settings() == ["enabled", *expected, "error_budget", "bounce.choose", "bounce.report_renderer",
+                                    "bounce.bake"], spec.name
         shown |= {(group, name) for group, cls in config.GROUPS.items() for name in config.limits(cls)
                   if spec.reads_setting(group, name)}
     # Written out for one case: `direct` has no VPL gather, so no VPL samples and no LPV or VCT group.
     bpy.context.scene.bounce.gi.method = "direct"
     assert drawn_settings() == ["enabled", "method", "resolution", "resolution", "shadow_bias_texels",
-                                "bounce.report_renderer", "bounce.bake"]
+                                "error_budget", "bounce.choose", "bounce.report_renderer", "bounce.bake"]
     # Every setting is shown under some method: none is unreachable from the UI (the command line's
     # flags: tests/unit/test_cli_flags.py; the defaults: test_properties_mirror_every_config_field).
     every = {(group, name) for group, cls in config.GROUPS.items() for name in config.limits(cls)}

@@ -1,0 +1,87 @@
+"""Choosing a method for a budget in the product: `render`/`bake --method auto`, stats.json's estimate,
+and the Choose for Budget operator. The model (addon/engine/data/choice_model.json) is what ships."""
+
+import json
+
+import pytest
+
+pytestmark = pytest.mark.blender
+bpy = pytest.importorskip("bpy")
+
+from addon.cli import main  # noqa: E402
+from addon.engine import choice  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def cornell_blend(tmp_path_factory):
+    path = tmp_path_factory.mktemp("choice") / "cornell.blend"
+    assert main(["scene", "cornell", "--out", str(path)]) == 0
+    return path
+
+
+def test_render_auto_runs_the_chosen_setting_and_says_why(cornell_blend, tmp_path):
+    # The choice is the model's for this scene: the stats name it, its method ran, and the estimate
+    # is the model's prediction for that row (the fastest row expected within the budget).
+    out = tmp_path / "auto"
+    assert main(["render", str(cornell_blend), "--out", str(out), "--method", "auto", "--error-budget", "0.3",
+                 "--res", "32", "--repeat", "1", "--quiet"]) == 0
+    stats = json.loads((out / "stats.json").read_text())
+    c = stats["choice"]
+    assert stats["method"] == c["method"] and c["meets_budget"]
+    assert c["predicted_rel_rmse_8"] * choice.load().margin <= 0.3
+    assert stats["estimated_rel_rmse_8"] == pytest.approx(c["predicted_rel_rmse_8"])
+    for key, value in c["setting"].items():
+        group, name = key.split(".")
+        assert stats["config"][group][name] == value
+
+
+def test_a_render_at_a_benchmarked_setting_carries_the_estimate(cornell_blend, tmp_path):
+    # The defaults of rsm are a benchmark row: the estimate is there; an unbenchmarked setting says why not.
+    out = tmp_path / "rsm"
+    assert main(["render", str(cornell_blend), "--out", str(out), "--method", "rsm", "--res", "32",
+                 "--repeat", "1", "--quiet"]) == 0
+    stats = json.loads((out / "stats.json").read_text())
+    assert 0 < stats["estimated_rel_rmse_8"] < 2 and stats["estimate_row"].startswith("rsm")
+    odd = tmp_path / "odd"
+    assert main(["render", str(cornell_blend), "--out", str(odd), "--method", "rsm", "--vpl-samples", "100",
+                 "--res", "32", "--repeat", "1", "--quiet"]) == 0
+    stats = json.loads((odd / "stats.json").read_text())
+    assert stats["estimated_rel_rmse_8"] is None and "no benchmark row" in stats["estimate_note"]
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--method", "auto"], "exactly one of --error-budget"),
+    (["--error-budget", "0.2"], "give them with --method auto"),
+    (["--method", "auto", "--error-budget", "0"], "out of range"),
+    (["--method", "auto", "--time-budget", "-5"], "positive number"),
+])
+def test_budget_flags_refused_alone_or_out_of_range(cornell_blend, tmp_path, capsys, argv, message):
+    out = tmp_path / "bad"
+    assert main(["render", str(cornell_blend), "--out", str(out), *argv]) == 2
+    assert message in capsys.readouterr().err and not out.exists()
+
+
+def test_bake_auto_records_the_choice(cornell_blend, tmp_path):
+    out = tmp_path / "bake"
+    assert main(["bake", str(cornell_blend), "--out", str(out), "--objects", "Floor", "--size", "16",
+                 "--method", "auto", "--time-budget", "100000", "--quiet"]) == 0
+    summary = json.loads((out / "bake.json").read_text())
+    assert summary["method"] == summary["choice"]["method"] and summary["choice"]["meets_budget"]
+    assert summary["objects"]["Floor"]["status"] == "ok"
+
+
+def test_choose_operator_sets_the_scene_and_notes_the_estimate(bounce, fresh_blend):
+    from addon.bridge import scenes
+
+    bounce.register()
+    try:
+        scenes.build("cornell")
+        s = bpy.context.scene.bounce
+        s.gi.resolution, s.error_budget = 32, 0.3
+        assert bpy.ops.bounce.choose() == {"FINISHED"}
+        assert s.choice_row and "% from a path tracer" in s.choice_note
+        from addon.properties import to_config
+
+        assert choice.row_for(choice.load(), to_config(s)) == s.choice_row
+    finally:
+        bounce.unregister()
