@@ -75,7 +75,7 @@ def test_lpv_variants_on_cornell(tmp_path):
     # improved on one grid (far_field=False; 93 iterations = the grid's Manhattan span), geometry-aware
     # lookup, blocking by projected area, surface offsets: rel_rmse 0.613, rel_rmse_8 0.474, bias 1.202
     # (without offsets 0.441 / 1.141; plain trilinear lookup: 0.456 / 0.797). Over the target: the L1 transfer
-    # over-reads along the axes, more the more steps light takes (docs/LPV.md, "Measured").
+    # over-reads along the axes, more the more steps light takes (docs/LPV.md, "Measured limits").
     # The default adds the far field (16 steps on this grid, the rest on a 16-cell grid: half the steps
     # for the same distance): rel_rmse 0.457, rel_rmse_8 0.326, bias 0.928; without surface offsets
     # 0.333 / 0.932. Both meet the target; the default's bound is its figure plus llvmpipe's
