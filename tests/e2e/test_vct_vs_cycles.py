@@ -1,8 +1,8 @@
 """Method `vct` against Cycles' Diffuse Indirect on the Cornell box (64 px), one and two bounces.
 
 The issue's target is rel_rmse_8 <= 0.15 with bias 0.9..1.1 (one bounce); measured here: 0.117 /
-0.953 with the default denoise filter (docs/VCT.md, "Alternatives measured", for the choices behind it). The bounds are the measured figures (in comments)
-with a margin; the references (256 spp) have rel_rmse_8 ~0.02 on their own, far below every bound.
+0.953 with the default denoise filter (docs/VCT.md, "Alternatives measured", for the choices behind
+it). The bounds are the measured figures (in comments) with a margin; the references (256 spp) have rel_rmse_8 ~0.02 on their own, far below every bound.
 """
 
 import pytest

@@ -1056,8 +1056,8 @@ def test_cascades_on_a_scene_larger_than_one_grid(gl):
     # (d) 20 m floor at 32 cells (0.69 m cells) vs cascades = 2 (the finest 0.34 m, around the camera), both
     # against one grid of the finest cell over the whole floor. Finite and non-negative; in the finest
     # cascade's region (weight 1) the cascaded answer agrees with the fine grid better than the single
-    # coarse grid. Measured: rel L1 0.302 cascaded against 0.546 on one grid (bias 0.81 against 0.47). At 24 cells (0.95 m) cascades do not help
-    # (0.541 against 0.523, bias 1.54), so the test uses 32.
+    # coarse grid. Measured: rel L1 0.302 cascaded against 0.546 on one grid (bias 0.81 against 0.47).
+    # At 24 cells (0.95 m) cascades do not help (0.541 against 0.523, bias 1.54), so the test uses 32.
     results = {c: cascaded(gl, c) for c in (1, 2)}
     fine = results[2][0].levels[0]
     ref_method, ref = cascaded(gl, 1, grid_cells=64, cell_size_m=fine.grid.cell_size_m)
