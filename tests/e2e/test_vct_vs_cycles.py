@@ -2,7 +2,8 @@
 
 The issue's target is rel_rmse_8 <= 0.15 with bias 0.9..1.1 (one bounce); measured here: 0.117 /
 0.953 with the default denoise filter (docs/VCT.md, "Alternatives measured", for the choices behind
-it). The bounds are the measured figures (in comments) with a margin; the references (256 spp) have rel_rmse_8 ~0.02 on their own, far below every bound.
+it). The bounds are the measured figures (in comments) with a margin; the references (256 spp) have
+rel_rmse_8 ~0.02 on their own, far below every bound.
 """
 
 import pytest
