@@ -4,8 +4,11 @@
 //   opacity a_t = min(1, projected area of the cell's surface along t's axis / h^2).
 // A Lambertian surfel of flux phi has radiance phi / (pi A); seen along t it covers A |n.t| of the
 // cell's h^2 cross-section, so its premultiplied radiance is phi |n.t| / (pi h^2): what the atlas
-// summed (phi max(0, n.t)) over pi h^2. ISOTROPIC replaces the six colours by their mean (opacity
-// stays directional). Stored x radiance_scale (vct_pyramid.radiance_scale: the first bounce's colours
+// summed (phi max(0, n.t)) over pi h^2. ISOTROPIC gives every direction one radiance, the cell's
+// premultiplied colours summed over the opacities they were premultiplied by, and premultiplies it
+// again by each direction's opacity: the six colours keep their sum (no energy made or lost), and a
+// direction that sees no surface stays empty (a floor seen edge-on has no colour to give a cone).
+// A cell with light but no surface (seen = 0) keeps its six colours. Stored x radiance_scale (vct_pyramid.radiance_scale: the first bounce's colours
 // stay below HALF_BOUND), clamped to half_clamp so that later bounces' light, whose bound is not
 // proven, cannot overflow the half floats.
 #include "common/atlas.glsl"
@@ -33,16 +36,19 @@ void main() {
     col[4] += texelFetch(add_pz, c, 0).rgb;
     col[5] += texelFetch(add_nz, c, 0).rgb;
 #endif
+    vec3 opacity = min(texelFetch(vox_projected, c, 0).xyz, vec3(1.0));
 #ifdef ISOTROPIC
-    vec3 mean = (col[0] + col[1] + col[2] + col[3] + col[4] + col[5]) / 6.0;
-    for (int i = 0; i < 6; i++) {
-        col[i] = mean;
+    float seen = 2.0 * (opacity.x + opacity.y + opacity.z);
+    if (seen > 0.0) {  // else no surface to spread over: the colours stay as injected
+        vec3 radiance = (col[0] + col[1] + col[2] + col[3] + col[4] + col[5]) / seen;
+        for (int i = 0; i < 6; i++) {
+            col[i] = radiance * opacity[i / 2];
+        }
     }
 #endif
     for (int i = 0; i < 6; i++) {
         col[i] = min(col[i] * radiance_scale, vec3(half_clamp));
     }
-    vec3 opacity = min(texelFetch(vox_projected, c, 0).xyz, vec3(1.0));
     imageStore(pyr_px, c, vec4(col[0], opacity.x));
     imageStore(pyr_nx, c, vec4(col[1], opacity.x));
     imageStore(pyr_py, c, vec4(col[2], opacity.y));

@@ -308,6 +308,22 @@ def test_level0_and_downsample_match_numpy(gl):
 
 
 # -- cone gathers against closed forms -----------------------------------------------------------------
+def test_isotropic_level0_keeps_the_colours_sum_and_empty_directions(gl):
+    """radiance="isotropic": one radiance per cell, premultiplied by each direction's opacity. A floor
+    cell (projected area along z only) lit from above: its +z colour L before, exact answers after:
+    +z and -z both L / 2 (the sum L spread over the two directions that see it, opacity 1 each), the
+    four sideways directions 0 (a floor seen edge-on gives a cone nothing). Half floats: rtol 1.5e-3."""
+    vols = Volumes((4, 4, 4))
+    vols.wall(2, 1, +1, 0.5, slice(1, 3))
+    pyr = vols.pyramid(gl, isotropic=True)
+    dims = vols.grid.dims
+    lit = 0.5 * RADIANCE_SCALE  # L x the scale: the +z colour of the directional pyramid
+    for d in DIRECTIONS:
+        got = gl.read(pyr[d])[:, :, :dims[0]][1, 1, 1]
+        want = lit / 2 if d in ("pz", "nz") else 0.0
+        np.testing.assert_allclose(got[:3], want, rtol=1.5e-3, atol=1e-6, err_msg=d)
+
+
 def test_empty_volume_gives_zero_and_no_occlusion(gl):
     vols = Volumes((16, 16, 16))
     e, ao = gather(gl, vols.pyramid(gl), vols.grid, [(8, 8, 8), (2, 3, 4)], [(0, 0, 1), (0.6, 0, 0.8)])
