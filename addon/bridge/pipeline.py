@@ -16,7 +16,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-from ..engine import choice, methods, registry
+from ..engine import choice, methods, metrics, registry
 from ..engine.backends.moderngl_backend import ModernGLBackend
 from ..engine.config import settings as complete_settings
 from ..engine.errors import SceneError
@@ -86,9 +86,32 @@ def update_costs(method, repeat: int) -> dict[str, float]:
     return {kind: statistics.median(ms) for kind, ms in samples.items()}
 
 
+def run_self_check(be, captured, settings: dict, decided: dict, written: dict) -> dict:
+    """The run-time estimate: the rendered indirect image against the one of the row of another method
+    the choice model expects most accurate (choice.check_row), both on the same captured scene."""
+    key = decided.get("estimate_row")
+    if key is None or "indirect" not in written:
+        return {"note": "no self-check: the choice model knows no indirect setting like this one"}
+    model = choice.load()
+    able = tuple(m for m in registry.NAMES if registry.get(m).max_bounces >= settings["gi"].bounces)
+    other = choice.check_row(model, decided["features"], key, able)
+    if other is None:
+        return {"note": "no self-check: the choice model knows no other method"}
+    row = model.rows[other]
+    method = methods.create(be, choice.apply_row(settings, row["method"], row["setting"]))
+    method.set_scene(captured)
+    theirs = method.run().images["indirect"]
+    ours = written["indirect"]
+    difference = metrics.rel_rmse_8(ours[..., :3], theirs[..., :3], ours[..., 3] > 0.5)
+    if difference is None:
+        return {"against": other, "note": "no self-check: the image holds no geometry"}
+    return {"against": other, "rel_rmse_8_between": difference,
+            "estimated_rel_rmse_8": choice.self_estimate(difference, decided["estimated_rel_rmse_8"])}
+
+
 def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
                 progress: Callable[[str], None] = lambda step: None, profile_updates: bool = False,
-                budget: dict | None = None) -> dict:
+                budget: dict | None = None, self_check: bool = False) -> dict:
     """Render `blend` with {group: config} settings (config.settings' form; missing groups take their
     defaults); write <product>.exr for each product and stats.json; return stats.
 
@@ -97,7 +120,9 @@ def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
     profile_updates, stats["update_ms"] holds `update_costs` (full, lights, camera) over `repeat` runs.
     budget ({"error_budget": E} or {"time_budget_ms": T}): the method and its settings are chosen for the
     captured scene (engine/choice.py) and stats["choice"] says which and why; every render's stats carry
-    the choice model's `estimated_rel_rmse_8` where it knows the settings.
+    the choice model's `estimated_rel_rmse_8` where it knows the settings. self_check: also render the
+    row of another method the model expects most accurate and estimate the error from the two images'
+    difference (stats["self_check"]).
     """
     settings = complete_settings(**settings)
     gi = settings["gi"]
@@ -133,6 +158,10 @@ def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
     if profile_updates:
         progress(f"timing the three kinds of update ({repeat} of each)")
         update_ms = update_costs(method, max(repeat, 1))
+    checked = None
+    if self_check:
+        progress("self-check: rendering another method to compare with")
+        checked = run_self_check(be, captured, settings, decided, written)
     progress(f"writing {out_dir}")
     for name, pixels in written.items():
         images.write_exr(out_dir / f"{name}.exr", pixels)
@@ -157,6 +186,7 @@ def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
         **({"update_ms": update_ms} if update_ms is not None else {}),
         **{k: v for k, v in decided.items() if k != "features"},
         "scene_features": decided.get("features"),
+        **({"self_check": checked} if checked is not None else {}),
         "renderer": be.renderer,
         "blender_version": bpy.app.version_string,
         "notes": notes,

@@ -22,6 +22,9 @@ def add_arguments(p) -> None:
     p.add_argument("--profile-updates", action="store_true",
                    help="also time the three kinds of update (every light moved 1 cm, the camera moved 1 cm, "
                         "everything): stats.json update_ms = {full, lights, camera}, medians of --repeat")
+    p.add_argument("--self-check", action="store_true",
+                   help="also render the method the choice model expects most accurate here and estimate the "
+                        "error from the two images' difference (stats.json self_check; costs that render)")
     add_quiet(p)
     add_config_flags(p)
     add_budget_flags(p)
@@ -37,12 +40,14 @@ def run(args) -> int:
     from ..bridge.pipeline import render_file  # imports bpy: only when actually rendering
 
     stats = render_file(blend, out, settings, repeat=max(1, args.repeat), progress=progress(args.quiet),
-                        profile_updates=args.profile_updates, budget=chosen_for)
+                        profile_updates=args.profile_updates, budget=chosen_for, self_check=args.self_check)
     summary = {"out": str(out), "total_ms": round(stats["total_ms"], 2), "notes": stats["notes"]}
     if "choice" in stats:
         summary["choice"] = {k: stats["choice"][k] for k in ("method", "setting", "why")}
     if stats.get("estimated_rel_rmse_8") is not None:
         summary["estimated_rel_rmse_8"] = round(stats["estimated_rel_rmse_8"], 3)
+    if "self_check" in stats:
+        summary["self_check"] = stats["self_check"]
     if "update_ms" in stats:
         summary["update_ms"] = {k: round(v, 2) for k, v in stats["update_ms"].items()}
     print(json.dumps(summary))

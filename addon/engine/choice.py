@@ -373,3 +373,23 @@ def decide(scene: Scene, settings: dict, pixels: int, error_budget: float | None
     else:
         info.update(estimated_rel_rmse_8=model.predict(key, feats)[0], estimate_row=key)
     return settings, info
+
+
+# -- the run-time check ---------------------------------------------------------------------------------
+
+def check_row(model: Model, features: dict, key: str, methods: tuple[str, ...] | None = None) -> str | None:
+    """The row a run-time check compares `key`'s image with: of the other methods (an error two
+    methods share stays hidden from their difference, so never the same method), the one the model
+    expects to be most accurate here; None when the model has no other method."""
+    own = model.rows[key]["method"]
+    others = [k for k, row in model.rows.items()
+              if row["method"] != own and (methods is None or row["method"] in methods)]
+    return min(others, key=lambda k: model.predict(k, features)[0]) if others else None
+
+
+def self_estimate(difference: float, predicted: float) -> float:
+    """The run-time estimate of a row's rel_rmse_8 from its image's rel_rmse_8 against the check row's
+    (`difference`) and the model's prediction: their geometric mean. Judged against the measured error
+    on held-out scenes by tools/fit_choice.py (benchmarks/choice/REPORT.md) with the difference alone
+    and the model alone."""
+    return math.sqrt(max(difference, 0.0) * max(predicted, 0.0))

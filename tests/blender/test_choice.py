@@ -85,3 +85,32 @@ def test_choose_operator_sets_the_scene_and_notes_the_estimate(bounce, fresh_ble
         assert choice.row_for(choice.load(), to_config(s)) == s.choice_row
     finally:
         bounce.unregister()
+
+
+def test_self_check_compares_with_another_method(cornell_blend, tmp_path):
+    # The check renders the row of another method the model expects most accurate: its rel_rmse_8
+    # against our image is exactly the difference of the two renders, and the estimate is the geometric
+    # mean of that difference and the model's prediction (choice.self_estimate).
+    from addon.bridge import images
+    from addon.engine.metrics import rel_rmse_8
+
+    ours, theirs = tmp_path / "ours", tmp_path / "theirs"
+    assert main(["render", str(cornell_blend), "--out", str(ours), "--method", "lpv", "--res", "32",
+                 "--repeat", "1", "--self-check", "--quiet"]) == 0
+    stats = json.loads((ours / "stats.json").read_text())
+    check = stats["self_check"]
+    row = choice.load().rows[check["against"]]
+    assert row["method"] != "lpv"
+    def flag(key, value):
+        name = key.split(".")[1].replace("_", "-")
+        if isinstance(value, bool):
+            return f"--{'' if value else 'no-'}{name}"
+        return f"--{name}={value}"
+
+    flags = [flag(k, v) for k, v in row["setting"].items()]
+    assert main(["render", str(cornell_blend), "--out", str(theirs), "--method", row["method"], "--res", "32",
+                 "--repeat", "1", "--quiet", *flags]) == 0
+    a, b = images.read_exr(ours / "indirect.exr"), images.read_exr(theirs / "indirect.exr")
+    assert check["rel_rmse_8_between"] == pytest.approx(rel_rmse_8(a[..., :3], b[..., :3], a[..., 3] > 0.5), rel=1e-5)
+    assert check["estimated_rel_rmse_8"] == pytest.approx(
+        (check["rel_rmse_8_between"] * stats["estimated_rel_rmse_8"]) ** 0.5)
