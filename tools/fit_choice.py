@@ -1,7 +1,7 @@
 """Fit the method-choice model (addon/engine/choice.py) on a benchmark's results.json, judge it scene by
 scene on scenes it was not fitted on, and write the model and the report.
 
-    .venv/bin/python tools/fit_choice.py RESULTS.json [--cache out/bench] [--out benchmarks/choice]
+    .venv/bin/python tools/fit_choice.py RESULTS.json [MORE.json ...] [--cache out/bench] [--out benchmarks/choice]
         [--model addon/engine/data/choice_model.json]
 
 Each scene's features come from its .blend in the bench cache (`<cache>/scenes/<scene>.blend`, what
@@ -155,7 +155,12 @@ def summary(judged: dict) -> dict:
                    and r["fastest_ms"] and r["ms"] <= 2.0 * r["fastest_ms"])
         est = sum(1 for r in rows if r["measured"] and 1 / ESTIMATE_FACTOR <= r["predicted"] / r["measured"]
                   <= ESTIMATE_FACTOR)
-        s[budget] = {"scenes": n, "met": met, "possible": possible, "within_2x": fast, "estimate_within_1.5x": est}
+        checks = {(e["scene"], e["row"]): e for e in judged.get("agreement", [])}
+        self_est = sum(1 for r in rows if r["measured"] and (r["scene"], r["choice"]) in checks
+                       and 1 / ESTIMATE_FACTOR <= checks[(r["scene"], r["choice"])]["blend"] / r["measured"]
+                       <= ESTIMATE_FACTOR)
+        s[budget] = {"scenes": n, "met": met, "possible": possible, "within_2x": fast, "estimate_within_1.5x": est,
+                     "self_check_within_1.5x": self_est}
     ratios = [e["predicted"] / e["measured"] for e in judged["estimates"]]
     s["all_rows_estimate_within_1.5x"] = float(np.mean([1 / ESTIMATE_FACTOR <= x <= ESTIMATE_FACTOR for x in ratios]))
     for kind in ("model", "agree", "blend"):
@@ -165,7 +170,7 @@ def summary(judged: dict) -> dict:
     return s
 
 
-def report(results_path: Path, judged: dict, summ: dict, model: choice.Model) -> str:
+def report(results_path: str, judged: dict, summ: dict, model: choice.Model) -> str:
     lines = ["# Choosing a method for an error budget", "",
              f"Model: addon/engine/choice.py fitted on `{results_path}` ({len(model.scenes)} scenes, "
              f"{len(model.rows)} settings), margin x{model.margin:.2f} (its {MARGIN_QUANTILE:.0%} quantile of "
@@ -174,13 +179,14 @@ def report(results_path: Path, judged: dict, summ: dict, model: choice.Model) ->
              "Each scene judged by a model fitted without it. met: the choice's measured rel_rmse_8 is within the "
              "budget; possible: some measured setting is; within 2x: met, and its time at most twice the fastest "
              "setting measured within the budget; estimate: the choice's predicted error within a factor 1.5 of "
-             "its measured one.", "",
-             "| budget | scenes | met | possible | within 2x | estimate within 1.5x |",
-             "| --- | --- | --- | --- | --- | --- |"]
+             "its measured one; self-check: `render --self-check`'s estimate (the geometric mean of the model's and "
+             "of the difference from another method's image) within that factor.", "",
+             "| budget | scenes | met | possible | within 2x | estimate within 1.5x | self-check within 1.5x |",
+             "| --- | --- | --- | --- | --- | --- | --- |"]
     for budget in map(str, BUDGETS):
         s = summ[budget]
         lines.append(f"| {budget} | {s['scenes']} | {s['met']} | {s['possible']} | {s['within_2x']} | "
-                     f"{s['estimate_within_1.5x']} |")
+                     f"{s['estimate_within_1.5x']} | {s['self_check_within_1.5x']} |")
     lines += ["", f"Every measured row's estimate within a factor 1.5: {summ['all_rows_estimate_within_1.5x']:.0%}.",
               ""]
     if "run_time_agree_within_1.5x" in summ:
@@ -206,14 +212,20 @@ def report(results_path: Path, judged: dict, summ: dict, model: choice.Model) ->
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("results", type=Path)
+    p.add_argument("results", type=Path, nargs="+",
+                   help="bench results.json files of one resolution, reference spp and bounce count (their "
+                        "records are pooled: e.g. a run of new methods beside an earlier one of the others)")
     p.add_argument("--cache", type=Path, default=ROOT / "out" / "bench")
     p.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "choice")
     p.add_argument("--model", type=Path, default=choice.MODEL_PATH)
     p.add_argument("--ridge", type=float, default=1.0)
     args = p.parse_args(argv)
-    results = json.loads(args.results.read_text())
-    records = records_of(results)
+    runs = [json.loads(path.read_text()) for path in args.results]
+    results = runs[0]
+    if any((r["res"], r["ref_spp"], r["bounces"]) != (results["res"], results["ref_spp"], results["bounces"])
+           for r in runs):
+        raise SystemExit("the results differ in resolution, reference spp or bounces: errors would not compare")
+    records = [rec for r in runs for rec in records_of(r)]
     features = scene_features(args.cache, sorted({r["scene"] for r in records}), results["bounces"], results["res"])
     judged = judge(records, features, args.ridge)
     ref_glob = f"*-r{results['res']}-spp{results['ref_spp']}-b{results['bounces']}-seed0"
@@ -224,7 +236,7 @@ def main(argv=None) -> int:
     args.model.parent.mkdir(parents=True, exist_ok=True)
     args.model.write_text(json.dumps(model.to_json(), indent=1, sort_keys=True) + "\n")
     args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "REPORT.md").write_text(report(args.results, judged, summ, model))
+    (args.out / "REPORT.md").write_text(report(" ".join(map(str, args.results)), judged, summ, model))
     (args.out / "judged.json").write_text(json.dumps({"summary": summ, **judged}, indent=1) + "\n")
     print(json.dumps(summ))
     return 0 if all(math.isfinite(r["predicted"]) for r in judged["estimates"]) else 1
