@@ -1,0 +1,67 @@
+"""The contributor tools that produce the figures the docs quote run and print what they promise, on
+sizes small enough for CI (their figures come from full-size runs; these only hold their plumbing)."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.blender
+pytest.importorskip("bpy")
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def tool(*args: str, timeout: int = 600) -> str:
+    done = subprocess.run([sys.executable, *args], cwd=ROOT, capture_output=True, text=True, timeout=timeout)
+    assert done.returncode == 0, done.stderr[-2000:]
+    return done.stdout
+
+
+@pytest.fixture(scope="module")
+def cornell(tmp_path_factory):
+    path = tmp_path_factory.mktemp("tools") / "cornell.blend"
+    tool("-m", "addon", "scene", "cornell", "--out", str(path))
+    return path
+
+
+def test_denoise_cost_prints_the_filters_share_of_an_update(cornell):
+    line = tool("tools/denoise_cost.py", str(cornell), "--res", "32", "--iterations", "1", "--repeat", "1")
+    row = json.loads(line.strip().splitlines()[-1])
+    text = json.dumps(row)
+    assert "32" in text and "ms" in text
+
+
+def test_bake_speedup_prints_a_row_per_object():
+    out = tool("tools/bake_speedup.py", "--size", "16", "--ref-spp", "16", "--method", "lpv")
+    rows = [line for line in out.splitlines() if line.startswith("| ") and not line.startswith("| ---")]
+    assert [r.split("|")[1].strip() for r in rows[1:]] == ["Floor", "BackWall"]
+
+
+def test_fit_choice_fits_judges_and_writes(tmp_path):
+    # Three scenes and two rows whose errors do not depend on the scene (0.1 and 0.3) nor their times
+    # (100 and 10 ms): every held-out prediction is exact, so at E = 0.2 the choice is the 0.1 row on
+    # every scene and its estimate is within 1.5x everywhere; at E = 0.3 the margin (1) admits the fast row.
+    cache = tmp_path / "cache"
+    scenes = ("cornell", "cornell-point", "cornell-sun")
+    (cache / "scenes").mkdir(parents=True)
+    for name in scenes:
+        tool("-m", "addon", "scene", name, "--out", str(cache / "scenes" / f"{name}.blend"))
+    rows = [("rsm", {"rsm.vpl_samples": 256}, 0.1, 100.0), ("lpv", {"lpv.grid_cells": 16}, 0.3, 10.0)]
+    records = [{"scene": s, "method": m, "setting": st, "product": "indirect", "rel_rmse_8": e, "total_ms": t}
+               for s in scenes for m, st, e, t in rows]
+    results = tmp_path / "results.json"
+    results.write_text(json.dumps({"res": 32, "ref_spp": 16, "bounces": 1, "records": records}))
+    model, out = tmp_path / "model.json", tmp_path / "report"
+    summary = json.loads(tool("tools/fit_choice.py", str(results), "--cache", str(cache), "--out", str(out),
+                              "--model", str(model)).strip().splitlines()[-1])
+    assert summary["0.2"] == {"scenes": 3, "met": 3, "possible": 3, "within_2x": 3, "estimate_within_1.5x": 3,
+                              "self_check_within_1.5x": 0}
+    assert summary["0.3"]["met"] == 3 and summary["0.3"]["within_2x"] == 3
+    assert "| 0.2 | 3 | 3 | 3 | 3 | 3 | 0 |" in (out / "REPORT.md").read_text()
+    from addon.engine import choice
+
+    fitted = choice.Model.from_json(json.loads(model.read_text()))
+    assert set(fitted.rows) == {"rsm vpl_samples=256", "lpv grid_cells=16"}
