@@ -47,7 +47,8 @@ UPDATE_STEP_M = 0.01  # how far update_costs moves the lights or the camera per 
 def update_costs(method, repeat: int) -> dict[str, float]:
     """Median wall time in ms (GPU work finished, no read-back) of the three kinds of update a user
     makes, each right after its change, alternately moving by UPDATE_STEP_M and back:
-    - full: everything (the G-buffer, the light views, the solve, the gathers);
+    - full: a geometry change, everything: the upload and the setup passes (set_scene: voxelization,
+      blocking volumes), the G-buffer, the light views, the solve, the gathers;
     - lights: every light moved UPDATE_STEP_M along z: the light views, the solve and the gathers
       (the G-buffer is still valid);
     - camera: the camera moved UPDATE_STEP_M along its right axis: the G-buffer and the gathers
@@ -73,7 +74,7 @@ def update_costs(method, repeat: int) -> dict[str, float]:
     try:
         for i in range(repeat):
             away = i % 2 == 0
-            samples["full"].append(timed(lambda: method.compute(solve=True)))
+            samples["full"].append(timed(lambda: (method.set_scene(method.source), method.compute())))
             method.set_lights(moved_lights if away else lights)
             samples["lights"].append(timed(lambda: method.compute(run_gbuffer=False)))
             method.set_camera(moved_camera if away else camera)

@@ -20,8 +20,8 @@ def add_arguments(p) -> None:
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--repeat", type=int, default=3, help="timed runs after a warm-up (median reported)")
     p.add_argument("--profile-updates", action="store_true",
-                   help="also time the three kinds of update (every light moved 1 cm, the camera moved 1 cm, "
-                        "everything): stats.json update_ms = {full, lights, camera}, medians of --repeat")
+                   help="also time the three kinds of update (a geometry change: everything; every light moved 1 cm; "
+                        "the camera moved 1 cm): stats.json update_ms = {full, lights, camera}, medians of --repeat")
     p.add_argument("--self-check", action="store_true",
                    help="also render the method the choice model expects most accurate here and estimate the "
                         "error from the two images' difference (stats.json self_check; costs that render)")
