@@ -90,8 +90,9 @@ class LpvConfig(_Validated):
                            "(with a far field: near_steps on the grid, the span on the far field's)")
     # Defaults: the improved transport with occlusion (Cornell rel_rmse_8 0.42); the published scheme
     # stays a variant for comparison (1.15, no better than a constant: ../shared/BASELINE.md).
-    variant: str = _choice("improved", ("classic", "improved"),
-                           "transport: classic CLPV 5-face scheme, or improved (straight, flux-conserving)")
+    variant: str = _choice("improved", ("classic", "improved", "octree"),
+                           "transport: classic CLPV 5-face scheme, improved (straight, flux-conserving), or "
+                           "octree (improved on a mip chain of grids, merged: paper 002)")
     geometry_volume: bool = field(default=True, metadata={"doc": "occlude propagation by the voxelized surfaces"})
     # On: a surface blocks the transfers on its side of the cell's centre (by where it lies in the cell),
     # so light does not depend on how walls align with cells (thin-wall 0.68 -> 0.22); off: each cell's
@@ -113,6 +114,22 @@ class LpvConfig(_Validated):
     # variant with one cascade, first bounce.
     emitter_classes: bool = field(default=False, metadata={
         "doc": "a surface reads no light from surfaces facing its way (six propagations; one cascade)"})
+    # Octree (variant octree, passes/lpv_octree.py): the grid is level 0 of a mip chain of grids, each
+    # twice the cell of the one below, each propagated octree_iterations steps and merged coarse to fine.
+    # The paper's settings: 5 levels (32^3 .. 2^3), k = 4, the index merge with epsilon ~0 (the finest
+    # level with non-zero light), every level blocked; the time merge splits the light between the levels
+    # by its time of flight, as the far field does (docs/LPV.md, "Octree", measures both).
+    octree_levels: int = _num(5, 2, 6, "octree: grids in the mip chain, each twice the cell of the one below")
+    octree_iterations: int = _num(8, 1, 64, "octree: propagation steps on every level (the paper's k = 4)")
+    octree_merge: str = _choice("time", ("index", "time"), "octree: levels merged per cell by the finest holding "
+                                "light (index, the paper's) or per time of flight (time)")
+    octree_epsilon: float = _num(0.5, 1e-6, 1.0, "octree, index merge: a finer level counts where its light reaches "
+                                 "this share of the coarser answer's, fully at twice it (~0: the paper's rule)")
+    # A cell of 8 grid cells or more holds walls and the open space in front of them together: its
+    # geometry volume blocks the light of the surfaces in it (cornell, index merge: bias 0.70 with four
+    # blocked levels, 0.90 with three; docs/LPV.md, "Octree").
+    octree_blocked_levels: int = _num(3, 0, 6, "octree: the finest levels the geometry volume blocks (coarser ones "
+                                      "propagate unblocked)")
     cascades: int = _num(1, 1, 4, "nested grids, each finer one half the cell size, the finest around the camera")
     cell_size_m: float = _num(0.0, 0.0, 1.0e6, "finest cascade's cell in metres when the cascades can cover "
                               "the scene with it; 0: the coarsest fits the scene")

@@ -34,6 +34,10 @@ light about k / 2 cells: its reading there is a small fraction of the coarser le
 makes the switch continuous in the light, so a light that moves a little changes the image a little.
 Each merged coefficient lies between the finer level's and the coarser answer's: the merge creates no
 light. Where the coarser answer is not positive the finer level is taken whenever it holds light.
+
+The time merge (`add_up`, LpvConfig.octree_merge = "time"): each level accumulates its steps with the
+shares of passes/lpv_octree.time_share (by time of flight; they sum to 1 over the levels at every
+time), and the levels are added: M_i = A_i + upsample(M_{i+1}).
 """
 
 from __future__ import annotations
@@ -93,13 +97,25 @@ def chain(injected: np.ndarray, levels: int) -> list[np.ndarray]:
     return out
 
 
-def propagate(snapshots: list[np.ndarray], steps: int, throughs=None) -> list[np.ndarray]:
-    """Every level's accumulation after `steps` improved-transport steps of its own, as the GPU pass
-    runs them (lpv_reference.gpu_improved_transfer); throughs: per level lpv_reference.pass_through's
-    shares, or None in empty space."""
+def propagate(snapshots: list[np.ndarray], steps, throughs=None, shares=None) -> list[np.ndarray]:
+    """Every level's accumulation after its improved-transport steps, as the GPU pass runs them
+    (lpv_reference.gpu_improved_transfer). steps: one count for every level, or one per level;
+    throughs: per level lpv_reference.pass_through's shares, or None in empty space; shares: per level
+    a function (step, 1-based) -> the weight that step is accumulated with (the time merge's
+    passes/lpv_octree.time_share), or None for 1."""
     matrices, path = ref.gpu_improved_transfer()
-    throughs = throughs or [None] * len(snapshots)
-    return [ref.accumulate(s, matrices, path, steps, t) for s, t in zip(snapshots, throughs, strict=True)]
+    n = len(snapshots)
+    steps = [steps] * n if np.isscalar(steps) else steps
+    throughs = throughs or [None] * n
+    shares = shares or [None] * n
+    out = []
+    for field, count, through, share in zip(snapshots, steps, throughs, shares, strict=True):
+        acc, current = np.zeros(np.shape(field)), np.asarray(field, np.float64)
+        for s in range(1, count + 1):
+            current = ref.step(current, matrices, through)
+            acc += (1.0 if share is None else share(s)) * (current @ path.T)
+        out.append(acc)
+    return out
 
 
 def upsample(coarse: np.ndarray, fine_shape: tuple[int, ...]) -> np.ndarray:
@@ -148,6 +164,14 @@ def merge(accumulations: list[list[np.ndarray]], epsilon: float) -> tuple[list[n
                   for f, u in zip(fine, up, strict=True)]
         weights.insert(0, w)
     return merged, weights
+
+
+def add_up(accumulations: list[list[np.ndarray]]) -> list[np.ndarray]:
+    """The time merge: M_{L-1} = acc_{L-1}, M_i = acc_i + upsample(M_{i+1}); per colour channel."""
+    merged = [np.asarray(c, np.float64) for c in accumulations[-1]]
+    for fine in reversed(accumulations[:-1]):
+        merged = [np.asarray(f, np.float64) + upsample(m, np.shape(f)) for f, m in zip(fine, merged, strict=True)]
+    return merged
 
 
 def index_volume(weights: list[np.ndarray]) -> np.ndarray:

@@ -1,31 +1,15 @@
 // LPV far field, combine: a fine grid's accumulation += the light its far-field grid (twice the cell
-// size, same origin, ceil(dims / 2) cells) carried beyond the fine grid's near steps, read trilinearly
-// at the fine cell's centre, times (h / H)^2 = 1/4 (a fine cell's cross-section is a quarter of a coarse
-// one's, so of the flux passing through a coarse cell a quarter passes through a fine cell there).
-// Fine cell i's centre lies at coarse coordinate (i + 0.5) / 2 - 0.5 (coarse centres at j): corners
-// floor of it and the next, weights 0.75 / 0.25, clamped to the edge. Plain trilinear: weighting the
-// corners by their geometry (as the lookup does) was measured and was worse (docs/LPV.md, "Far field").
-
-vec4 far_light(sampler3D coarse, ivec3 fine) {
-    vec3 t = (vec3(fine) + 0.5) * 0.5 - 0.5;
-    ivec3 i0 = ivec3(floor(t));
-    vec3 f = t - vec3(i0);
-    vec4 sum = vec4(0.0);
-    for (int k = 0; k < 8; ++k) {
-        ivec3 corner = ivec3(k & 1, (k >> 1) & 1, k >> 2);
-        ivec3 c = clamp(i0 + corner, ivec3(0), coarse_dims - 1);
-        vec3 wv = mix(1.0 - f, f, vec3(corner));
-        sum += (wv.x * wv.y * wv.z) * texelFetch(coarse, c, 0);
-    }
-    return 0.25 * sum;
-}
+// size, same origin, ceil(dims / 2) cells) carried beyond the fine grid's near steps, read at the fine
+// cell's centre (upsample.glsl: trilinear times 1/4). Plain trilinear: weighting the corners by their
+// geometry (as the lookup does) was measured and was worse (docs/LPV.md, "Far field").
+#include "lpv/upsample.glsl"
 
 void main() {
     ivec3 c = ivec3(gl_GlobalInvocationID);
     if (any(greaterThanEqual(c, dims))) {
         return;
     }
-    imageStore(acc_r, c, imageLoad(acc_r, c) + far_light(far_r, c));
-    imageStore(acc_g, c, imageLoad(acc_g, c) + far_light(far_g, c));
-    imageStore(acc_b, c, imageLoad(acc_b, c) + far_light(far_b, c));
+    imageStore(acc_r, c, imageLoad(acc_r, c) + upsampled(far_r, c));
+    imageStore(acc_g, c, imageLoad(acc_g, c) + upsampled(far_g, c));
+    imageStore(acc_b, c, imageLoad(acc_b, c) + upsampled(far_b, c));
 }

@@ -20,6 +20,9 @@ CASES = {
     "lpv-classes": ("lpv", {}, {"grid_cells": 16, "emitter_classes": True}, {}, True),
     "lpv-cascades": ("lpv", {}, {"grid_cells": 16, "cascades": 2}, {}, False),
     "lpv-2-bounces": ("lpv", {"bounces": 2}, {"grid_cells": 16}, {}, False),
+    "lpv-octree": ("lpv", {}, {"grid_cells": 16, "variant": "octree"}, {}, True),
+    "lpv-octree-index": ("lpv", {}, {"grid_cells": 16, "variant": "octree", "octree_merge": "index"}, {}, True),
+    "lpv-octree-2-bounces": ("lpv", {"bounces": 2}, {"grid_cells": 16, "variant": "octree"}, {}, False),
     "vct": ("vct", {}, {}, {"voxel_cells": 16, "diffuse_cones": 6}, True),
     "vct-2-bounces": ("vct", {"bounces": 2}, {}, {"voxel_cells": 16, "diffuse_cones": 6}, True),
     # diffusion (16 cells, _method): its light field does not depend on the camera, bounces included.

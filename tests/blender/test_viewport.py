@@ -197,11 +197,13 @@ def test_navigating_gives_preview_then_full_quality(cornell):
     np.testing.assert_array_equal(full.view, preview.view)
 
 
-@pytest.mark.parametrize("name", ["direct", "rsm", "lpv", "lpv-far-field", "lpv-emitter-classes", "vct",
-                                  "vct-filtered", "diffusion"])
+@pytest.mark.parametrize("name", ["direct", "rsm", "lpv", "lpv-far-field", "lpv-emitter-classes", "lpv-octree",
+                                  "lpv-octree-index", "vct", "vct-filtered", "diffusion"])
 def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, name):
     # lpv at 16 cells runs one grid; "lpv-far-field" at 32 cells adds the far field's passes;
     # "lpv-emitter-classes" (16 cells) the classes' injection, unpacks and own-light lookups;
+    # "lpv-octree" (16 cells) every level's injection and the time merge, "lpv-octree-index" the
+    # downsampling and the index merge's shader;
     # "vct-filtered" the filtered injection (gl_VertexID, the projected-area fetches).
     from addon.bridge import scenes
     from addon.bridge.capture import SceneCache
@@ -215,8 +217,9 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
     rsm = RsmConfig(resolution=128, vpl_samples=64)
     results = []
     for be in (gl, blender_backend):
-        lpv = LpvConfig(grid_cells=grid_cells, variant="improved", geometry_volume=True,
-                        emitter_classes=name == "lpv-emitter-classes")
+        lpv = LpvConfig(grid_cells=grid_cells, variant="octree" if "octree" in name else "improved",
+                        geometry_volume=True, emitter_classes=name == "lpv-emitter-classes",
+                        octree_merge="index" if name == "lpv-octree-index" else "time")
         vct = VctConfig(voxel_cells=16, diffuse_cones=6, filtered_injection=name == "vct-filtered")
         method = methods.create(be, {"gi": gi, "rsm": rsm, "lpv": lpv, "vct": vct,
                                      "diffusion": DiffusionConfig(grid_cells=16)})

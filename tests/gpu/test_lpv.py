@@ -10,13 +10,22 @@ Volumes read back as (z, y, x, 4) arrays.
 import numpy as np
 import pytest
 
+from addon.engine import lpv_octree_reference as octree_ref
 from addon.engine import lpv_reference as ref
 from addon.engine import sh
 from addon.engine.config import GIConfig, LpvConfig, RsmConfig
 from addon.engine.grid import Grid
 from addon.engine.methods.lpv import LpvMethod, iterations_for, near_steps_for
 from addon.engine.passes import atlas as atlas_pass
-from addon.engine.passes import lpv_cascade, lpv_far_field, lpv_inject, lpv_lookup, lpv_propagate, lpv_reinject
+from addon.engine.passes import (
+    lpv_cascade,
+    lpv_far_field,
+    lpv_inject,
+    lpv_lookup,
+    lpv_octree,
+    lpv_propagate,
+    lpv_reinject,
+)
 from addon.engine.scene import Camera, Light, Scene
 from addon.engine.transforms import look_along, perspective
 
@@ -675,7 +684,8 @@ def corner_scene():
 
 
 @pytest.mark.parametrize("variant, classes, bounces", [("classic", False, 1), ("improved", False, 1),
-                                                       ("improved", True, 1), ("improved", True, 2)])
+                                                       ("improved", True, 1), ("improved", True, 2),
+                                                       ("octree", False, 1), ("octree", False, 2)])
 def test_method_output_is_finite_and_non_negative(gl, variant, classes, bounces):
     method = LpvMethod(gl, GIConfig(method="lpv", bounces=bounces), RsmConfig(resolution=64),
                        LpvConfig(grid_cells=12, variant=variant, geometry_volume=True, emitter_classes=classes))
@@ -1069,3 +1079,87 @@ def test_cascades_on_a_scene_larger_than_one_grid(gl):
               f"bias {pairs[c][1]:.3f}; timings {result.timings_ms}")
     assert region.sum() > 100
     assert errors[2] < 0.7 * errors[1]
+
+
+# -- octree -------------------------------------------------------------------------------------------
+def test_octree_index_merge_equals_numpy(gl):
+    # fine := w fine + (1 - w) 1/4 trilinear(coarse), w = clamp(rho / eps - 1, 0, 1) from the colours'
+    # summed c0 (lpv_octree_reference.merge). Odd fine dims (the coarse grid's last cells half outside).
+    # Light c0 >= 0 as propagated fields hold it, other coefficients signed. fp32: the weight's ratio
+    # rounds at 1e-7, so 1e-5 of the largest value.
+    rng = np.random.default_rng(13)
+    fine = Grid(np.zeros(3), 1.0, (7, 4, 5))
+    coarse = lpv_far_field.grid_for(fine)
+
+    def field(grid):
+        a = rng.normal(size=tuple(reversed(grid.dims)) + (4,))
+        a[..., 0] = rng.uniform(0.0, 1.0, a.shape[:3]) * (rng.random(a.shape[:3]) < 0.8)  # some dark cells
+        return a.astype(np.float32)
+
+    fine_acc, coarse_acc = [field(fine) for _ in range(3)], [field(coarse) for _ in range(3)]
+    for eps in (1e-6, 0.25):
+        acc = {f"acc_{c}": gl.texture(fine.dims, "RGBA32F", a) for c, a in zip("rgb", fine_acc, strict=True)}
+        far = {f"acc_{c}": gl.texture(coarse.dims, "RGBA32F", a) for c, a in zip("rgb", coarse_acc, strict=True)}
+        lpv_octree.merge(gl, far, coarse, acc, fine, "index", eps)
+        want, weights = octree_ref.merge([fine_acc, coarse_acc], eps)
+        assert 0.0 < weights[0].mean() < 1.0  # both levels are used
+        for c, w in zip("rgb", want, strict=True):
+            np.testing.assert_allclose(gl.read(acc[f"acc_{c}"]), w, rtol=0, atol=1e-5 * np.abs(w).max())
+
+
+def octree_method(gl, merge, levels=3, k=4):
+    """An octree LpvMethod on corner_scene at 16 cells without a geometry volume (the transport alone)."""
+    method = LpvMethod(gl, GIConfig(method="lpv"), RsmConfig(resolution=32),
+                       LpvConfig(grid_cells=16, variant="octree", geometry_volume=False, octree_levels=levels,
+                                 octree_iterations=k, octree_merge=merge))
+    method.set_scene(corner_scene())
+    return method
+
+
+@pytest.mark.parametrize("merge", ["index", "time"])
+def test_octree_propagation_equals_numpy(gl, merge):
+    # The method's own path (fill_octree summing the source down the chain, each level's steps with
+    # its shares, the merges) against lpv_octree_reference from one isotropic source and one lobe in
+    # the grid. float64 reference against fp32 passes over ~20 steps: 1e-4 of the largest coefficient.
+    method = octree_method(gl, merge)
+    top = method.levels[0]
+    dims = top.grid.dims
+    channels = [np.zeros(tuple(reversed(dims)) + (4,), np.float32) for _ in range(3)]
+    channels[0][dims[2] // 2, dims[1] // 2, dims[0] // 2, 0] = 1.0
+    channels[1][1, 2, 3] = sh.cosine_lobe_l1(np.array([0.6, 0.0, 0.8])) / np.pi
+    top.snapshots[0] = volumes(gl, dims, channels)
+    method.fill_octree(top, injected=False)
+    method.propagate(level=top)
+    levels, k = 3, 4
+    snapshots = [octree_ref.chain(c, levels) for c in channels]  # per colour, per level
+    per_level = list(zip(*snapshots, strict=True))  # per level, per colour
+    if merge == "time":
+        steps = [lpv_octree.steps(i, k, levels, "time", sum(g.dims) - 3)
+                 for i, g in enumerate([top.grid, *[lv.grid for lv in top.octree]])]
+        shares = [lambda s, i=i: lpv_octree.time_share(i, s, k, levels) for i in range(levels)]
+        accs = [octree_ref.propagate(list(level), [steps[i]] * 3, shares=[shares[i]] * 3)
+                for i, level in enumerate(per_level)]
+        want = octree_ref.add_up(accs)
+    else:
+        accs = [octree_ref.propagate(list(level), k) for level in per_level]
+        want, _ = octree_ref.merge(accs, method.lpv_config.octree_epsilon)
+    for c, w in zip("rgb", want, strict=True):
+        np.testing.assert_allclose(gl.read(top.accumulated[f"acc_{c}"]), w, rtol=0, atol=1e-4 * np.abs(w).max())
+    assert np.abs(want[0][..., 0]).max() > 0 and np.abs(want[1][..., 0]).max() > 0
+
+
+def test_octree_time_merge_injects_every_level_itself(gl):
+    # The time merge's first bounce: every level gets the VPLs injected itself (a VPL in the coarse cell
+    # in front of its surface); each level's injected flux is the same here, where every VPL's point
+    # (0.6 of the level's cell in front of its surface) lies inside every level's grid. fp32 sums of
+    # ~1000 splats: 1e-5 relative. Levels 3 and 4 (cells of 8 and 16 grid cells) are not blocked.
+    method = LpvMethod(gl, GIConfig(method="lpv"), RsmConfig(resolution=32),
+                       LpvConfig(grid_cells=16, variant="octree", octree_merge="time"))
+    method.set_scene(corner_scene())
+    method.compute()
+    top = method.levels[0]
+    fluxes = [flux([gl.read(lv.snapshots[0][f"sh_{c}"]) for c in "rgb"]) for lv in (top, *top.octree)]
+    assert len(fluxes) == 5 and fluxes[0].min() > 0
+    for f in fluxes[1:]:
+        np.testing.assert_allclose(f, fluxes[0], rtol=1e-5)
+    assert [lv.blocking is not None for lv in (top, *top.octree)] == [True, True, True, False, False]

@@ -27,8 +27,11 @@ emitter_classes, improved, one cascade: `uses_emitter_classes`) the atlases hold
 VPL normal, each class is unpacked and propagated on its own into `class_accumulated` and added to the
 total, and lpv_lookup.own records each pixel's own class's reading, which the lookup subtracts from the
 total's; with later bounces lpv_reinject.own records each surface side's own-class reading too, which
-the second bounce's re-injection subtracts (later bounces propagate and look up their total). Products:
-direct, indirect, albedo.
+the second bounce's re-injection subtracts (later bounces propagate and look up their total). With the
+octree variant (lpv_octree; improved transport) the coarsest grid is level 0 of a mip chain of
+LpvConfig.octree_levels grids (`LpvVolume.octree`): every propagation of it (each bounce's) sums its
+source snapshot down the chain, runs octree_iterations steps on every level and merges the levels into
+its accumulation; it has no far field. Products: direct, indirect, albedo.
 """
 
 from __future__ import annotations
@@ -46,6 +49,7 @@ from ..passes import (
     lpv_far_field,
     lpv_inject,
     lpv_lookup,
+    lpv_octree,
     lpv_propagate,
     lpv_reinject,
     rsm_reduce,
@@ -57,11 +61,17 @@ from ..passes.voxelize import Voxelizer
 from .direct import OneBounceMethod
 
 
+def transport(config: LpvConfig) -> str:
+    """The propagation step's transfer (lpv_propagate's variants): the octree runs the improved one."""
+    return "classic" if config.variant == "classic" else "improved"
+
+
 def iterations_for(config: LpvConfig, grid: Grid) -> int:
-    """Propagation steps. classic: config.iterations. improved: at least the grid's Manhattan span
-    (sum(dims) - 3, capped at 256): light moves one cell per step along one axis, so fewer steps cut
-    it off before it has crossed the grid (BASELINE.md: light 'lost beyond ~12 cells')."""
-    if config.variant == "improved":
+    """Propagation steps. classic: config.iterations. improved (and the octree's finer cascades): at
+    least the grid's Manhattan span (sum(dims) - 3, capped at 256): light moves one cell per step along
+    one axis, so fewer steps cut it off before it has crossed the grid (BASELINE.md: light 'lost beyond
+    ~12 cells'). The octree's mip chain runs octree_iterations on each level instead (LpvMethod.propagate)."""
+    if transport(config) == "improved":
         return max(config.iterations, min(256, sum(grid.dims) - 3))
     return config.iterations
 
@@ -85,13 +95,17 @@ def uses_emitter_classes(config: LpvConfig) -> bool:
 
 class LpvVolume:
     """One grid's textures: snapshot sets (0 = the injection, kept for a finer cascade's inflow; 1 and 2
-    ping-pong), the accumulation, the injection atlas, when asked for the voxels, and its far-field grid
-    (`far`, an LpvVolume made with far_field_of, or None). A far-field grid's accumulation holds only
-    the far light of one propagation; it has no bounce accumulation, and with the geometry volume its
-    voxels (projected areas and offsets only) are summed from its fine grid's, not voxelized."""
+    ping-pong), the accumulation, the injection atlas, when asked for the voxels, its far-field grid
+    (`far`, an LpvVolume made with far_field_of, or None) and the coarser levels of its octree
+    (`octree`, each made with far_field_of = the level below; empty without). A far-field grid's (or
+    octree level's) accumulation holds only its own propagation's light; it has no bounce
+    accumulation, and with the geometry volume its voxels (projected areas and offsets only) are summed
+    from its fine grid's, not voxelized."""
 
-    def __init__(self, method: LpvMethod, cascade: lpv_cascade.Cascade, far_field_of: LpvVolume | None = None):
+    def __init__(self, method: LpvMethod, cascade: lpv_cascade.Cascade, far_field_of: LpvVolume | None = None,
+                 blocks: bool = True):
         be = method.backend
+        self.blocks = blocks  # False: an octree level above LpvConfig.octree_blocked_levels (no geometry volume)
         self.cascade, self.grid = cascade, cascade.grid
         self.far_field_of = far_field_of
         is_far_field = far_field_of is not None
@@ -113,12 +127,13 @@ class LpvVolume:
         self.voxels = None
         self.blocking = None  # lpv_propagate.blocking's volumes, with the geometry volume
         self.far: LpvVolume | None = None
+        self.octree: list[LpvVolume] = []
         self.voxelize(method)
 
     def voxelize(self, method: LpvMethod) -> None:
         cfg = method.lpv_config
         fine = self.far_field_of
-        if not (cfg.geometry_volume or (method.gi.bounces > 1 and fine is None)):
+        if not (cfg.geometry_volume or (method.gi.bounces > 1 and fine is None)) or not self.blocks:
             return
         if fine is not None:
             self.voxels = lpv_far_field.voxels(method.backend, fine.voxels, fine.grid, self.grid, self.voxels)
@@ -128,8 +143,10 @@ class LpvVolume:
             self.voxels = self._voxelizer.run()
         if cfg.geometry_volume:
             # Classic is the published scheme's baseline: its cells block half and half whatever the config.
-            offsets = cfg.surface_offsets and cfg.variant == "improved"
+            offsets = cfg.surface_offsets and transport(cfg) == "improved"
             self.blocking = lpv_propagate.blocking(method.backend, self.voxels, self.grid, offsets, self.blocking)
+        for coarse in self.octree:  # each level's geometry from the one below's, finest first
+            coarse.voxelize(method)
 
     def move(self, method: LpvMethod, cascade: lpv_cascade.Cascade) -> None:
         """The same dims at another place (the camera moved): re-voxelized; the atlas layout is unchanged."""
@@ -150,7 +167,7 @@ class LpvMethod(OneBounceMethod):
         OneBounceMethod.PASSES, setup=(voxelize.DECL, lpv_propagate.BLOCKING_DECL),
         # Per cascade, coarsest first: a finer one's inflow reads its parent's propagated light.
         solve=(lpv_cascade.PLACE_DECL, lpv_inject.DECL, lpv_propagate.DECL, lpv_cascade.INFLOW_DECL,
-               lpv_far_field.DECL),
+               lpv_far_field.DECL, lpv_octree.DECL),
         # With emitter classes the lookup's own-class readings need each class's propagation: the
         # gather runs them (propagate_classes); later bounces re-inject and propagate in the gather too.
         gather=(lpv_inject.DECL, lpv_propagate.DECL, lpv_lookup.DECL, lpv_reinject.DECL))
@@ -192,6 +209,12 @@ class LpvMethod(OneBounceMethod):
         top = self.levels[-1]
         if near_steps_for(self.lpv_config, top.grid):
             top.far = LpvVolume(self, lpv_cascade.Cascade(lpv_far_field.grid_for(top.grid)), far_field_of=top)
+        if self.lpv_config.variant == "octree":
+            below = top
+            for i, grid in enumerate(lpv_octree.level_grids(top.grid, self.lpv_config.octree_levels), start=1):
+                below = LpvVolume(self, lpv_cascade.Cascade(grid), far_field_of=below,
+                                  blocks=i < self.lpv_config.octree_blocked_levels)
+                top.octree.append(below)
         res = self.rsm_config.resolution
         self._reduce = rsm_reduce.factor_for(res, self.lpv_config.grid_cells)
         self._vpls = rsm_reduce.textures(self.backend, res, self._reduce) if self._reduce > 1 else None
@@ -214,12 +237,13 @@ class LpvMethod(OneBounceMethod):
     def lookup_vox(self, level: LpvVolume):
         """The improved variant's lookup skips the trilinear corners a surface blocks along its normal;
         classic keeps the published plain trilinear lookup (docs/LPV.md, "Lookup")."""
-        return level.vox_normal if self.lpv_config.variant == "improved" else None
+        return level.vox_normal if transport(self.lpv_config) == "improved" else None
 
     def grids(self) -> list[LpvVolume]:
         """Every grid that receives the VPLs: the cascades, finest first, then the far field if any."""
         far = self.levels[-1].far
-        return self.levels + ([far] if far is not None else [])
+        octree = self.levels[-1].octree if lpv_octree.injects(self.lpv_config.octree_merge) else []
+        return self.levels + ([far] if far is not None else []) + octree
 
     def keeps_light_field(self) -> bool:
         """Cascades are placed around the camera (a camera move can move them: a new solve); later
@@ -248,9 +272,14 @@ class LpvMethod(OneBounceMethod):
         """Propagate a grid's (default: the finest's) snapshot set 0 into `accumulated` (default: its
         total), overwriting it; set 0 is kept. With a far field (whose snapshot set 0 the caller has
         filled too) the grid runs its near steps, the far field its own span, and its far light is added.
-        `iterations` overrides the config: that many steps on this grid alone."""
+        With an octree, set 0 is summed down the mip chain, every level runs octree_iterations steps, and
+        the levels are merged into `accumulated`. `iterations` overrides the config: that many steps on
+        this grid alone."""
         level = self.levels[0] if level is None else level
         acc = level.accumulated if accumulated is None else accumulated
+        if level.octree and iterations is None:
+            self._propagate_octree(level, acc)
+            return
         near = near_steps_for(self.lpv_config, level.grid) if level.far is not None and iterations is None else 0
         if not near:
             self._steps(level, iterations_for(self.lpv_config, level.grid) if iterations is None else iterations,
@@ -263,13 +292,37 @@ class LpvMethod(OneBounceMethod):
                     lambda step: lpv_far_field.coarse_weight(step, near))
         lpv_far_field.add(self.backend, far.accumulated, far.grid, acc, level.grid)
 
+    def fill_octree(self, level: LpvVolume, injected: bool) -> None:
+        """The source snapshot (set 0) of every coarser level of `level`'s octree: unpacked from its own
+        injection (`injected`: the first bounce of the time merge) or summed down from level 0's."""
+        be, chain = self.backend, [level, *level.octree]
+        for fine, coarse in zip(chain[:-1], chain[1:], strict=True):
+            if injected:
+                lpv_inject.unpack(be, coarse.inject_atlas, coarse.snapshots[0], coarse.grid, coarse.atlas)
+            else:
+                lpv_octree.downsample(be, fine.snapshots[0], fine.grid, coarse.snapshots[0], coarse.grid)
+
+    def _propagate_octree(self, level: LpvVolume, acc: dict) -> None:
+        """`level`'s octree (lpv_octree; every level's snapshot set 0 filled by fill_octree) propagated
+        and merged into acc (overwritten)."""
+        cfg, chain = self.lpv_config, [level, *level.octree]
+        accs = [acc] + [coarse.accumulated for coarse in level.octree]
+        k, n, mode = cfg.octree_iterations, len(chain), cfg.octree_merge
+        span = min(256, sum(chain[-1].grid.dims) - 3)  # the coarsest level's Manhattan span
+        for i, (lv, lv_acc) in enumerate(zip(chain, accs, strict=True)):
+            share = (lambda step, i=i: lpv_octree.time_share(i, step, k, n)) if mode == "time" else None
+            self._steps(lv, lpv_octree.steps(i, k, n, mode, span), lv_acc, share)
+        for i in reversed(range(n - 1)):  # coarse to fine: each merge reads the merged level above
+            lpv_octree.merge(self.backend, accs[i + 1], chain[i + 1].grid, accs[i], chain[i].grid, mode,
+                             cfg.octree_epsilon)
+
     def _steps(self, level: LpvVolume, n: int, acc: dict, share=None) -> None:
         """n propagation steps of `level` from its snapshot set 0, accumulated into acc (overwritten),
         step s (1-based) weighted by share(s) when given."""
         sets = level.snapshots
         for i in range(n):
             src = sets[0] if i == 0 else sets[2 - i % 2]
-            lpv_propagate.run(self.backend, src, sets[1 + i % 2], acc, level.grid, self.lpv_config.variant,
+            lpv_propagate.run(self.backend, src, sets[1 + i % 2], acc, level.grid, transport(self.lpv_config),
                               first_step=i == 0, geometry=level.blocking,
                               step_scale=1.0 if share is None else share(i + 1))
 
@@ -293,10 +346,12 @@ class LpvMethod(OneBounceMethod):
                     if i + 1 < len(levels):
                         parent = levels[i + 1]
                         lpv_cascade.inflow(be, level.cascade, level.snapshots[0], parent.grid,
-                                           parent.bounce_accumulated, parent.snapshots[0], self.lpv_config.variant)
+                                           parent.bounce_accumulated, parent.snapshots[0], transport(self.lpv_config))
                     if level.far is not None:
                         lpv_far_field.source(be, level.snapshots[0], level.grid, level.far.snapshots[0],
                                              level.far.grid)
+                    if level.octree:  # the re-injected light summed down the mip chain
+                        self.fill_octree(level, injected=False)
                 with self.step(timings, lpv_propagate.DECL):
                     self.propagate(accumulated=level.bounce_accumulated, level=level)
             if look_up:
@@ -332,10 +387,12 @@ class LpvMethod(OneBounceMethod):
                 if level.far is not None:
                     far = level.far
                     lpv_inject.unpack(be, far.inject_atlas, far.snapshots[0], far.grid, far.atlas)
+                if level.octree:
+                    self.fill_octree(level, injected=lpv_octree.injects(self.lpv_config.octree_merge))
                 if i + 1 < len(self.levels):
                     parent = self.levels[i + 1]
                     lpv_cascade.inflow(be, level.cascade, level.snapshots[0], parent.grid, parent.accumulated,
-                                       parent.snapshots[0], self.lpv_config.variant)
+                                       parent.snapshots[0], transport(self.lpv_config))
             with self.step(timings, lpv_propagate.DECL):
                 if len(self.levels) > 1:
                     with self.timed(timings, f"lpv_propagate_cascade{i}"):
