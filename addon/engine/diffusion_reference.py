@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import sh
+from .lpv_reference import gpu_improved_transfer
 
 AXES = ((0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0), (2, 1.0), (2, -1.0))
 DIRECTIONS = np.array([np.eye(3)[axis] * sign for axis, sign in AXES])  # (6, 3)
@@ -130,19 +131,41 @@ def emit(flux_plus: np.ndarray, flux_minus: np.ndarray, normal: np.ndarray, occu
 
 
 # -- one step ------------------------------------------------------------------------------------------
-def face_fluxes(field: np.ndarray, open_faces: np.ndarray) -> np.ndarray:
-    """(z, y, x, 6) W leaving each cell through each face: the field's flux through the face's cone,
-    <L, T_d> (exact for the L1 intensity), clamped at 0 and kept only on open faces, then scaled so
-    the faces carry the cell's whole flux, max(0, 2 sqrt(pi) c0): the L1 lobe is negative behind
-    itself, and a clamp alone would add light; the scale moves it to the faces it can leave by."""
-    raw = np.maximum(field @ CONES.T, 0.0) * open_faces
+TRANSFERS = ("cone", "directional")
+
+
+def directional_matrices() -> np.ndarray:
+    """(6, 4, 4) M_d of the `directional` transfer: LPV's improved transfer (lpv_reference.
+    gpu_improved_transfer, docs/LPV.md), the L1 projection of L(w) max(0, w.d) / |w|_1; sum_d M_d = 1."""
+    return np.array(gpu_improved_transfer()[0])
+
+
+def face_transport(field: np.ndarray, transfer: str) -> tuple[np.ndarray, np.ndarray]:
+    """(raw face fluxes (z, y, x, 6) W, the SH each face carries (z, y, x, 6, 4) per W of them).
+    cone (the paper's, normalised): the flux through the face's cone, <L, T_d>, arriving as the uniform
+    cone 3 / (2 pi) T_d. directional: the flux of M_d L, arriving as M_d L itself (the light keeps its
+    direction within the face's share)."""
+    if transfer == "cone":
+        shape = (*field.shape[:-1], 6, 4)
+        return field @ CONES.T, np.broadcast_to(TRANSFER_NORM * CONES, shape)
+    moved = np.einsum("dij,...j->...di", directional_matrices(), field)
+    raw = FLUX_PER_C0 * moved[..., 0]
+    return raw, moved / np.where(raw > 0.0, raw, 1.0)[..., None]
+
+
+def face_fluxes(field: np.ndarray, open_faces: np.ndarray, transfer: str = "cone") -> np.ndarray:
+    """(z, y, x, 6) W leaving each cell through each face: the transfer's raw face flux (exact for the L1
+    intensity), clamped at 0 and kept only on open faces, then scaled so the faces carry the cell's whole
+    flux, max(0, 2 sqrt(pi) c0): the L1 lobe is negative behind itself, and a clamp alone would add
+    light; the scale moves it to the faces it can leave by."""
+    raw = np.maximum(face_transport(field, transfer)[0], 0.0) * open_faces
     total = np.maximum(FLUX_PER_C0 * field[..., 0], 0.0)
     s = raw.sum(axis=-1, keepdims=True)
     return np.where(s > 0.0, raw * (total[..., None] / np.where(s > 0.0, s, 1.0)), 0.0)
 
 
 def inflow(out: np.ndarray) -> np.ndarray:
-    """(z, y, x, 6): a[j, d] = the flux neighbour j - d sends through face d into j (0 from outside)."""
+    """(z, y, x, 6, ...): a[j, d] = what neighbour j - d sends through face d into j (0 from outside)."""
     a = np.zeros_like(out)
     for f, (axis, sign) in enumerate(AXES):
         zyx = 2 - axis
@@ -163,28 +186,32 @@ def side_weights(normal: np.ndarray) -> np.ndarray:
     return np.where(dn < -SIDE_EPSILON, 1.0, np.where(dn > SIDE_EPSILON, 0.0, 0.5))
 
 
-def step(field: np.ndarray, cell: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def step(field: np.ndarray, cell: dict, transfer: str = "cone") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """One gather step: (next field, flux absorbed on the plus side, on the minus side), W.
 
     Each cell gathers its neighbours' face fluxes a_d (`face_fluxes`, `inflow`). An occupied cell's
     surface absorbs block[axis(d)] x a_d, split between its sides (`side_weights`); the rest, and all of
-    an empty cell's inflow, is carried on: the next field is TRANSFER_NORM x sum_d carried_d T_d
-    (flux sum_d carried_d: nothing is gained). Absorbed light is not re-emitted within the step: each
-    bounce is its own propagation (`emit` makes the next one's emitters)."""
-    a = inflow(face_fluxes(field, cell["open"]))
+    an empty cell's inflow, is carried on as the transfer's SH per W (`face_transport`): the next field
+    is sum_d carried_d x shape_d, of flux sum_d carried_d (nothing is gained). Absorbed light is not
+    re-emitted within the step: each bounce is its own propagation (`emit` makes the next emitters)."""
+    out = face_fluxes(field, cell["open"], transfer)
+    a = inflow(out)
+    shape = inflow(np.ascontiguousarray(face_transport(field, transfer)[1]))
     axis_of_face = np.array([axis for axis, _ in AXES])
     absorbed = a * cell["block"][..., axis_of_face]
     carried = a - absorbed
     plus = side_weights(cell["normal"])
-    return TRANSFER_NORM * carried @ CONES, np.sum(absorbed * plus, -1), np.sum(absorbed * (1.0 - plus), -1)
+    nxt = np.einsum("...d,...dk->...k", carried, shape)
+    return nxt, np.sum(absorbed * plus, -1), np.sum(absorbed * (1.0 - plus), -1)
 
 
-def propagate(field: np.ndarray, cell: dict, steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def propagate(field: np.ndarray, cell: dict, steps: int,
+              transfer: str = "cone") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """`steps` steps from emitters `field`: (field left in flight, absorbed plus, absorbed minus)."""
     plus = np.zeros(field.shape[:-1])
     minus = np.zeros(field.shape[:-1])
     for _ in range(steps):
-        field, p, m = step(field, cell)
+        field, p, m = step(field, cell, transfer)
         plus += p
         minus += m
     return field, plus, minus

@@ -1,30 +1,72 @@
-// One diffusion step, gather form (diffusion_reference.step; Mavridis et al., seeds 000, with the face
-// transfer normalised by 3 / (2 pi)). Each neighbour's flux through the face it shares with this cell
-// is its field's flux through that face's cone, clamped at 0, kept on its open faces and scaled so its
-// faces carry its whole flux (`outflow`). This cell's surface (if any) absorbs block[axis] of each face's
-// inflow, on the side the light travels into; the rest is carried on as a uniform intensity over the
-// face's cone: dst = 3 / (2 pi) x sum_f carried_f T_f. Absorbed flux (W, per side) goes to acc_plus /
-// acc_minus (first_step: written, else added). Six neighbours x six faces, unrolled by the compiler.
+// One diffusion step, gather form (diffusion_reference.step; Mavridis et al., seeds 000). Each
+// neighbour's raw flux through the face it shares with this cell (cone: its field's flux through the
+// face's cone, the paper's transfer; DIRECTIONAL: the flux of M_d L, LPV's improved transfer) is clamped
+// at 0, kept on its open faces and scaled so its faces carry its whole flux (`outflow`). This cell's
+// surface (if any) absorbs block[axis] of each face's inflow, on the side the light travels into; the
+// rest is carried on in the transfer's shape: cone, a uniform intensity over the face's cone, 3 / (2 pi)
+// T_f per W (the normalisation that keeps a uniform field unchanged); DIRECTIONAL, M_d L per W of it.
+// Absorbed flux (W, per side) goes to acc_plus / acc_minus (first_step: written, else added).
 #include "diffusion/cell.glsl"
 
-vec3 outflow(ivec3 i, int face) {
+#ifdef DIRECTIONAL
+// M_d L for face f (lpv/transfer.glsl's symmetric form: M00 = 1/6, m_cross between c0 and the face
+// axis's coefficient, m_along on it, m_side on the two others).
+vec4 directional(vec4 c, int f) {
+    int slot = (f >> 1) == 0 ? 3 : (f >> 1);  // x, y, z -> coefficient 3, 1, 2 of (1, y, z, x)
+    float s = (f & 1) == 0 ? 1.0 : -1.0;
+    vec4 m = m_side * c;
+    m.x = c.x / 6.0 + s * m_cross * c[slot];
+    m[slot] = s * m_cross * c.x + m_along * c[slot];
+    return m;
+}
+#endif
+
+// The raw flux of channel c through the six faces, as two vec3 (+x +y +z, -x -y -z): both transfers'
+// are k0 c0 +- k1 c_axis (cone: <L, T_d> = c0 sqrt(pi) / 3 +- c1 c_axis; directional: 2 sqrt(pi) x
+// (M_d L)_0 = 2 sqrt(pi) (c0 / 6 +- m_cross c_axis)).
+#ifdef DIRECTIONAL
+#define RAW_K0 (DIFFUSION_FLUX_PER_C0 / 6.0)
+#define RAW_K1 (DIFFUSION_FLUX_PER_C0 * m_cross)
+#else
+#define RAW_K0 DIFFUSION_CONE_C0
+#define RAW_K1 DIFFUSION_CONE_C1
+#endif
+
+// Of one channel's field c: the flux sent through `face` once clamped, masked by the open faces and
+// scaled to the cell's flux; `shape` = the SH it arrives as per W.
+float channel_outflow(vec4 c, vec3 open_plus, vec3 open_minus, int face, out vec4 shape) {
+    vec3 along = c.wyz;  // the coefficients of x, y, z
+    vec3 raw_plus = RAW_K0 * c.x + RAW_K1 * along;
+    vec3 raw_minus = RAW_K0 * c.x - RAW_K1 * along;
+    vec3 plus = max(raw_plus, vec3(0.0)) * open_plus;
+    vec3 minus = max(raw_minus, vec3(0.0)) * open_minus;
+    float sum = dot(plus + minus, vec3(1.0));
+    int axis = face >> 1;
+    bool positive = (face & 1) == 0;
+    float through = positive ? plus[axis] : minus[axis];
+#ifdef DIRECTIONAL
+    float raw = positive ? raw_plus[axis] : raw_minus[axis];
+    shape = directional(c, face) / (raw > 0.0 ? raw : 1.0);
+#else
+    shape = diffusion_cone(face) * DIFFUSION_TRANSFER_NORM;
+#endif
+    float total = max(DIFFUSION_FLUX_PER_C0 * c.x, 0.0);
+    return sum > 0.0 ? through * (total / sum) : 0.0;
+}
+
+// The flux neighbour i sends through `face` (per colour, W) and, per colour, the SH it arrives as per W.
+vec3 outflow(ivec3 i, int face, out vec4 shape_r, out vec4 shape_g, out vec4 shape_b) {
+    shape_r = shape_g = shape_b = vec4(0.0);
     if (!diffusion_inside(i)) {
         return vec3(0.0);
     }
-    vec4 r = texelFetch(src_r, i, 0);
-    vec4 g = texelFetch(src_g, i, 0);
-    vec4 b = texelFetch(src_b, i, 0);
     vec4 block = texelFetch(cell_block, i, 0);
-    vec3 through = vec3(0.0);
-    vec3 sum = vec3(0.0);
-    for (int f = 0; f < 6; f++) {
-        vec4 t = diffusion_cone(f);
-        vec3 v = diffusion_face_open(block, f) ? max(vec3(dot(r, t), dot(g, t), dot(b, t)), vec3(0.0)) : vec3(0.0);
-        sum += v;
-        through = f == face ? v : through;
-    }
-    vec3 total = max(DIFFUSION_FLUX_PER_C0 * vec3(r.x, g.x, b.x), vec3(0.0));
-    return mix(vec3(0.0), through * (total / max(sum, vec3(1e-30))), greaterThan(sum, vec3(0.0)));
+    int mask = block.w <= 0.0 ? 63 : int(block.w) - 1;
+    vec3 open_plus = vec3(notEqual(ivec3(mask & 1, mask & 4, mask & 16), ivec3(0)));
+    vec3 open_minus = vec3(notEqual(ivec3(mask & 2, mask & 8, mask & 32), ivec3(0)));
+    return vec3(channel_outflow(texelFetch(src_r, i, 0), open_plus, open_minus, face, shape_r),
+                channel_outflow(texelFetch(src_g, i, 0), open_plus, open_minus, face, shape_g),
+                channel_outflow(texelFetch(src_b, i, 0), open_plus, open_minus, face, shape_b));
 }
 
 void main() {
@@ -39,7 +81,8 @@ void main() {
     vec3 plus = vec3(0.0), minus = vec3(0.0);
     for (int f = 0; f < 6; f++) {
         vec3 d = diffusion_direction(f);
-        vec3 a = outflow(c - ivec3(d), f);
+        vec4 shape_r, shape_g, shape_b;
+        vec3 a = outflow(c - ivec3(d), f, shape_r, shape_g, shape_b);
         float absorb = occupied ? block[f >> 1] : 0.0;
         vec3 absorbed = a * absorb;
         vec3 carried = a - absorbed;
@@ -47,10 +90,9 @@ void main() {
         float to_plus = dn < -DIFFUSION_SIDE_EPSILON ? 1.0 : (dn > DIFFUSION_SIDE_EPSILON ? 0.0 : 0.5);
         plus += absorbed * to_plus;
         minus += absorbed * (1.0 - to_plus);
-        vec4 t = diffusion_cone(f) * DIFFUSION_TRANSFER_NORM;
-        r += carried.r * t;
-        g += carried.g * t;
-        b += carried.b * t;
+        r += carried.r * shape_r;
+        g += carried.g * shape_g;
+        b += carried.b * shape_b;
     }
     imageStore(dst_r, c, r);
     imageStore(dst_g, c, g);

@@ -94,7 +94,8 @@ def sh_volumes(gl, grid, data=None):
     return {f"sh_{c}": gl.texture(grid.dims, "RGBA32F", x) for c, x in zip("rgb", d, strict=True)}
 
 
-def test_propagation_steps_are_the_twins(gl):
+@pytest.mark.parametrize("transfer", ref.TRANSFERS)
+def test_propagation_steps_are_the_twins(gl, transfer):
     # Two steps through random cells: the next fields, and the absorbed flux written by the first step
     # and added by the second (stale contents in the accumulation are overwritten by the first).
     rng = np.random.default_rng(2)
@@ -108,9 +109,10 @@ def test_propagation_steps_are_the_twins(gl):
     want = [np.asarray(f, np.float64) for f in fields]
     plus, minus = np.zeros((3, *zyx(GRID, 0)[:3])), np.zeros((3, *zyx(GRID, 0)[:3]))
     for i in range(2):
-        diffusion_propagate.run(gl, sets[i % 2], sets[(i + 1) % 2], absorbed, cells, GRID, first_step=i == 0)
+        diffusion_propagate.run(gl, sets[i % 2], sets[(i + 1) % 2], absorbed, cells, GRID, first_step=i == 0,
+                                transfer=transfer)
         for ch in range(3):
-            want[ch], p, m = ref.step(want[ch], cell)
+            want[ch], p, m = ref.step(want[ch], cell, transfer)
             plus[ch] += p
             minus[ch] += m
         got = [gl.read(sets[(i + 1) % 2][f"sh_{c}"]) for c in "rgb"]

@@ -29,14 +29,15 @@ def test_the_face_cones_partition_the_sphere():
     np.testing.assert_allclose(sh.project(inside.astype(float), dirs, w), ref.CONES[0], rtol=0, atol=2e-4)
 
 
-def test_a_uniform_isotropic_field_is_unchanged_by_a_step():
+@pytest.mark.parametrize("transfer", ref.TRANSFERS)
+def test_a_uniform_isotropic_field_is_unchanged_by_a_step(transfer):
     # The digest's check of the normalisation 3 / (2 pi): an isotropic intensity c0 sends <L, T_d> =
     # c0 sqrt(pi) / 3 through each face; each arrives as 3 / (2 pi) x that x T_d, and the six cones sum
-    # to (2 sqrt(pi), 0, 0, 0): c0 exactly.
+    # to (2 sqrt(pi), 0, 0, 0): c0 exactly. directional: sum_d M_d = 1 (LPV's improved transfer).
     # Cells next to the grid's edge miss the inflow from outside, so only the interior is compared.
     field = np.zeros((*DIMS_ZYX, 4))
     field[..., 0] = 1.7
-    nxt, plus, minus = ref.step(field, empty_cells())
+    nxt, plus, minus = ref.step(field, empty_cells(), transfer)
     # Band 1 cancels between opposite faces to 3e-17 (the cones' x, y, z terms in float64).
     np.testing.assert_allclose(nxt[1:-1, 1:-1, 1:-1], field[1:-1, 1:-1, 1:-1], rtol=1e-14, atol=1e-15)
     assert not plus.any() and not minus.any()  # no surface: nothing absorbed
@@ -51,8 +52,9 @@ def random_cells(rng, dims=DIMS_ZYX, share=0.3):
     return ref.cells(occ, normal, proj)
 
 
+@pytest.mark.parametrize("transfer", ref.TRANSFERS)
 @pytest.mark.parametrize("seed", range(5))
-def test_a_step_never_adds_light(seed):
+def test_a_step_never_adds_light(seed, transfer):
     # Fields with strong band 1 (|c1| up to 3 c0: negative lobes the clamp must not turn into light):
     # the flux carried on plus the flux absorbed is at most the flux of the cells with positive c0 (the
     # rest may leave the grid, never exceed it); with no open boundary (light kept inside by a closed
@@ -61,7 +63,7 @@ def test_a_step_never_adds_light(seed):
     field = rng.normal(size=(*DIMS_ZYX, 4))
     field[..., 0] = np.abs(field[..., 0])
     cell = random_cells(rng)
-    nxt, plus, minus = ref.step(field, cell)
+    nxt, plus, minus = ref.step(field, cell, transfer)
     before = ref.flux_w(field)
     after = ref.flux_w(nxt) + plus.sum() + minus.sum()
     assert after <= before * (1 + 1e-12)
@@ -70,7 +72,8 @@ def test_a_step_never_adds_light(seed):
     assert np.all(nxt[..., 0] >= -1e-15)
 
 
-def test_a_closed_box_keeps_all_of_its_light():
+@pytest.mark.parametrize("transfer", ref.TRANSFERS)
+def test_a_closed_box_keeps_all_of_its_light(transfer):
     # A shell of fully blocking cells (projected area 1 on every axis) around an empty interior: all the
     # interior sends into the shell is absorbed, the rest stays inside, so the field's flux plus the
     # absorbed flux stays the emitters' to rounding, step after step.
@@ -85,13 +88,14 @@ def test_a_closed_box_keeps_all_of_its_light():
     total = ref.flux_w(field)
     absorbed = 0.0
     for _ in range(4):
-        field, plus, minus = ref.step(field, cell)
+        field, plus, minus = ref.step(field, cell, transfer)
         absorbed += plus.sum() + minus.sum()
         assert ref.flux_w(field) + absorbed == pytest.approx(total, rel=1e-12)
 
 
+@pytest.mark.parametrize("transfer", ref.TRANSFERS)
 @pytest.mark.parametrize("cancelled_normal", [False, True])
-def test_a_one_cell_wall_stops_light(cancelled_normal):
+def test_a_one_cell_wall_stops_light(cancelled_normal, transfer):
     # A wall one cell thick across the whole grid at x = 4 (projected area 1 along x). Its normal is +x,
     # or (cancelled_normal) 0: both faces of a thin wall in one cell, whose mean normal cancels; the
     # cells then take the axis it projects the most along. An isotropic emitter at x = 1: after 40 steps
@@ -110,7 +114,7 @@ def test_a_one_cell_wall_stops_light(cancelled_normal):
     field = np.zeros((*dims, 4))
     field[4, 4, 1, 0] = 1.0
     total = ref.flux_w(field)
-    left, plus, minus = ref.propagate(field, cell, 40)
+    left, plus, minus = ref.propagate(field, cell, 40, transfer)
     assert not left[:, :, 5:].any()
     assert plus.sum() == 0.0
     # Most of the rest leaves the 8 x 8 cross-section sideways; a fifth reaches the wall (measured 0.25).

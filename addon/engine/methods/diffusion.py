@@ -86,6 +86,7 @@ class DiffusionMethod(OneBounceMethod):
         propagation into `absorbed`, added to `accumulated` (the same volumes with one bounce)."""
         be, grid = self.backend, self.grid
         steps = steps_per_bounce(self.diffusion_config, grid, self.gi.bounces)
+        transfer = self.diffusion_config.transfer
         for bounce in range(1, self.gi.bounces + 1):
             with self.step(timings, diffusion_inject.EMIT_DECL):
                 if bounce == 1:
@@ -96,7 +97,7 @@ class DiffusionMethod(OneBounceMethod):
             with self.step(timings, diffusion_propagate.DECL):
                 for i in range(steps):
                     diffusion_propagate.run(be, self.snapshots[i % 2], self.snapshots[(i + 1) % 2], self.absorbed,
-                                            self.cells, grid, first_step=i == 0)
+                                            self.cells, grid, first_step=i == 0, transfer=transfer)
                 if self.accumulated is not self.absorbed:
                     diffusion_propagate.add(be, self.absorbed, self.accumulated, grid, first=bounce == 1)
 

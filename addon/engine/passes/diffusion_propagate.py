@@ -3,8 +3,9 @@
 Inputs: the snapshot `src_r/g/b` (RGBA32F 3D, L1 SH of radiant intensity W/sr by direction of travel),
 the cells (diffusion_cells). Outputs: the next snapshot `dst_r/g/b` and `acc_plus` / `acc_minus`
 (RGBA32F 3D, rgb = flux in W absorbed on each side of a cell's plane; first_step: written, else added).
-gpu_shaders/diffusion/propagate.comp.glsl has the step (Mavridis et al., seeds 000, the face transfer
-normalised by 3 / (2 pi)); diffusion_reference.step is its twin and docs/DIFFUSION.md derives it.
+gpu_shaders/diffusion/propagate.comp.glsl has the step (Mavridis et al., seeds 000): the paper's face
+transfer normalised by 3 / (2 pi) (`cone`), or LPV's improved transfer (`directional`, light keeps its
+direction); diffusion_reference.step is its twin and docs/DIFFUSION.md derives and measures both.
 `add` sums one bounce's absorbed flux into the light field's total.
 """
 
@@ -15,20 +16,30 @@ from ..grid import Grid
 from .declare import PassDecl, Port
 from .diffusion_cells import CELL_BLOCK, CELL_NORMAL
 from .diffusion_inject import SNAPSHOT
+from .lpv_propagate import improved_constants
 
 ABSORBED = Port("diffusion", "absorbed", "RGBA32F", "grid", "one bounce's flux (W) absorbed on each side of a plane")
 ACCUMULATED = Port("diffusion", "accumulated", "RGBA32F", "grid",
                    "every bounce's flux (W) absorbed on each side of a plane: the light field")
 
-SPEC = ShaderSpec(
-    name="diffusion_propagate",
-    compute="diffusion/propagate.comp.glsl",
-    local_size=(4, 4, 4),
-    samplers=(*(Sampler(f"src_{c}", "3D") for c in "rgb"), Sampler("cell_normal", "3D"), Sampler("cell_block", "3D")),
-    images=(*(Image(f"dst_{c}", "3D", "RGBA32F", "write") for c in "rgb"),
-            Image("acc_plus", "3D", "RGBA32F", "read_write"), Image("acc_minus", "3D", "RGBA32F", "read_write")),
-    uniforms=(Var("dims", "ivec3"), Var("first_step", "int")),
-)
+def _spec(transfer: str) -> ShaderSpec:
+    directional = transfer == "directional"
+    return ShaderSpec(
+        name=f"diffusion_propagate_{transfer}",
+        compute="diffusion/propagate.comp.glsl",
+        local_size=(4, 4, 4),
+        samplers=(*(Sampler(f"src_{c}", "3D") for c in "rgb"), Sampler("cell_normal", "3D"),
+                  Sampler("cell_block", "3D")),
+        images=(*(Image(f"dst_{c}", "3D", "RGBA32F", "write") for c in "rgb"),
+                Image("acc_plus", "3D", "RGBA32F", "read_write"), Image("acc_minus", "3D", "RGBA32F", "read_write")),
+        uniforms=(Var("dims", "ivec3"), Var("first_step", "int"))
+        + ((Var("m_cross", "float"), Var("m_along", "float"), Var("m_side", "float")) if directional else ()),
+        defines=(("DIRECTIONAL", "1"),) if directional else (),
+    )
+
+
+# cone: the paper's face-cone transfer, normalised; directional: LPV's improved transfer (docs/DIFFUSION.md).
+SPECS = {t: _spec(t) for t in ("cone", "directional")}
 
 ADD = ShaderSpec(
     name="diffusion_add",
@@ -48,11 +59,16 @@ def sides(backend: Backend, grid: Grid) -> dict:
     return {k: backend.texture(grid.dims) for k in ("flux_plus", "flux_minus")}
 
 
-def run(backend: Backend, src: dict, dst: dict, absorbed: dict, cells: dict, grid: Grid, first_step: bool) -> None:
+def run(backend: Backend, src: dict, dst: dict, absorbed: dict, cells: dict, grid: Grid, first_step: bool,
+        transfer: str = "cone") -> None:
     """One step: src (sh_r/g/b) -> dst, the flux absorbed written (first_step) or added into `absorbed`
     (flux_plus / flux_minus)."""
-    backend.dispatch(backend.program(SPEC), group_count(grid.dims, SPEC.local_size),
-                     uniforms={"dims": grid.dims, "first_step": int(first_step)},
+    spec = SPECS[transfer]
+    uniforms = {"dims": grid.dims, "first_step": int(first_step)}
+    if transfer == "directional":
+        c = improved_constants()
+        uniforms.update(m_cross=c["m_cross"], m_along=c["m_along"], m_side=c["m_side"])
+    backend.dispatch(backend.program(spec), group_count(grid.dims, spec.local_size), uniforms=uniforms,
                      samplers={**{f"src_{c}": src[f"sh_{c}"] for c in "rgb"}, **cells},
                      images={**{f"dst_{c}": dst[f"sh_{c}"] for c in "rgb"}, "acc_plus": absorbed["flux_plus"],
                              "acc_minus": absorbed["flux_minus"]})

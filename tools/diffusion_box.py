@@ -1,0 +1,89 @@
+"""The `diffusion` transport's measured limits on its numpy twin (addon/engine/diffusion_reference.py):
+the figures docs/DIFFUSION.md quotes, reproducible without a GPU.
+
+1. A closed cube of N cells (one-cell walls, black: each bounce alone) whose floor has a lit patch of
+   10 x 10 cells in its middle: the share of the patch's light absorbed after Y, 2Y, 4Y steps (Y = N),
+   and where it lands: on the floor itself (exact 0: a plane cannot light itself) and on the ceiling
+   (exact: the patch's view factor to the ceiling, about 0.23 at N = 32).
+2. An isotropic point source in an empty grid: r^2 x the irradiance on the +x axis at 2..12 cells
+   (exact: 1 / (4 pi) at every r).
+
+Run: .venv/bin/python tools/diffusion_box.py [--cells 32]  (about 10 s at 32 cells)
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from addon.engine import diffusion_reference as ref  # noqa: E402
+
+
+def closed_box(n: int) -> dict:
+    dims = (n, n, n)
+    occ = np.zeros(dims, bool)
+    normal = np.zeros((*dims, 3))
+    proj = np.zeros((*dims, 3))
+    for axis in range(3):
+        for index, sign in ((1, 1.0), (n - 2, -1.0)):  # walls one cell in from the grid's edge, facing in
+            sl = [slice(None)] * 3
+            sl[2 - axis] = index
+            occ[tuple(sl)] = True
+            normal[tuple(sl)] += sign * np.eye(3)[axis]
+            proj[tuple(sl)] = np.maximum(proj[tuple(sl)], np.eye(3)[axis])
+    length = np.linalg.norm(normal, axis=-1, keepdims=True)
+    normal = np.where(length > 0, normal / np.maximum(length, 1e-30), 0.0)
+    return ref.cells(occ, normal, proj)
+
+
+def box_figures(n: int) -> None:
+    cell = closed_box(n)
+    lit = np.zeros((n, n, n))
+    mid = n // 2
+    lit[1, mid - 5:mid + 5, mid - 5:mid + 5] = 1.0
+    field = ref.emit(lit, np.zeros_like(lit), cell["normal"], cell["occupied"])
+    total = ref.flux_w(field)
+    absorbed = np.zeros_like(lit)
+    print(f"closed box of {n} cells, 10 x 10 lit floor patch (exact: floor 0, ceiling ~0.23 at 32 cells)")
+    print("steps  absorbed  floor  ceiling  walls")
+    done = 0
+    for steps in (n, 2 * n, 4 * n):
+        field, plus, minus = ref.propagate(field, cell, steps - done)
+        done = steps
+        absorbed += plus + minus
+        floor = absorbed[1, 2:-2, 2:-2].sum() / total
+        ceiling = absorbed[n - 2, 2:-2, 2:-2].sum() / total
+        share = absorbed.sum() / total
+        print(f"{steps:5d}  {share:8.3f}  {floor:5.3f}  {ceiling:7.3f}  {share - floor - ceiling:5.3f}")
+
+
+def point_source_figures(steps: int = 120, size: int = 41) -> None:
+    dims = (size, size, size)
+    c = size // 2
+    cell = ref.cells(np.zeros(dims, bool), np.zeros((*dims, 3)), np.zeros((*dims, 3)))
+    field = np.zeros((*dims, 4))
+    field[c, c, c, 0] = 1.0 / ref.FLUX_PER_C0
+    through = np.zeros(size)
+    for _ in range(steps):
+        through += ref.inflow(ref.face_fluxes(field, cell["open"]))[c, c, :, 0]
+        field, _, _ = ref.step(field, cell)
+    r = np.arange(2, 13)
+    print(f"point source, {steps} steps on {size}^3 cells: 4 pi r^2 E(r) on the axis (exact 1)")
+    print("  ".join(f"r={k}: {v:.2f}" for k, v in zip(r, 4 * np.pi * r**2 * through[c + r], strict=True)))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--cells", type=int, default=32)
+    args = parser.parse_args()
+    box_figures(args.cells)
+    point_source_figures()
+
+
+if __name__ == "__main__":
+    main()

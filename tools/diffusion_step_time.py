@@ -1,0 +1,80 @@
+"""One `diffusion` propagation step (both transfers) against one `lpv` step (improved, geometry volume: its
+defaults), on
+the same backend in the same run, on a grid of N^3 cells a third of which hold surfaces (docs/DIFFUSION.md,
+"Speed"). Each figure: the median over 5 rounds of (32 steps, finish()) / 32, alternating the methods so
+both see the same load.
+
+Run: .venv/bin/python tools/diffusion_step_time.py [--cells 32]
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from addon.engine.backends.moderngl_backend import ModernGLBackend  # noqa: E402
+from addon.engine.grid import Grid  # noqa: E402
+from addon.engine.passes import diffusion_cells, diffusion_propagate, lpv_propagate  # noqa: E402
+
+STEPS, ROUNDS = 32, 5
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--cells", type=int, default=32)
+    n = parser.parse_args().cells
+    be = ModernGLBackend()
+    grid = Grid(np.zeros(3), 0.1, (n, n, n))
+    rng = np.random.default_rng(0)
+    shape = (n, n, n, 4)
+    occupied = rng.random((n, n, n)) < 0.33
+    voxels = {
+        "vox_albedo": np.where(occupied[..., None], [0.5, 0.5, 0.5, 1.0], 0.0).astype(np.float32),
+        "vox_normal": np.where(occupied[..., None], [0.0, 0.0, 1.0, 1.0], 0.0).astype(np.float32),
+        "vox_projected": np.where(occupied[..., None], [0.2, 0.3, 1.0, 1.0], 0.0).astype(np.float32),
+        "vox_offset": np.zeros(shape, np.float32),
+    }
+    vox = {k: be.texture(grid.dims, "RGBA32F", v) for k, v in voxels.items()}
+    cells = diffusion_cells.textures(be, grid)
+    diffusion_cells.run(be, vox, cells, grid)
+    blocking = lpv_propagate.blocking(be, vox, grid, True)
+    field = [rng.random(shape).astype(np.float32) for _ in range(3)]
+    sets = [{f"sh_{c}": be.texture(grid.dims, "RGBA32F", f) for c, f in zip("rgb", field, strict=True)}
+            for _ in range(2)]
+    absorbed = diffusion_propagate.sides(be, grid)
+    acc = {f"acc_{c}": be.texture(grid.dims) for c in "rgb"}
+
+    def diffusion(transfer):
+        def steps():
+            for i in range(STEPS):
+                diffusion_propagate.run(be, sets[i % 2], sets[(i + 1) % 2], absorbed, cells, grid, i == 0, transfer)
+        return steps
+
+    def lpv():
+        for i in range(STEPS):
+            lpv_propagate.run(be, sets[i % 2], sets[(i + 1) % 2], acc, grid, "improved", i == 0, blocking)
+
+    runs = {"diffusion (cone)": diffusion("cone"), "diffusion (directional)": diffusion("directional"), "lpv": lpv}
+    times = {name: [] for name in runs}
+    for round_ in range(ROUNDS + 1):  # the first round compiles and warms up
+        for name, steps in runs.items():
+            be.finish()
+            t0 = time.perf_counter()
+            steps()
+            be.finish()
+            if round_:
+                times[name].append((time.perf_counter() - t0) * 1e3 / STEPS)
+    for name, t in times.items():
+        print(f"{name}: {statistics.median(t):.2f} ms per step at {n}^3 (median of {ROUNDS} x {STEPS} steps)")
+    print("renderer:", be.renderer)
+
+
+if __name__ == "__main__":
+    main()
