@@ -15,8 +15,9 @@ from addon.engine.scene import Camera, Light, Scene
 from addon.engine.transforms import look_along, perspective
 
 # Every shipped method; a later method joins the suite by joining config.METHODS.
-# Every method, rsm with its voxel visibility, and lpv with emitter classes (LpvConfig.emitter_classes).
-ALL_METHODS = (*METHODS, "rsm+voxel", "lpv+classes")
+# Every method, rsm with its voxel visibility, lpv with emitter classes (LpvConfig.emitter_classes) and
+# lpv's octree variant (LpvConfig.variant = "octree").
+ALL_METHODS = (*METHODS, "rsm+voxel", "lpv+classes", "lpv+octree")
 
 # rsm without visibility lets one bounce through walls: a known property of the method (its
 # `--visibility voxel` option is the fix), marked here once so every leak test says so the same way.
@@ -100,12 +101,15 @@ def sun(direction, strength, color=(1, 1, 1)):
 
 def make(gl, name, rsm_res=128, vpl=64):
     """A method by name; "rsm+voxel" is the rsm method with voxel-traced visibility, "lpv+classes" lpv
-    with emitter classes, "vct+filtered" vct with filtered injection."""
+    with emitter classes, "lpv+octree" lpv's octree variant, "vct+filtered" vct with filtered injection."""
     method, _, variant = name.partition("+")
     kw = {"resolution": rsm_res, "vpl_samples": vpl}
     if variant == "classes":
         return methods.create(gl, {"gi": GIConfig(method=method), "rsm": RsmConfig(**kw),
                                    "lpv": LpvConfig(emitter_classes=True)})
+    if variant == "octree":
+        return methods.create(gl, {"gi": GIConfig(method=method), "rsm": RsmConfig(**kw),
+                                   "lpv": LpvConfig(variant="octree")})
     if variant == "filtered":
         return methods.create(gl, {"gi": GIConfig(method=method), "rsm": RsmConfig(**kw),
                                    "vct": VctConfig(filtered_injection=True)})
