@@ -77,20 +77,37 @@ def update_costs_block(results: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _speedup(s: dict | None) -> str:
+    """A speed-up with the bound of metrics.cycles_equivalent_speedup: '<=' our error is above Cycles'
+    fastest point (at most this), '>=' below its slowest (at least this); '–' where undefined."""
+    if s is None or s["speedup"] is None:
+        return "–"
+    return {"=": "", "<": "<= ", ">": ">= "}[s["bound"]] + f"{s['speedup']:.3g}x"
+
+
 def accuracy_block(results: dict) -> str:
-    """Table: each method's rel_rmse_8 / bias at its defaults on every scene of the run."""
+    """Table: each method's rel_rmse_8 / bias at its defaults on every scene of the run, and its speed-up
+    against Cycles + OIDN where the run measured that anchor (results.json schema 2 on)."""
     records = _default_records(results)
     methods = _methods(records)
     by_key = {(r["scene"], r["method"]): r for r in records}
+    oidn = any(r.get("speedup_oidn") for r in records)
     lines = ["**Accuracy against Cycles** of each method at its default settings.", "",
              _produced_by(results) + f" {results['res']} px long side, Cycles reference {results['ref_spp']} spp; "
-             "cells: rel_rmse_8 / bias (direct against Cycles' Diffuse Direct, the others against Diffuse Indirect).",
+             "cells: rel_rmse_8 / bias" + (" / speed-up against Cycles + OIDN" if oidn else "")
+             + " (direct against Cycles' Diffuse Direct, the others against Diffuse Indirect"
+             + ("; speed-up = the time Cycles with Open Image Denoise needs for the same rel_rmse_8 / ours, <= and "
+                ">= where our error lies outside its curve" if oidn else "") + ").",
              "", "| scene | " + " | ".join(methods) + " |", "| --- " * (1 + len(methods)) + "|"]
     for scene in dict.fromkeys(r["scene"] for r in records):
         cells = []
         for method in methods:
             r = by_key.get((scene, method))
-            cells.append("–" if r is None or r["rel_rmse_8"] is None else f"{r['rel_rmse_8']:.3f} / {r['bias']:.3f}")
+            if r is None or r["rel_rmse_8"] is None:
+                cells.append("–")
+                continue
+            cell = f"{r['rel_rmse_8']:.3f} / {r['bias']:.3f}"
+            cells.append(cell + f" / {_speedup(r['speedup_oidn'])}" if oidn else cell)
         lines.append(f"| {scene} | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 

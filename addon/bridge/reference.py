@@ -5,8 +5,10 @@ Cycles is configured so that its Diffuse Direct / Indirect / Color passes are an
 nothing else, no clamping, no denoising, no adaptive sampling, a 0.01 px pixel filter, and a
 transparent film so that Combined alpha is the geometry mask.
 
-Output of render_reference(): out_dir/indirect.exr, direct.exr, albedo.exr, each RGBA float32 with
-A = Combined alpha (geometry mask; `compare` uses it when the file is the reference), and stats.json.
+Output of render_reference(): out_dir/indirect.exr, direct.exr, albedo.exr, normal.exr, each RGBA float32
+with A = Combined alpha (geometry mask; `compare` uses it when the file is the reference), and stats.json.
+normal.exr is Cycles' Normal pass (world-space unit normals, 0 on the background): with albedo.exr, the
+auxiliary images of the benchmark's Cycles + OIDN anchor (bridge/anchors.py).
 With glossy=True also glossy.exr: Glossy Color x Glossy Indirect, the light glossy lobes add to the
 image after one glossy bounce (glossy_bounces = 1; its second vertex is lit by `bounces` - 1 diffuse
 bounces and direct light), the `vct` method's `glossy` product. Without it glossy_bounces = 0: the
@@ -28,7 +30,7 @@ from ..engine.metrics import compare
 from . import images
 from .capture import image_size
 
-PASSES = {"indirect": "Diffuse Indirect", "direct": "Diffuse Direct", "albedo": "Diffuse Color"}
+PASSES = {"indirect": "Diffuse Indirect", "direct": "Diffuse Direct", "albedo": "Diffuse Color", "normal": "Normal"}
 GLOSSY_PASSES = ("Glossy Indirect", "Glossy Color")  # multiplied into glossy.exr
 
 
@@ -112,6 +114,7 @@ def _configure(bpy, scene, spp, bounces, width, height, seed, exr_path, glossy: 
     vl = bpy.context.view_layer
     vl.use_pass_combined = True
     vl.use_pass_diffuse_direct = vl.use_pass_diffuse_indirect = vl.use_pass_diffuse_color = True
+    vl.use_pass_normal = True
     vl.use_pass_glossy_indirect = vl.use_pass_glossy_color = glossy
     im = r.image_settings
     im.media_type = "MULTI_LAYER_IMAGE"  # 5.0: must come before the file format (FACTS.md)
@@ -136,15 +139,16 @@ def _configure(bpy, scene, spp, bounces, width, height, seed, exr_path, glossy: 
 def _render(bpy, exr_path) -> float:
     """Render and save the multi-layer EXR; returns the render call's wall time in seconds.
 
-    The time covers what a user waits for in Cycles: scene sync, BVH build and sampling. The EXR is
-    written after the timed call (Image.save_render), so file I/O is not counted.
+    The time covers what a user waits for in Cycles: scene sync, BVH build and sampling (in EEVEE, for
+    bench's anchor: scene sync, shaders and sampling). The EXR is written after the timed call
+    (Image.save_render), so file I/O is not counted.
     """
     t0 = time.perf_counter()
     bpy.ops.render.render(write_still=False)
     elapsed = time.perf_counter() - t0
     bpy.data.images["Render Result"].save_render(filepath=str(exr_path))
     if not Path(exr_path).is_file():
-        raise SceneError("Cycles wrote no image (render cancelled or failed)")
+        raise SceneError(f"{bpy.context.scene.render.engine} wrote no image (render cancelled or failed)")
     return elapsed
 
 

@@ -1,6 +1,7 @@
 """`python -m addon bench [--scenes a,b] [--methods direct,rsm] [--settings-filter all|default] [--quick]
-[--no-update-costs] [--res N] [--ref-spp N] [--out DIR]`: speed against error for every method x setting on
-every scene, with each setting's update costs (see addon/bridge/bench.py).
+[--no-update-costs] [--anchors oidn,eevee] [--res N] [--ref-spp N] [--out DIR]`: speed against error for every
+method x setting on every scene, with each setting's update costs, against raw Cycles and the anchors
+(see addon/bridge/bench.py and addon/bridge/anchors.py).
 
 Writes DIR/REPORT.md (the generated block between its markers; text outside them is kept),
 DIR/results.json (one record per scene x method x setting) and DIR/<scene>.png; caches scenes and Cycles
@@ -14,6 +15,7 @@ import json
 import os
 from pathlib import Path
 
+from ..bridge.anchors import ANCHORS, DEFAULT_ANCHORS
 from ..bridge.bench import ROW_FILTERS  # bridge/bench.py imports without bpy
 from ..engine.config import GIConfig
 from ..engine.errors import ConfigError
@@ -41,6 +43,10 @@ def add_arguments(p) -> None:
                         "method's default settings (one run per method and scene)")
     p.add_argument("--no-update-costs", action="store_true",
                    help="skip timing the full / lights / camera updates of each row (faster)")
+    p.add_argument("--anchors", help=f"comma-separated anchors measured besides raw Cycles, of {', '.join(ANCHORS)} "
+                                     f"(default {','.join(DEFAULT_ANCHORS)}): oidn = Cycles' curve denoised by "
+                                     "Open Image Denoise; eevee = one EEVEE render per scene (about a minute or more "
+                                     "per scene on a CPU rasteriser)")
     p.add_argument("--quick", action="store_true",
                    help="CI size: reference 128 spp, Cycles curve 1/4/16 spp, 2 timed runs")
     add_field_flag(p, GIConfig, "resolution", "--res", default=128, doc="long side in pixels")
@@ -67,6 +73,7 @@ def run(args) -> int:
     from ..bridge.reference import check_settings
 
     scenes, methods = _names(args.scenes), _names(args.methods)
+    anchors = bench.resolve_anchors(_names(args.anchors))
     ref_spp = args.ref_spp
     check_settings(ref_spp or bench.REF_SPP, args.bounces, args.res)  # before bpy is imported
     for m in methods or ():
@@ -74,9 +81,10 @@ def run(args) -> int:
     update_costs = not args.no_update_costs
     opt = bench.Options(
         scenes=scenes, methods=methods, quick=args.quick, res=args.res, ref_spp=ref_spp, bounces=args.bounces,
-        update_costs=update_costs, row_filter=args.settings_filter, out=output_dir(args.out), cache=Path(args.cache),
+        update_costs=update_costs, row_filter=args.settings_filter, anchors=anchors, out=output_dir(args.out),
+        cache=Path(args.cache),
         command=bench.command_line(scenes, methods, args.quick, args.res, ref_spp, args.bounces, args.out,
-                                   args.cache, update_costs, args.settings_filter),
+                                   args.cache, update_costs, args.settings_filter, anchors),
     )
     with _quiet_stderr(args.quiet):
         result = bench.run_bench(opt)

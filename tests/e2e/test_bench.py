@@ -77,8 +77,13 @@ def _fake_result():
                     "cycles_device": "CPU", "blender": "5.0.1"},
         "scenes": [{
             "name": "cornell", "source": "procedural", "size": [48, 48], "ref_spp": 128, "ref_time_s": 0.2,
-            "noise_floor": {"direct": metric}, "notes": [], "plot": "cornell.png",
-            "curve": {"direct": [{"spp": 1, "time_s": 0.006, "rel_rmse": 0.16, "rel_rmse_8": 0.05, "bias": 0.99}]},
+            "noise_floor": {"direct": metric, "indirect": metric}, "notes": [], "plot": "cornell.png",
+            "curve": {"direct": [{"spp": 1, "time_s": 0.006, "rel_rmse": 0.16, "rel_rmse_8": 0.05, "bias": 0.99}],
+                      "indirect": [{"spp": 1, "time_s": 0.006, "rel_rmse": 0.9, "rel_rmse_8": 0.3, "bias": 1.01}]},
+            # OIDN denoises the indirect pass only (anchors.OIDN_PRODUCTS)
+            "curve_oidn": {"indirect": [{"spp": 1, "time_s": 0.026, "render_time_s": 0.006, "oidn_time_s": 0.02,
+                                         "rel_rmse": 0.08, "rel_rmse_8": 0.04, "bias": 0.98}]},
+            "eevee": None,
             "runs": [{"method": "direct", "setting": "resolution 256", "setting_fields": {"rsm.resolution": 256},
                       "default": True, "product": "direct", "image_size": [48, 48], "triangles": 34,
                       "config": {"gi": {"method": "direct", "resolution": 48}, "rsm": {"resolution": 256}},
@@ -86,7 +91,16 @@ def _fake_result():
                       "timings_ms": {"gbuffer": 0.4, "rsm": 2.7, "solve": 2.7, "total": 3.1},
                       "total_ms": 3.1, "runs": 2,
                       "metrics": metric, "noise": 0.0,
-                      "speedup": {"cycles_time_s": 0.006, "speedup": 1.9, "bound": "<"}}],
+                      "speedup": {"cycles_time_s": 0.006, "speedup": 1.9, "bound": "<"},
+                      "speedup_oidn": None, "vs_eevee": None},
+                     {"method": "rsm", "setting": "vpl_samples 64", "setting_fields": {"rsm.vpl_samples": 64},
+                      "default": True, "product": "indirect", "image_size": [48, 48], "triangles": 34,
+                      "config": {"gi": {"method": "rsm", "resolution": 48}, "rsm": {"vpl_samples": 64}},
+                      "update_ms": None, "timings_ms": {"gbuffer": 0.4, "rsm": 2.7, "total": 20.0},
+                      "total_ms": 20.0, "runs": 2,
+                      "metrics": {"rel_rmse": 0.5, "rel_rmse_8": 0.2, "bias": 1.1, "pixels": 100, "note": None},
+                      "noise": 0.05, "speedup": {"cycles_time_s": 0.12, "speedup": 6.0, "bound": "="},
+                      "speedup_oidn": {"cycles_time_s": 0.03, "speedup": 1.5, "bound": "="}, "vs_eevee": None}],
         }],
     }
 
@@ -98,9 +112,22 @@ def test_report_formatting_and_merge_keep_hand_written_text():
     assert "Some CPU (2 cores)" in block and "llvmpipe" in block and "sponza (not found)" in block
     # passes in run order, total last; "solve" sums passes already shown, so it is no column
     assert "| gbuffer ms | rsm ms | total ms |" in block
-    row = "| direct | resolution 256 | direct | 0.40 | 2.70 | 3.10 | 0.3 | 0.06 | 0.9970 | 0 | <= 6.0 ms | <= 1.9x |"
-    assert row in block
-    assert "| 1 | 6.0 ms | 0.16 | 0.05 | 0.9900 |" in block
+    assert "| speed-up | Cycles + OIDN time to same rel_rmse_8 | speed-up vs Cycles + OIDN |\n" in block
+    assert "Cycles + OIDN: the indirect pass of each render of Cycles' curve denoised" in block
+    assert "EEVEE" not in block  # not run: no column, no paragraph
+    # direct has no denoised curve: n/a against Cycles + OIDN
+    assert ("| direct | resolution 256 | direct | 0.40 | 2.70 | 3.10 | 0.3 | 0.06 | 0.9970 | 0 | <= 6.0 ms | <= 1.9x "
+            "| n/a | n/a |") in block
+    assert ("| rsm | vpl_samples 64 | indirect | 0.40 | 2.70 | 20.00 | 0.5 | 0.2 | 1.1000 | 0.05 | 120.0 ms | 6x "
+            "| 30.0 ms | 1.5x |") in block
+    assert "\n" + "| --- " * 14 + "|\n" in block  # 10 fixed + 2 passes + 2 Cycles + OIDN columns
+    # the curve tables: raw Cycles, then (indirect only) the same render denoised (OIDN time alone; its point
+    # adds it)
+    assert "| spp | time | rel_rmse | rel_rmse_8 | bias |\n| --- | --- | --- | --- | --- |\n" \
+           "| 1 | 6.0 ms | 0.16 | 0.05 | 0.9900 |\n" in block
+    assert ("| spp | time | rel_rmse | rel_rmse_8 | bias | OIDN time | + OIDN rel_rmse | + OIDN rel_rmse_8 "
+            "| + OIDN bias |") in block
+    assert "| 1 | 6.0 ms | 0.9 | 0.3 | 1.0100 | 20.0 ms | 0.08 | 0.04 | 0.9800 |" in block
     assert "](cornell.png)" in block
 
     old = f"# Title\n\nHand-written intro.\n\n{bench.MARK_BEGIN}\nold numbers\n{bench.MARK_END}\n\n## Notes\nkept\n"
@@ -109,6 +136,45 @@ def test_report_formatting_and_merge_keep_hand_written_text():
     assert "old numbers" not in merged and merged.count(bench.MARK_BEGIN) == 1
     assert bench.merge_report(None, block).startswith("# ")
     assert bench.merge_report("no markers", block).count("no markers") == 0
+
+
+def test_against_eevee_only_at_equal_or_better_error():
+    eevee = {"product": "indirect", "time_s": 40.0, "metrics": {"rel_rmse_8": 0.5}}
+    # rel_rmse_8 0.4 <= 0.5 in 0.2 s: EEVEE took 40 / 0.2 = 200 times as long for a worse image
+    assert bench.against_eevee(0.4, 0.2, "indirect", eevee) == \
+        {"eevee_time_s": 40.0, "eevee_rel_rmse_8": 0.5, "speedup": 200.0}
+    assert bench.against_eevee(0.5, 0.2, "indirect", eevee)["speedup"] == 200.0  # equal error counts
+    assert bench.against_eevee(0.6, 0.2, "indirect", eevee)["speedup"] is None  # worse than EEVEE: no ratio
+    assert bench.against_eevee(None, 0.2, "indirect", eevee)["speedup"] is None
+    assert bench.against_eevee(0.4, 0.2, "direct", eevee) is None  # EEVEE's anchor is indirect only
+    assert bench.against_eevee(0.4, 0.2, "indirect", None) is None  # not run
+    assert [bench.format_eevee_cell(v) for v in (None, {"speedup": None}, {"speedup": 200.0})] == \
+        ["n/a", "error above EEVEE's", "200x"]
+
+
+def test_report_with_eevee_has_its_paragraph_and_column():
+    result = _fake_result()
+    sc = result["scenes"][0]
+    sc["eevee"] = {"product": "indirect", "time_s": 41.5, "settings_label": "some settings",
+                   "compared": "A minus B", "metrics": {"rel_rmse": 0.9, "rel_rmse_8": 0.7, "bias": 1.002}}
+    sc["runs"][1]["vs_eevee"] = {"eevee_time_s": 41.5, "eevee_rel_rmse_8": 0.7, "speedup": 2.075}
+    block = bench.format_report(result)
+    assert ("EEVEE (some settings): 41.50 s for the frame; indirect as A minus B: rel_rmse 0.9, rel_rmse_8 0.7, "
+            "bias 1.0020.") in block
+    assert "| speed-up vs Cycles + OIDN | EEVEE's time / ours |\n" + "| --- " * 15 + "|\n" in block
+    assert "| <= 6.0 ms | <= 1.9x | n/a | n/a | n/a |" in block  # direct: EEVEE's anchor is indirect only
+    assert "| 120.0 ms | 6x | 30.0 ms | 1.5x | 2.08x |" in block
+
+
+def test_anchors_resolve_and_spell():
+    assert bench.resolve_anchors(None) == ("oidn",)
+    assert bench.resolve_anchors(["eevee", "oidn", "eevee"]) == ("eevee", "oidn")
+    with pytest.raises(ConfigError, match="unknown anchor"):
+        bench.resolve_anchors(["cycles"])  # raw Cycles is always measured: no anchor of that name
+    base = ["cornell"], ["rsm"], True, 48, None, 1, "o", "out/bench"
+    assert "--anchors" not in bench.command_line(*base)  # the default
+    spelled = bench.command_line(*base, anchors=("oidn", "eevee"))
+    assert spelled.endswith("--quick --anchors oidn,eevee --res 48 --out o")
 
 
 def test_default_filter_keeps_the_row_at_the_defaults():
@@ -135,26 +201,30 @@ def test_update_cells_and_columns():
     assert "| total ms | update full ms | update lights ms | update camera ms | camera/full | rel_rmse |" in block
     assert "| 3.10 | 3.00 | 2.00 | 1.50 | 50 % | 0.3 | 0.06 |" in block
     assert "Update costs (`update ... ms`): medians of 2 updates" in block
-    assert "\n" + "| --- " * 16 + "|\n" in block  # 10 fixed + 2 passes + 4 update columns
+    assert "\n" + "| --- " * 18 + "|\n" in block  # 10 fixed + 2 passes + 4 update + 2 Cycles + OIDN columns
 
 
 def test_results_json_has_one_record_per_run():
     result = _fake_result()
-    result.update(quick=True, update_costs=True, row_filter="all")
+    result.update(quick=True, update_costs=True, row_filter="all", anchors=["oidn"])
     result["machine"]["date"] = "2026-12-01"
-    run = result["scenes"][0]["runs"][0]
+    run, rsm = result["scenes"][0]["runs"]
     run["update_ms"] = {"full": 3.0, "lights": 2.0, "camera": 1.5}
-    nan_run = {**run, "setting": "resolution 512", "setting_fields": {"rsm.resolution": 512}, "default": False,
-               "update_ms": None, "metrics": {**run["metrics"], "rel_rmse_8": None},
-               "speedup": {"cycles_time_s": math.nan, "speedup": math.nan, "bound": "=", "extrapolated_speedup": None}}
+    nan_run = {**rsm, "setting": "vpl_samples 128", "setting_fields": {"rsm.vpl_samples": 128}, "default": False,
+               "metrics": {**rsm["metrics"], "rel_rmse_8": None},
+               "speedup": {"cycles_time_s": math.nan, "speedup": math.nan, "bound": "=", "extrapolated_speedup": None},
+               "speedup_oidn": {"cycles_time_s": math.nan, "speedup": math.nan, "bound": "=",
+                                "extrapolated_speedup": None}}
     result["scenes"][0]["runs"].append(nan_run)
     out = bench.results_json(result)
     text = json.dumps(out, allow_nan=False)  # NaN is not JSON: an undefined speed-up must be null
     assert json.loads(text) == out
     assert out["schema"] == bench.RESULTS_SCHEMA and out["machine"]["date"] == "2026-12-01"
     assert out["command"] == result["command"] and out["res"] == 48 and out["row_filter"] == "all"
+    assert out["anchors"] == ["oidn"]
     assert [s["name"] for s in out["scenes"]] == ["cornell"] and "runs" not in out["scenes"][0]
-    first, second = out["records"]
+    assert out["scenes"][0]["curve_oidn"] == result["scenes"][0]["curve_oidn"] and out["scenes"][0]["eevee"] is None
+    first, middle, second = out["records"]
     assert first == {
         "scene": "cornell", "method": "direct", "setting": {"rsm.resolution": 256}, "label": "resolution 256",
         "default": True, "product": "direct", "config": run["config"], "image_size": [48, 48], "triangles": 34,
@@ -162,9 +232,12 @@ def test_results_json_has_one_record_per_run():
         "update_ms": {"full": 3.0, "lights": 2.0, "camera": 1.5},
         "rel_rmse": 0.3, "rel_rmse_8": 0.06, "bias": 0.997, "noise": 0.0,
         "speedup": {"cycles_time_s": 0.006, "speedup": 1.9, "bound": "<"},
+        "speedup_oidn": None, "vs_eevee": None,
     }
-    assert second["setting"] == {"rsm.resolution": 512} and second["update_ms"] is None
+    assert middle["speedup_oidn"] == {"cycles_time_s": 0.03, "speedup": 1.5, "bound": "="}
+    assert second["setting"] == {"rsm.vpl_samples": 128} and second["update_ms"] is None
     assert second["rel_rmse_8"] is None and second["speedup"]["speedup"] is None
+    assert second["speedup_oidn"]["speedup"] is None
 
 
 def test_code_version_names_the_commit(tmp_path):
@@ -196,8 +269,9 @@ def test_cli_rejects_bad_input_before_rendering(capsys):
     assert cli.main(["bench", "--res", "4"]) == 2
     assert cli.main(["bench", "--methods", ","]) == 2
     assert cli.main(["bench", "--settings-filter", "first"]) == 2
+    assert cli.main(["bench", "--anchors", "oidn,denoiser"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 4 and all(line.startswith("error: ") for line in err)
+    assert len(err) == 5 and all(line.startswith("error: ") for line in err)
 
 
 # ------------------------------------------------------------------------------ quick bench, e2e
@@ -241,14 +315,19 @@ def test_quick_bench_on_cornell(tmp_path):
         print(f"{r['setting']}: {m}, {r['total_ms']:.2f} ms, speed-up {r['speedup']}")
         assert m["rel_rmse_8"] <= BOUND_REL_RMSE_8, m
         assert BOUND_BIAS[0] <= m["bias"] <= BOUND_BIAS[1], m
-        # the speed-up is the one along the curve of this run (same product)
+        # the speed-ups are the ones along the curves of this run (same product), raw and denoised
         again = cycles_equivalent_speedup(m["rel_rmse_8"], r["total_ms"] / 1000, sc["curve"]["direct"])
         assert again == r["speedup"]
+        # Diffuse Direct is not denoised (anchors.OIDN_PRODUCTS), and EEVEE is not a default anchor
+        assert r["speedup_oidn"] is None and r["vs_eevee"] is None
     assert all(isinstance(x, (int, float)) and math.isfinite(x) for x in numbers if x is not None)
+
+    assert sc["eevee"] is None and sc["curve_oidn"] == {} and result["anchors"] == ["oidn"]
+    assert "OIDN" not in report  # no product of this run is denoised: no empty columns
 
     # results.json: one record per run, the report's numbers, update costs timed by default
     results = json.loads((out / "results.json").read_text())
-    assert results["schema"] == bench.RESULTS_SCHEMA and results["command"] == result["command"]
+    assert results["schema"] == bench.RESULTS_SCHEMA == 2 and results["command"] == result["command"]
     assert set(results["machine"]) >= {"cpu", "bounce_renderer", "blender", "date", "commit", "dirty",
                                           "load_average_1min"}
     assert [(r["scene"], r["method"], r["setting"], r["default"]) for r in results["records"]] == \
@@ -259,6 +338,7 @@ def test_quick_bench_on_cornell(tmp_path):
         assert rec["config"]["gi"]["resolution"] == QUICK_RES and rec["config"]["rsm"] == r["config"]["rsm"]
         assert (rec["rel_rmse_8"], rec["bias"], rec["total_ms"]) == (r["metrics"]["rel_rmse_8"], r["metrics"]["bias"],
                                                                      r["total_ms"])
+        assert rec["speedup_oidn"] is None and rec["vs_eevee"] is None
         assert set(rec["update_ms"]) == {"full", "lights", "camera"}
         assert all(math.isfinite(ms) and ms > 0 for ms in rec["update_ms"].values()), rec["update_ms"]
     assert all(sc["noise_floor"]["direct"][k] is not None for k in ("rel_rmse", "rel_rmse_8", "bias"))
@@ -268,8 +348,22 @@ def test_quick_bench_on_cornell(tmp_path):
     ref_dir = next((cache / "refs").glob("cornell-*-seed0"))
     ours = bench.cycles_curves(cache / "scenes" / "cornell.blend", [1, 4], 1, QUICK_RES, ref_dir,
                                ["indirect", "direct"], tmp_path / "curve")
+    # Cycles + OIDN: the same renders' indirect pass denoised, so the same spp and render times plus the
+    # OIDN time. At 1 spp denoising must lower rel_rmse_8: at 48 px it fell 1.67x here (reference seed 0),
+    # 1.22x and 1.11x with references of seed 1 and 2, so the bound is only "lower"; at 4 spp the gain was
+    # 1.03-1.49x (6 x 6 blocks of 8 px leave little to average), not bounded.
+    assert set(ours["cycles+oidn"]) == {"indirect"}
+    for raw, den in zip(ours["cycles"]["indirect"], ours["cycles+oidn"]["indirect"], strict=True):
+        assert den["spp"] == raw["spp"] and den["render_time_s"] == raw["time_s"]
+        assert den["oidn_time_s"] > 0 and den["time_s"] == den["render_time_s"] + den["oidn_time_s"]
+        assert all(math.isfinite(den[k]) for k in ("rel_rmse", "rel_rmse_8", "bias"))
+    raw1, den1 = ours["cycles"]["indirect"][0], ours["cycles+oidn"]["indirect"][0]
+    assert den1["rel_rmse_8"] < raw1["rel_rmse_8"], (raw1, den1)
+    without = bench.cycles_curves(cache / "scenes" / "cornell.blend", [1], 1, QUICK_RES, ref_dir, ["indirect"],
+                                  tmp_path / "curve-raw", oidn=False)
+    assert without["cycles+oidn"] == {}
     theirs = cycles_curve(cache / "scenes" / "cornell.blend", [1, 4], 1, QUICK_RES, ref_dir)
-    for a, b in zip(ours["indirect"], theirs, strict=True):
+    for a, b in zip(ours["cycles"]["indirect"], theirs, strict=True):
         assert a["spp"] == b["spp"]
         for k in ("rel_rmse", "rel_rmse_8", "bias"):
             assert a[k] == pytest.approx(b[k], rel=1e-9), (k, a, b)
@@ -304,3 +398,30 @@ def test_cached_real_scene_keeps_its_textures(tmp_path):
     path = bpy.path.abspath(bpy.data.images["tex"].filepath)
     assert cached.parent == tmp_path / "cache" / "scenes"
     assert os.path.exists(path), path
+
+
+@pytest.mark.blender
+@pytest.mark.slow
+def test_eevee_anchor_on_cornell(tmp_path, monkeypatch):
+    """bench --anchors eevee's render on the Cornell box at 32 px against a 64-spp Cycles reference, with 8
+    EEVEE samples instead of 64 to keep it near 30 s (EEVEE on llvmpipe costs about a second per sample at
+    any size). Measured so: the no-GI render's Diffuse Light against Cycles' Diffuse Direct, bias 0.985,
+    rel_rmse_8 0.058 (0.979 / 0.066 with 64 samples): the subtraction removes the direct light Cycles
+    has, bounded at 0.95..1.05 and 0.15 (shadow-map edges). EEVEE's indirect: bias 0.49 (0.65 with 64
+    samples; 1.00 at 128 px), bounded at 0.25..1.5: a render with no indirect light gives 0 (ray tracing
+    off), one whose direct light was not subtracted about 2.1 (direct and indirect means are about equal)."""
+    from addon.bridge import anchors, images
+    from addon.bridge.reference import render_reference
+    from addon.engine.metrics import compare
+
+    monkeypatch.setitem(anchors.EEVEE_SETTINGS, "taa_render_samples", 8)
+    blend = bench._cache_blend("cornell", None, tmp_path / "cache")
+    render_reference(blend, tmp_path / "ref", 64, 1, 32, 0)
+    ev = bench.eevee_anchor(blend, 32, tmp_path / "ref", tmp_path / "eevee")
+    assert ev["product"] == "indirect" and ev["time_s"] > 0 and ev["no_gi_time_s"] > 0
+    assert images.read_exr(tmp_path / "eevee" / "indirect.exr").shape == (32, 32, 4)
+    assert 0.25 <= ev["metrics"]["bias"] <= 1.5, ev["metrics"]
+    no_gi = images.read_multilayer(tmp_path / "eevee" / "eevee_no_gi.exr")["Diffuse Direct"][:, :, :3]
+    direct = images.read_exr(tmp_path / "ref" / "direct.exr")
+    m = compare(no_gi, direct[:, :, :3], direct[:, :, 3] > 0.5)
+    assert 0.95 <= m["bias"] <= 1.05 and m["rel_rmse_8"] <= 0.15, m

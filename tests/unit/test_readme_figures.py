@@ -69,3 +69,21 @@ def test_accuracy_block():
     assert lines[0] == "**Accuracy against Cycles** of each method at its default settings."
     assert lines[5:] == ["| scene | direct | lpv |", "| --- | --- | --- |",
                          "| cornell | 0.102 / 0.996 | 0.500 / 0.900 |", "| emissive | 0.500 / 0.900 | – |"]
+
+
+def test_accuracy_block_with_the_oidn_anchor():
+    """Schema 2 records carry the speed-up against Cycles + OIDN: the cells gain it, with its bound;
+    records of a run without that anchor (speedup_oidn None, or schema 1 without the key) keep two numbers."""
+    def rec(scene, method, speedup_oidn):
+        return {**_record(scene, method, rel_rmse_8=0.1024, bias=0.9957), "speedup_oidn": speedup_oidn}
+
+    records = [rec("cornell", "direct", {"speedup": 1.94, "bound": "<"}),
+               rec("cornell", "lpv", {"speedup": 12.345, "bound": "="}),
+               rec("emissive", "direct", {"speedup": 300.0, "bound": ">"}),
+               rec("emissive", "lpv", {"speedup": None, "bound": "="})]
+    lines = readme_figures.accuracy_block(_results(records)).splitlines()
+    assert "cells: rel_rmse_8 / bias / speed-up against Cycles + OIDN (" in lines[3]
+    assert lines[7:] == ["| cornell | 0.102 / 0.996 / <= 1.94x | 0.102 / 0.996 / 12.3x |",
+                         "| emissive | 0.102 / 0.996 / >= 300x | 0.102 / 0.996 / – |"]
+    without = [{**r, "speedup_oidn": None} for r in records]
+    assert "OIDN" not in readme_figures.accuracy_block(_results(without))
