@@ -28,7 +28,7 @@ from ..backends.base import Backend
 from ..config import GIConfig, RsmConfig
 from ..errors import ConfigError
 from ..passes import accumulate, declare, denoise, direct_light, gbuffer, rsm, zero
-from ..passes.light_views import LightView, emissive_lights, views_for
+from ..passes.light_views import LightView, emissive_lights, reaches, views_for
 from ..scene import Camera, Scene
 
 # Each light face's RSM is kept between updates while all of them fit in this budget, so a gather after
@@ -227,6 +227,8 @@ class DirectMethod:
         lights = []
         for light in self.source.lights:
             local = replace(light, position_m=light.position_m - self.origin_m)
+            if not reaches(local, bounds):
+                continue  # only what the scene needs: a light that cannot reach the geometry has no view
             lights += split_area_light(local, self.rsm_config.area_patches) if local.kind == "AREA" else [local]
         lights += self.emissive
         # The world's suns share one light's VPL budget by power (vpl_shares: light index -> share): a

@@ -133,6 +133,28 @@ def light_intensity(light: Light) -> np.ndarray:
     return light.color * light.power_w / (4.0 * np.pi)
 
 
+def reaches(light: Light, bounds: tuple[np.ndarray, np.ndarray]) -> bool:
+    """Whether the light can send any light into the geometry's bounds: not when it emits nothing, a
+    spot's cone misses the bounds' enclosing sphere, or a one-sided area light faces away from every
+    corner. Conservative (a light that reaches the sphere but not the box is kept); a light that cannot
+    reach adds exactly nothing, so skipping its light views changes no image."""
+    if not np.any(np.asarray(light.color) > 0) or (light.kind == "SUN" and light.sun_strength <= 0) or (
+            light.kind != "SUN" and light.power_w <= 0):
+        return False
+    lo, hi = (np.asarray(b, np.float64) for b in bounds)
+    if light.kind == "SPOT" and light.spot_size_rad < np.pi:
+        centre, radius = (lo + hi) / 2.0, float(np.linalg.norm(hi - lo)) / 2.0
+        to_centre = centre - light.position_m
+        dist = float(np.linalg.norm(to_centre))
+        if dist <= radius:
+            return True  # the light is inside the sphere
+        off_axis = np.arccos(np.clip(np.dot(to_centre / dist, light.direction), -1.0, 1.0))
+        return off_axis - np.arcsin(radius / dist) < light.spot_size_rad / 2.0
+    if light.kind == "AREA":
+        return bool(np.any((box_corners(lo, hi) - light.position_m) @ light.direction > 0.0))
+    return True
+
+
 def views_for(light: Light, index: int, bounds: tuple[np.ndarray, np.ndarray], resolution: int) -> list[LightView]:
     lo, hi = bounds
     corners = box_corners(lo, hi)
