@@ -495,6 +495,23 @@ def _compare(test_exr: Path, ref_exr: Path) -> dict:
     return compare(a[:, :, :3], b[:, :, :3], mask)
 
 
+def _compare_full(run_dir: Path, ref_dir: Path) -> dict | None:
+    """The full image a user sees, (direct + indirect) x albedo, ours against Cycles' (its Diffuse
+    Direct + Indirect times Diffuse Color), over the reference's geometry; None for a method without
+    both light products."""
+    from ..engine.metrics import compare
+    from . import images
+
+    names = ("direct", "indirect", "albedo")
+    if not all((run_dir / f"{n}.exr").is_file() and (ref_dir / f"{n}.exr").is_file() for n in names):
+        return None
+    ours, ref = ({n: images.read_exr(d / f"{n}.exr")[..., :3] for n in names} for d in (run_dir, ref_dir))
+    mask = images.read_exr(ref_dir / "indirect.exr")[..., 3] > 0.5
+    full = [(x["direct"] + x["indirect"]) * x["albedo"] for x in (ours, ref)]
+    m = compare(full[0], full[1], mask)
+    return {"rel_rmse_8": m["rel_rmse_8"], "bias": m["bias"]}
+
+
 def _denoised(render_dir: Path, product: str) -> tuple[Path, float]:
     """The product's pass of one Cycles render denoised by OIDN (anchors.timed_denoise), written beside it
     as <product>_oidn.exr with the render's alpha; returns (that file, OIDN seconds)."""
@@ -582,7 +599,7 @@ def _run_row(opt: Options, blend: Path, scene: str, method: str, setting: dict, 
             "timings_ms": st["timings_ms"], "total_ms": st["total_ms"], "runs": st["runs"],
             "update_ms": st.get("update_ms"), "metrics": m, "noise": noise, "speedup": speed,
             "speedup_oidn": speed_oidn, "vs_eevee": against_eevee(m["rel_rmse_8"], our_s, product, eevee),
-            "renderer": st["renderer"]}
+            "full": _compare_full(run_dir, ref_dir), "renderer": st["renderer"]}
 
 
 def _seed_noise(blend: Path, run_dir: Path, settings: dict, product: str) -> float:
@@ -628,6 +645,8 @@ def results_json(result: dict) -> dict:
                 "speedup": {k: _finite(v) for k, v in r["speedup"].items()},
                 "speedup_oidn": r["speedup_oidn"] and {k: _finite(v) for k, v in r["speedup_oidn"].items()},
                 "vs_eevee": r["vs_eevee"],
+                # (direct + indirect) x albedo against Cycles' (the image a user sees); None: no indirect
+                "full": r.get("full"),
             })
     scenes = [{k: sc[k] for k in ("name", "source", "size", "ref_spp", "ref_time_s", "noise_floor", "curve",
                                   "curve_oidn", "eevee", "notes")}

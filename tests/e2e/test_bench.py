@@ -12,6 +12,7 @@ blocks at 48 px than at 128 px, where the demo measured 0.086) and the bias at 0
 import json
 import math
 
+import numpy as np
 import pytest
 
 from addon.bridge import bench
@@ -232,12 +233,30 @@ def test_results_json_has_one_record_per_run():
         "update_ms": {"full": 3.0, "lights": 2.0, "camera": 1.5},
         "rel_rmse": 0.3, "rel_rmse_8": 0.06, "bias": 0.997, "noise": 0.0,
         "speedup": {"cycles_time_s": 0.006, "speedup": 1.9, "bound": "<"},
-        "speedup_oidn": None, "vs_eevee": None,
+        "speedup_oidn": None, "vs_eevee": None, "full": None,
     }
     assert middle["speedup_oidn"] == {"cycles_time_s": 0.03, "speedup": 1.5, "bound": "="}
     assert second["setting"] == {"rsm.vpl_samples": 128} and second["update_ms"] is None
     assert second["rel_rmse_8"] is None and second["speedup"]["speedup"] is None
     assert second["speedup_oidn"]["speedup"] is None
+
+
+def test_full_image_is_direct_plus_indirect_times_albedo(tmp_path):
+    # Constant images: ours direct 1, indirect 2, albedo 0.5 -> 1.5; Cycles' direct 1, indirect 1, albedo
+    # 0.5 -> 1.0: bias exactly 1.5, rel_rmse_8 exactly 0.5. Without an indirect image: None.
+    from addon.bridge import images
+
+    def write(d, **values):
+        d.mkdir()
+        for name, v in values.items():
+            images.write_exr(d / f"{name}.exr", np.full((16, 16, 4), [v, v, v, 1.0], np.float32))
+
+    write(tmp_path / "ours", direct=1.0, indirect=2.0, albedo=0.5)
+    write(tmp_path / "ref", direct=1.0, indirect=1.0, albedo=0.5)
+    full = bench._compare_full(tmp_path / "ours", tmp_path / "ref")
+    assert full["bias"] == pytest.approx(1.5, rel=1e-6) and full["rel_rmse_8"] == pytest.approx(0.5, rel=1e-6)
+    (tmp_path / "ours" / "indirect.exr").unlink()
+    assert bench._compare_full(tmp_path / "ours", tmp_path / "ref") is None
 
 
 def test_code_version_names_the_commit(tmp_path):
@@ -339,6 +358,7 @@ def test_quick_bench_on_cornell(tmp_path):
         assert (rec["rel_rmse_8"], rec["bias"], rec["total_ms"]) == (r["metrics"]["rel_rmse_8"], r["metrics"]["bias"],
                                                                      r["total_ms"])
         assert rec["speedup_oidn"] is None and rec["vs_eevee"] is None
+        assert rec["full"] is None  # direct has no indirect light: no full image to compare
         assert set(rec["update_ms"]) == {"full", "lights", "camera"}
         assert all(math.isfinite(ms) and ms > 0 for ms in rec["update_ms"].values()), rec["update_ms"]
     assert all(sc["noise_floor"]["direct"][k] is not None for k in ("rel_rmse", "rel_rmse_8", "bias"))
