@@ -112,10 +112,50 @@ def accuracy_block(results: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _median(values: list[float]) -> float | None:
+    values = sorted(v for v in values if v is not None)
+    if not values:
+        return None
+    mid = len(values) // 2
+    return values[mid] if len(values) % 2 else (values[mid - 1] + values[mid]) / 2
+
+
+def methods_block(results: dict) -> str:
+    """Table: per method at its defaults, the medians over the run's scenes of its error (rel_rmse_8),
+    its own noise (seed against seed), its update time, and its speed-ups against Cycles and against
+    Cycles + OIDN (undefined speed-ups, where our error lies outside a curve, left out of the median)."""
+    records = _default_records(results)
+    scenes = list(dict.fromkeys(r["scene"] for r in records))
+
+    def speed(r, key):
+        s = r.get(key)
+        return s["speedup"] if s and s["bound"] == "=" else None
+
+    lines = ["**The methods at a glance**: medians over the " + f"{len(scenes)} scenes of the run below "
+             "(rel_rmse_8 and noise of the light each method makes, against Cycles' Diffuse Indirect, or Direct for "
+             "`direct`; time of one full update on the run's machine; speed-up = the time Cycles needs for the "
+             "same rel_rmse_8 / ours, where our error lies on its curve).", "",
+             "| method | rel_rmse_8 | noise | ms | speed-up vs Cycles | vs Cycles + OIDN |",
+             "| --- | --- | --- | --- | --- | --- |"]
+    for method in _methods(records):
+        rows = [r for r in records if r["method"] == method]
+        err, noise = _median([r["rel_rmse_8"] for r in rows]), _median([r.get("noise") for r in rows])
+        ms = _median([r["total_ms"] for r in rows])
+        raw, oidn = _median([speed(r, "speedup") for r in rows]), _median([speed(r, "speedup_oidn") for r in rows])
+
+        def f(x, fmt):
+            return "–" if x is None else fmt.format(x)
+
+        lines.append(f"| {method} | {f(err, '{:.3f}')} | {f(noise, '{:.3f}')} | {f(ms, '{:.0f}')} | "
+                     f"{f(raw, '{:.2g}x')} | {f(oidn, '{:.2g}x')} |")
+    return "\n".join(lines) + "\n"
+
+
 # block name -> (its results.json, the function that formats it)
 BLOCKS: dict[str, tuple[Path, Callable[[dict], str]]] = {
     "update-costs": (UPDATES_JSON, update_costs_block),
     "accuracy": (DEFAULTS_JSON, accuracy_block),
+    "methods": (DEFAULTS_JSON, methods_block),
 }
 
 

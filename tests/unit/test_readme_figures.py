@@ -87,3 +87,17 @@ def test_accuracy_block_with_the_oidn_anchor():
                          "| emissive | 0.102 / 0.996 / >= 300x | 0.102 / 0.996 / – |"]
     without = [{**r, "speedup_oidn": None} for r in records]
     assert "OIDN" not in readme_figures.accuracy_block(_results(without))
+
+
+def test_methods_block_gives_medians_over_scenes():
+    # direct on three scenes: errors 0.1, 0.3, 0.2 -> median 0.2; times 10, 30, 20 -> 20; speed-ups
+    # 2 (=), 4 (=), 9 (<=, a bound: left out) -> median 3; no OIDN speed-up -> a dash.
+    def rec(scene, err, ms, speed, bound="="):
+        return {**_record(scene, "direct", rel_rmse_8=err), "noise": 0.0, "total_ms": ms,
+                "speedup": {"speedup": speed, "bound": bound}, "speedup_oidn": None}
+
+    records = [rec("a", 0.1, 10.0, 2.0), rec("b", 0.3, 30.0, 4.0), rec("c", 0.2, 20.0, 9.0, "<")]
+    lines = readme_figures.methods_block(_results(records)).splitlines()
+    assert lines[0].startswith("**The methods at a glance**: medians over the 3 scenes")
+    assert lines[2:] == ["| method | rel_rmse_8 | noise | ms | speed-up vs Cycles | vs Cycles + OIDN |",
+                         "| --- | --- | --- | --- | --- | --- |", "| direct | 0.200 | 0.000 | 20 | 3x | – |"]
