@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import re
 import sys
 from pathlib import Path
 
@@ -119,7 +120,8 @@ def agreement(records: list[dict], features: dict, cache: Path, ridge: float, re
         model = choice.fit([r for r in records if r["scene"] != held],
                            {s: f for s, f in features.items() if s != held}, ridge)
         rows = [r for r in records if r["scene"] == held and choice.row_key(r["method"], r["setting"]) in model.rows]
-        refs = sorted((cache / "refs").glob(f"{held}-{ref_glob}"))
+        refs = [d for d in sorted((cache / "refs").glob(f"{held}-{ref_glob}"))
+                if re.fullmatch(rf"{re.escape(held)}-[0-9a-f]{{12}}-.*", d.name)]  # not cornell-sun for cornell
         if not rows or not refs:
             continue
         ref = images.read_exr(refs[-1] / "indirect.exr")
