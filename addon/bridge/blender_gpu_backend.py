@@ -227,9 +227,10 @@ class BlenderGPUBackend(Backend):
         with target.fbo.bind():
             target.fbo.clear(**kwargs)
 
-    def draw(self, program, target, mesh, uniforms=None, samplers=None, blend="none", depth_test=False) -> None:
+    def draw(self, program, target, mesh, uniforms=None, samplers=None, blend="none", depth_test=False,
+             viewport=None) -> None:
         with target.fbo.bind():
-            gpu.state.viewport_set(0, 0, *target.size)
+            gpu.state.viewport_set(*(viewport if viewport is not None else (0, 0, *target.size)))
             gpu.state.blend_set("ADDITIVE_PREMULT" if blend == "add" else "NONE")
             gpu.state.depth_test_set("LESS_EQUAL" if depth_test else "NONE")
             gpu.state.depth_mask_set(depth_test)

@@ -160,6 +160,30 @@ class VctConfig(_Validated):
 
 
 @dataclass(frozen=True)
+class ProbesConfig(_Validated):
+    """Probe grid with L2 SH and distance moments (method `probes`, paper 004): docs/PROBES.md."""
+
+    # Cornell at 128 px against Cycles (docs/PROBES.md), rel_rmse_8: 4 probes a side 0.35, 8 0.20,
+    # 12 0.16, 16 0.124 at 8^2 texels a face (8 at 16^2: 0.198, the same as at 8^2 within 0.01): the
+    # error is the probes' spacing, not their faces' resolution. Cost: 6 draws of the scene per probe
+    # per geometry change, 6 face_texels^2 texels per probe re-shaded per light change.
+    probes_per_side: int = _num(16, 2, 64, "probes along the bounds' longest side (spacing = that side / n)")
+    face_texels: int = _num(8, 4, 64, "texels per side of each of a probe's six captured faces")
+    normal_bias: float = _num(0.25, 0.0, 1.0, "lookup point moved off its surface along the normal, x spacing")
+    chebyshev_visibility: bool = field(default=True, metadata={
+        "doc": "weigh probes by Chebyshev visibility from their distance moments (no light through walls)"})
+    # The capture draws the whole scene 6 times per probe: 1e6 triangles at 16 a side (256 probes on a
+    # flat floor) took 308 s on llvmpipe (tests/hard, million-triangle floor). Above this budget
+    # probes_per_side is lowered until 6 x probes x triangles fits (probe_grid.ProbeGrid.fit).
+    capture_mtris: float = _num(50.0, 1.0, 1.0e6, "most triangles drawn per capture, in millions (6 x probes x "
+                                "triangles): fewer probes where a scene has more")
+    # A probe inside a closed object or buried in a wall sees back faces in most directions: its light
+    # is the inside's, so it is switched off (1: never).
+    backface_share: float = _num(1.0, 0.0, 1.0, "probe switched off when back faces fill more than this "
+                                 "share of its sphere")
+
+
+@dataclass(frozen=True)
 class DiffusionConfig(_Validated):
     """Volume diffusion (method `diffusion`, paper 000): docs/DIFFUSION.md derives the transport."""
 
@@ -205,7 +229,7 @@ class GIConfig(_Validated):
 # Settings group -> its config class: the Blender property groups (scene.bounce.<group>), the command
 # line's flags and the registry's `reads` use these names.
 GROUPS: dict[str, type] = {"gi": GIConfig, "rsm": RsmConfig, "lpv": LpvConfig, "vct": VctConfig,
-                           "diffusion": DiffusionConfig}
+                           "probes": ProbesConfig, "diffusion": DiffusionConfig}
 
 
 def settings(**configs) -> dict[str, Any]:

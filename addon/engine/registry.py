@@ -92,6 +92,15 @@ METHODS: tuple[MethodSpec, ...] = (
         bench=({"vct.voxel_cells": 64}, {"vct.voxel_cells": 64, "vct.gather_scale": 2}, {"vct.voxel_cells": 128},
                {"vct.voxel_cells": 64, "vct.filtered_injection": True})),
     MethodSpec(
+        name="probes", summary="probe grid: cube-map captures re-shaded per light, L2 SH, visibility (paper 004)",
+        module="probes", class_name="ProbesMethod", products=("direct", "indirect", "albedo"), max_bounces=8,
+        reads=(*_IMAGE, "gi.bounces", *_LIGHT_VIEWS, "probes.*"),
+        # The defaults (16 probes along the longest side, 8^2 texels a face), coarser grids (the paper's
+        # 16^2 faces at 8 a side), and the trilinear and back-face weights alone (no visibility),
+        # docs/PROBES.md.
+        bench=({}, {"probes.probes_per_side": 12}, {"probes.probes_per_side": 8, "probes.face_texels": 16},
+               {"probes.chebyshev_visibility": False})),
+    MethodSpec(
         name="diffusion", summary="occupancy-aware SH diffusion through the voxels, re-emitted at surfaces (paper 000)",
         module="diffusion", class_name="DiffusionMethod", products=("direct", "indirect", "albedo"), max_bounces=8,
         reads=(*_IMAGE, "gi.bounces", *_LIGHT_VIEWS, "diffusion.*"),

@@ -25,3 +25,33 @@ float sh_irradiance(vec4 c, vec3 n) {
 float sh_evaluate(vec4 c, vec3 d) {
     return dot(c, sh_basis(d));
 }
+
+// L2 (9 coefficients: the L1 order, then xy, yz, 3z^2-1, xz, x^2-y^2), as sh.py's basis_l2. Coefficient
+// i of the basis and of the clamped-cosine lobe (band factors pi, 2 pi / 3, pi / 4).
+const float SH_Y2_XY = 1.09254843;   // sqrt(15 / pi) / 2 (xy, yz, xz)
+const float SH_Y2_ZZ = 0.31539157;   // sqrt(5 / pi) / 4 (3z^2 - 1)
+const float SH_Y2_XXYY = 0.54627422; // sqrt(15 / pi) / 4 (x^2 - y^2)
+const float SH_A2 = 0.78539816;      // pi / 4, l = 2
+
+float sh2_basis(int i, vec3 d) {
+    if (i < 4) {
+        return sh_basis(d)[i];
+    }
+    if (i == 4) {
+        return SH_Y2_XY * d.x * d.y;
+    }
+    if (i == 5) {
+        return SH_Y2_XY * d.y * d.z;
+    }
+    if (i == 6) {
+        return SH_Y2_ZZ * (3.0 * d.z * d.z - 1.0);
+    }
+    if (i == 7) {
+        return SH_Y2_XY * d.x * d.z;
+    }
+    return SH_Y2_XXYY * (d.x * d.x - d.y * d.y);
+}
+
+float sh2_cosine_lobe(int i, vec3 n) {
+    return (i == 0 ? SH_A0 : (i < 4 ? SH_A1 : SH_A2)) * sh2_basis(i, n);
+}

@@ -28,6 +28,9 @@ CASES = {
     # diffusion (16 cells, _method): its light field does not depend on the camera, bounces included.
     "diffusion": ("diffusion", {}, {}, {}, True),
     "diffusion-2-bounces": ("diffusion", {"bounces": 2}, {}, {}, True),
+    # probes (6 a side, _method): the SH field does not depend on the camera, bounces included.
+    "probes": ("probes", {}, {}, {}, True),
+    "probes-2-bounces": ("probes", {"bounces": 2}, {}, {}, True),
 }
 
 
@@ -52,12 +55,13 @@ def cornell_scene():
 
 def _method(gl, case):
     from addon.engine import methods
-    from addon.engine.config import DiffusionConfig, GIConfig, LpvConfig, RsmConfig, VctConfig
+    from addon.engine.config import DiffusionConfig, GIConfig, LpvConfig, ProbesConfig, RsmConfig, VctConfig
 
     name, gi, lpv, vct, _ = CASES[case]
     return methods.create(gl, {"gi": GIConfig(method=name, resolution=32, **gi),
                                "rsm": RsmConfig(resolution=64, vpl_samples=16), "lpv": LpvConfig(**lpv),
-                               "vct": VctConfig(**vct), "diffusion": DiffusionConfig(grid_cells=16)})
+                               "vct": VctConfig(**vct), "diffusion": DiffusionConfig(grid_cells=16),
+                               "probes": ProbesConfig(probes_per_side=6)})
 
 
 def _fresh_images(gl, case, scene):

@@ -198,7 +198,7 @@ def test_navigating_gives_preview_then_full_quality(cornell):
 
 
 @pytest.mark.parametrize("name", ["direct", "rsm", "lpv", "lpv-far-field", "lpv-emitter-classes", "lpv-octree",
-                                  "lpv-octree-index", "vct", "vct-filtered", "diffusion"])
+                                  "lpv-octree-index", "vct", "vct-filtered", "diffusion", "probes"])
 def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, name):
     # lpv at 16 cells runs one grid; "lpv-far-field" at 32 cells adds the far field's passes;
     # "lpv-emitter-classes" (16 cells) the classes' injection, unpacks and own-light lookups;
@@ -208,7 +208,7 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
     from addon.bridge import scenes
     from addon.bridge.capture import SceneCache
     from addon.engine import methods
-    from addon.engine.config import DiffusionConfig, GIConfig, LpvConfig, RsmConfig, VctConfig
+    from addon.engine.config import DiffusionConfig, GIConfig, LpvConfig, ProbesConfig, RsmConfig, VctConfig
 
     scenes.build("cornell-glossy" if name.startswith("vct") else "cornell")  # vct: its glossy product too
     scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 64, 48)
@@ -222,7 +222,8 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
                         octree_merge="index" if name == "lpv-octree-index" else "time")
         vct = VctConfig(voxel_cells=16, diffuse_cones=6, filtered_injection=name == "vct-filtered")
         method = methods.create(be, {"gi": gi, "rsm": rsm, "lpv": lpv, "vct": vct,
-                                     "diffusion": DiffusionConfig(grid_cells=16)})
+                                     "diffusion": DiffusionConfig(grid_cells=16),
+                                     "probes": ProbesConfig(probes_per_side=6)})
         method.set_scene(scene)
         results.append(method.run().images)
     a, b = results

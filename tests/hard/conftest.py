@@ -125,6 +125,19 @@ DIFFUSION_KNOWN_DEFECTS = {
 }
 
 
+# Known defects of `probes` (defaults: 16 probes a side, 8^2 texels a face, Chebyshev visibility),
+# measured on llvmpipe, 48 px (docs/PROBES.md, "Measured").
+PROBES = "probes: "
+PROBES_KNOWN_DEFECTS = {
+    "test_camera_inside_closed_block[probes]": "indirect 0.13 inside a closed block (exact 0) at an inner corner: "
+                                               "the receiver lies 2 mm behind the wall an outside probe sees it "
+                                               "through, below what 8^2-texel distance moments resolve",
+    "test_light_inside_closed_box_stays_inside[probes]": "indirect 0.002 x P/(6 pi) outside a closed box (exact "
+                                                         "0): texels of the box's outer faces at its edges see "
+                                                         "its lit inside past the shared edge (rasterization)",
+}
+
+
 def pytest_collection_modifyitems(items):
     for item in items:
         reason = KNOWN_DEFECTS.get(item.name)
@@ -142,6 +155,9 @@ def pytest_collection_modifyitems(items):
         reason = DIFFUSION_KNOWN_DEFECTS.get(item.name)
         if reason is not None:
             item.add_marker(pytest.mark.xfail(strict=True, reason=DIFFUSION + reason))
+        reason = PROBES_KNOWN_DEFECTS.get(item.name)
+        if reason is not None:
+            item.add_marker(pytest.mark.xfail(strict=True, reason=PROBES + reason))
 
 
 # Module-level rather than in a session fixture: the outcomes come from the report hook and are only

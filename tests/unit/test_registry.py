@@ -11,7 +11,7 @@ from addon.engine import config, methods, registry
 
 def test_config_method_choices_are_the_registry():
     assert config.limits(config.GIConfig)["method"]["choices"] == registry.NAMES
-    assert registry.NAMES == ("direct", "rsm", "lpv", "vct", "diffusion")  # shipped, in menu order
+    assert registry.NAMES == ("direct", "rsm", "lpv", "vct", "probes", "diffusion")  # shipped, in menu order
 
 
 @pytest.mark.parametrize("spec", registry.METHODS, ids=lambda s: s.name)
@@ -44,7 +44,7 @@ def test_unknown_method_is_one_clear_error():
 def test_create_fills_missing_groups_with_defaults():
     # methods.create takes {group: config}; a group left out takes its defaults, an unknown one is refused.
     with pytest.raises(config.ConfigError, match="unknown settings group"):
-        config.settings(probes=config.GIConfig())
+        config.settings(photons=config.GIConfig())
     with pytest.raises(config.ConfigError, match="takes a LpvConfig"):
         config.settings(lpv=config.VctConfig())
     full = config.settings(gi=config.GIConfig(method="lpv"))

@@ -213,8 +213,11 @@ class Backend(abc.ABC):
         samplers: dict[str, Texture] | None = None,
         blend: str = "none",
         depth_test: bool = False,
+        viewport: tuple[int, int, int, int] | None = None,
     ) -> None:
-        """Rasterize `mesh`; blend 'add' accumulates (ONE, ONE) on all channels; points are 1 px."""
+        """Rasterize `mesh`; blend 'add' accumulates (ONE, ONE) on all channels; points are 1 px.
+        `viewport` (x, y, w, h): clip space maps onto that rectangle of the target (default: all of it),
+        so a draw fills one tile of an atlas and nothing outside it."""
 
     @abc.abstractmethod
     def depth_texture(self, size: tuple[int, int]) -> Texture: ...

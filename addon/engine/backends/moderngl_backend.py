@@ -309,10 +309,11 @@ class ModernGLBackend(Backend):
             self._gl.glClear(_GL_DEPTH_BUFFER_BIT)
 
     @_in_own_context
-    def draw(self, program, target, mesh, uniforms=None, samplers=None, blend="none", depth_test=False) -> None:
+    def draw(self, program, target, mesh, uniforms=None, samplers=None, blend="none", depth_test=False,
+             viewport=None) -> None:
         mgl = self._mgl
         target.fbo.use()
-        self.ctx.viewport = (0, 0, *target.size)
+        self.ctx.viewport = tuple(viewport) if viewport is not None else (0, 0, *target.size)
         flags = mgl.DEPTH_TEST if depth_test else mgl.NOTHING
         if blend == "add":
             flags |= mgl.BLEND

@@ -1,0 +1,87 @@
+"""Method `probes`: a grid of light probes with L2 SH and distance moments (Nijasure, Pattanaik & Goel
+2005, seeds 004; the visibility weighting of DDGI, Majercik et al. 2019). docs/PROBES.md.
+
+Setup (once per geometry change, set_scene): the grid is fitted to the bounds (probe_grid.ProbeGrid.fit,
+ProbesConfig.probes_per_side); probe_capture rasterizes every probe's six faces into one atlas G-buffer
+(position, normal, albedo), then the distance moments of each atlas texel and which probes sit inside
+geometry. Solve (per light change): per light face probe_direct (the direct pass on the atlas), then
+probe_project (albedo x direct -> L2 SH per probe); each further bounce reads the field back at the
+atlas (probe_lookup.bounce) and re-projects with it (GIConfig.bounces = N: N projections). Gather (per
+camera move, per lightmap): the direct pass on the G-buffer, then probe_lookup -> `indirect` (Cycles'
+Diffuse Indirect units). The light field (sh, moments, state) does not depend on the camera, so a
+camera move costs the G-buffer, the direct light and the lookup. Products: direct, indirect, albedo.
+"""
+
+from __future__ import annotations
+
+from .. import registry
+from ..config import ProbesConfig
+from ..passes import declare, probe_capture, probe_lookup, probe_project, zero
+from ..passes.light_views import LightView
+from ..probe_grid import ProbeGrid
+from .direct import OneBounceMethod, triangle_attributes
+
+
+class ProbesMethod(OneBounceMethod):
+    spec = registry.get("probes")
+    PASSES = declare.extend(
+        OneBounceMethod.PASSES, setup=(probe_capture.CAPTURE_DECL, probe_capture.MOMENTS_DECL),
+        solve=(probe_project.SHADE_DECL, probe_project.PROJECT_DECL, probe_lookup.BOUNCE_DECL,
+               probe_project.REPROJECT_DECL),
+        gather=(probe_lookup.DECL,))
+
+    def __init__(self, backend, gi, rsm_config, probes_config: ProbesConfig | None = None):
+        super().__init__(backend, gi, rsm_config)
+        self.probes_config = probes_config if probes_config is not None else ProbesConfig()
+        self.grid: ProbeGrid | None = None
+
+    def set_scene(self, scene) -> None:
+        super().set_scene(scene)
+        be, cfg = self.backend, self.probes_config
+        self.grid = grid = ProbeGrid.fit(*self.bounds_m, cfg.probes_per_side, cfg.face_texels,
+                                         self.scene.triangle_count, cfg.capture_mtris * 1e6)
+        size = grid.atlas_size
+        self.atlas = declare.allocate(be, probe_capture.ATLAS, size)
+        self._atlas_target = be.target(list(self.atlas.values()), be.depth_texture(size))
+        self.atlas_direct = be.texture(size)
+        self.atlas_indirect = be.texture(size) if self.gi.bounces > 1 else None
+        # Two SH tables: a bounce reads one while the next projection writes the other.
+        self._sh = [be.texture(grid.sh_size) for _ in range(2 if self.gi.bounces > 1 else 1)]
+        self.sh = self._sh[0]
+        self.moments = be.texture(size)
+        self.state = be.texture(grid.state_size)
+        far = probe_capture.far_m(self.bounds_m)
+        attrs = triangle_attributes(self.scene)  # every triangle: emitters and camera-hidden objects block
+        mesh = be.mesh(be.program(probe_capture.SPEC), attrs, "triangles") if attrs is not None else None
+        probe_capture.run(be, self._atlas_target, self.atlas, mesh, grid, probe_capture.face_matrices(grid, far))
+        probe_capture.moments(be, self.atlas, self.moments, self.state, grid, cfg.backface_share)
+
+    def field(self) -> dict:
+        """The light field the lookup reads."""
+        return {"sh": self.sh, "moments": self.moments, "state": self.state}
+
+    def begin_solve(self, timings: dict[str, float]) -> None:
+        zero.images(self.backend, [self.atlas_direct])
+
+    def solve_view(self, view: LightView, timings: dict[str, float]) -> None:
+        with self.step(timings, probe_project.SHADE_DECL):
+            probe_project.shade(self.backend, self.atlas, self.atlas_direct, self.rsm["position"], view,
+                                self.rsm_config.shadow_bias_texels, self.emitters)
+
+    def finish_solve(self, timings: dict[str, float]) -> None:
+        be, grid = self.backend, self.grid
+        self.sh = self._sh[0]
+        with self.step(timings, probe_project.PROJECT_DECL):
+            probe_project.run(be, self.atlas, self.atlas_direct, self.sh, grid)
+        for bounce in range(2, self.gi.bounces + 1):
+            with self.step(timings, probe_lookup.BOUNCE_DECL):
+                probe_lookup.run(be, self.atlas["position"], self.atlas["normal"], self.field(), self.atlas_indirect,
+                                 grid, self.probes_config)
+            self.sh = self._sh[(bounce - 1) % 2]
+            with self.step(timings, probe_project.REPROJECT_DECL):
+                probe_project.run(be, self.atlas, self.atlas_direct, self.sh, grid, self.atlas_indirect)
+
+    def gather_pixels(self, timings: dict[str, float]) -> None:
+        with self.step(timings, probe_lookup.DECL):
+            probe_lookup.run(self.backend, self.gbuf["position"], self.gbuf["normal"], self.field(), self.indirect,
+                             self.grid, self.probes_config)

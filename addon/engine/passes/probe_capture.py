@@ -1,0 +1,128 @@
+"""Probe capture (setup half, once per geometry change): every probe's six faces rasterized into one
+atlas G-buffer (the paper's key optimisation: later light changes only re-shade it), then per texel
+the distance moments its Chebyshev visibility reads, and per probe whether it is inside geometry.
+
+capture: for each probe and face, the scene's triangles drawn with the face's 90-degree view-projection
+(probe_grid.face_view_projection) into that face's n x n viewport of the atlas (layout: probe_grid.py).
+Outputs (RGBA32F, atlas): position (m, w = 1 where geometry), normal (towards the probe, w = +1 front
+face / -1 back face), albedo (w = 1 where geometry); depth 32F.
+moments: mean and mean square of the probe-to-surface distance over a (2 MOMENT_RADIUS + 1)^2 window
+of the texel's face, distances clamped at MAX_DISTANCE_RATIO x spacing (directions without geometry
+count as that).
+classify: per probe, the share of its sphere (exact texel solid angles) that sees back faces; above
+ProbesConfig.backface_share the probe is off (state.x = 0): it is inside something.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
+from ..probe_grid import ProbeGrid, face_view_projection
+from . import zero
+from .declare import TRIANGLES, PassDecl, Port
+
+# Texels each side of the moments' window. 0: each texel's own distance; the variance comes from the
+# lookup's bilinear blend of neighbouring texels alone. A 3 x 3 window (1) let a closed box's lit
+# inside leak 0.75 x its mean light onto the ground outside (tests/hard, light in a closed box; 0.002
+# at 0): at a silhouette the window mixes the near face with what lies behind it, and the variance
+# that makes stops nothing.
+MOMENT_RADIUS = 0
+# Distances in the moments are clamped at this x spacing: beyond any receiver that reads the probe (the
+# 8 probes around a point are within sqrt(3) spacings of it, plus the normal bias).
+MAX_DISTANCE_RATIO = 2.0
+NEAR_RATIO = 1e-3  # a face's near plane, x spacing: surfaces closer to a probe than that are not seen
+
+# What probe.glsl reads of the grid: the atlas layout alone, and with the probes' positions. A spec
+# declares only what its shader reads (Blender refuses a uniform the compiler optimised out).
+ATLAS_UNIFORMS = (Var("probe_dims", "ivec3"), Var("face_texels", "int"), Var("tiles_per_row", "int"))
+GRID_UNIFORMS = (Var("probe_first", "vec3"), Var("probe_spacing", "float"), *ATLAS_UNIFORMS)
+
+
+def grid_uniforms(spec: ShaderSpec, grid: ProbeGrid) -> dict:
+    """The grid's uniforms that `spec` declares."""
+    names = {u.name for u in spec.uniforms}
+    return {k: v for k, v in grid.uniforms().items() if k in names}
+
+
+def _atlas(name, units):
+    return Port("probes", name, "RGBA32F", "probe_atlas", units)
+
+
+ATLAS = (_atlas("position", "world position (m) a probe texel sees, w = 1 where geometry"),
+         _atlas("normal", "world normal towards the probe; w = +1 front face, -1 back face"),
+         _atlas("albedo", "diffuse albedo (linear), w = 1 where geometry"))
+ATLAS_POSITION, ATLAS_NORMAL, ATLAS_ALBEDO = ATLAS
+MOMENTS = _atlas("moments", "probe-to-surface distance: mean (m), mean square (m^2) over a texel window")
+STATE = Port("probes", "state", "RGBA32F", "probes", "x: 1 probe on, 0 off (inside geometry); y: back-face share")
+
+CAPTURE_DECL = PassDecl("probe_capture", "setup", (TRIANGLES,), ATLAS,
+                        "every probe's six faces rasterized into the atlas G-buffer")
+MOMENTS_DECL = PassDecl("probe_moments", "setup", (ATLAS_POSITION, ATLAS_NORMAL), (MOMENTS, STATE),
+                        "distance moments per atlas texel; probes inside geometry switched off")
+
+SPEC = ShaderSpec(
+    name="probe_capture",
+    vertex="probes/capture.vert.glsl",
+    fragment="probes/capture.frag.glsl",
+    uniforms=(Var("view_projection", "mat4"), Var("camera_pos_ws", "vec3")),
+    attributes=(Var("pos_ws", "vec3"), Var("normal_ws", "vec3"), Var("albedo", "vec3")),
+    varyings=(Var("v_pos_ws", "vec3"), Var("v_normal_ws", "vec3"), Var("v_albedo", "vec3")),
+    outputs=(Var("out_position", "vec4"), Var("out_normal", "vec4"), Var("out_albedo", "vec4")),
+)
+
+MOMENTS_SPEC = ShaderSpec(
+    name="probe_moments",
+    compute="probes/moments.comp.glsl",
+    local_size=(8, 8, 1),
+    samplers=(Sampler("atlas_position", "2D"),),
+    images=(Image("moments", "2D", "RGBA32F", "write"),),
+    uniforms=(*GRID_UNIFORMS, Var("max_distance_m", "float"), Var("moment_radius", "int")),
+)
+
+CLASSIFY_SPEC = ShaderSpec(
+    name="probe_classify",
+    compute="probes/classify.comp.glsl",
+    local_size=(8, 8, 1),
+    samplers=(Sampler("atlas_normal", "2D"),),
+    images=(Image("state", "2D", "RGBA32F", "write"),),
+    uniforms=(*ATLAS_UNIFORMS, Var("backface_share", "float")),
+)
+
+
+def far_m(bounds_m) -> float:
+    """Beyond every surface: the far plane of the faces."""
+    lo, hi = (np.asarray(b, np.float64) for b in bounds_m)
+    return 2.0 * float(np.linalg.norm(hi - lo)) + 1e-3
+
+
+def face_matrices(grid: ProbeGrid, far: float) -> list[np.ndarray]:
+    """The view-projection of every probe's faces, in probe order then face order."""
+    near = NEAR_RATIO * grid.spacing_m
+    return [face_view_projection(c, f, near, far) for c in grid.positions_m() for f in range(6)]
+
+
+def run(backend: Backend, target, atlas: dict, mesh, grid: ProbeGrid, matrices: list[np.ndarray]) -> None:
+    """Fill the atlas G-buffer (`atlas` = the ATLAS textures, attached to `target` with a depth)."""
+    zero.images(backend, [atlas[p.name] for p in ATLAS])
+    backend.clear(target, color=None, depth=1.0)
+    if mesh is None:
+        return
+    program = backend.program(SPEC)
+    n = grid.face_texels
+    positions = grid.positions_m()
+    for p in range(grid.count):
+        for f in range(6):
+            x, y = grid.face_origin(p, f)
+            backend.draw(program, target, mesh, depth_test=True, viewport=(x, y, n, n),
+                         uniforms={"view_projection": matrices[6 * p + f], "camera_pos_ws": positions[p]})
+
+
+def moments(backend: Backend, atlas: dict, out_moments, out_state, grid: ProbeGrid, backface_share: float) -> None:
+    backend.dispatch(backend.program(MOMENTS_SPEC), group_count(out_moments.size, MOMENTS_SPEC.local_size),
+                     uniforms={**grid_uniforms(MOMENTS_SPEC, grid), "moment_radius": MOMENT_RADIUS,
+                               "max_distance_m": MAX_DISTANCE_RATIO * grid.spacing_m},
+                     samplers={"atlas_position": atlas["position"]}, images={"moments": out_moments})
+    backend.dispatch(backend.program(CLASSIFY_SPEC), group_count(out_state.size, CLASSIFY_SPEC.local_size),
+                     uniforms={**grid_uniforms(CLASSIFY_SPEC, grid), "backface_share": backface_share},
+                     samplers={"atlas_normal": atlas["normal"]}, images={"state": out_state})

@@ -1,0 +1,145 @@
+"""The probe grid of method `probes` (paper 004; docs/PROBES.md): placement, the atlas layout of the
+probes' six faces, the faces' frames and view-projections, and the closed-form solid angle of a face
+texel. The numpy reference of gpu_shaders/probes/probe.glsl.
+
+Placement: spacing = the bounds' longest side / probes_per_side; each axis gets as many probes as its
+extent needs at that spacing (at least one, so a flat scene gets a flat grid), centred on the bounds, so
+the outermost probes sit half a spacing inside the outer walls.
+
+Faces: face f = 2 * axis + (1 if negative) looks along its `forward` axis; texel (i, j) of a face of
+n x n texels (i: column, j: row, GL row 0 at the bottom) looks along forward + s right + t up with
+s = 2 (i + 0.5) / n - 1 and t = 2 (j + 0.5) / n - 1: the face's view-projection maps that direction to
+NDC (s, t), so the rasterized texel and the direction the shaders give it agree.
+
+Atlas: probe p = ix + nx (iy + ny iz) owns a tile of 3n x 2n texels, face f at tile column f % 3, row
+f // 3; tiles fill rows of `tiles_per_row`. The SH table is (9 nx) x (ny nz) texels: coefficient c of
+probe (ix, iy, iz) at (c nx + ix, iy + ny iz).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+SH_COEFFS = 9  # L2: the paper's nine coefficients per colour
+
+# forward, right, up per face (face = 2 * axis + negative); right x up = forward for every face.
+FACE_FRAMES = np.array([
+    [(1, 0, 0), (0, 1, 0), (0, 0, 1)],
+    [(-1, 0, 0), (0, -1, 0), (0, 0, 1)],
+    [(0, 1, 0), (0, 0, 1), (1, 0, 0)],
+    [(0, -1, 0), (0, 0, -1), (1, 0, 0)],
+    [(0, 0, 1), (1, 0, 0), (0, 1, 0)],
+    [(0, 0, -1), (-1, 0, 0), (0, 1, 0)],
+], np.float64)
+
+
+@dataclass(frozen=True)
+class ProbeGrid:
+    first_m: np.ndarray          # position of probe (0, 0, 0), m
+    spacing_m: float
+    dims: tuple[int, int, int]
+    face_texels: int             # n: each face is n x n texels
+
+    @classmethod
+    def fit(cls, lo: np.ndarray, hi: np.ndarray, probes_per_side: int, face_texels: int, triangles: int = 0,
+            max_triangle_draws: float = math.inf) -> ProbeGrid:
+        """The grid of `probes_per_side`, or of fewer (down to 2) while 6 x probes x `triangles` exceeds
+        `max_triangle_draws` (the capture draws the scene once per face)."""
+        grid = cls._fit(lo, hi, probes_per_side, face_texels)
+        while probes_per_side > 2 and 6.0 * grid.count * triangles > max_triangle_draws:
+            probes_per_side -= 1
+            grid = cls._fit(lo, hi, probes_per_side, face_texels)
+        return grid
+
+    @classmethod
+    def _fit(cls, lo: np.ndarray, hi: np.ndarray, probes_per_side: int, face_texels: int) -> ProbeGrid:
+        lo, hi = np.asarray(lo, np.float64), np.asarray(hi, np.float64)
+        extent = np.maximum(hi - lo, 0.0)
+        spacing = max(float(extent.max()), 1e-6) / probes_per_side
+        # ceil with a tolerance: an axis of exactly k spacings gets k probes, not k + 1 from rounding.
+        dims = np.maximum(np.ceil(extent / spacing - 1e-6).astype(int), 1)
+        first = (lo + hi) / 2.0 - (dims - 1) * spacing / 2.0
+        return cls(first, spacing, tuple(int(d) for d in dims), int(face_texels))
+
+    @property
+    def count(self) -> int:
+        return int(np.prod(self.dims))
+
+    def positions_m(self) -> np.ndarray:
+        """(count, 3) probe positions in probe order p = ix + nx (iy + ny iz)."""
+        nx, ny, nz = self.dims
+        iz, iy, ix = np.meshgrid(np.arange(nz), np.arange(ny), np.arange(nx), indexing="ij")
+        idx = np.stack([ix.ravel(), iy.ravel(), iz.ravel()], axis=-1)
+        return self.first_m + idx * self.spacing_m
+
+    @property
+    def tiles_per_row(self) -> int:
+        """Tiles per atlas row: about as many rows of tiles (2n high) as columns (3n wide)."""
+        return max(1, min(self.count, math.ceil(math.sqrt(self.count * 2.0 / 3.0))))
+
+    @property
+    def atlas_size(self) -> tuple[int, int]:
+        n, cols = self.face_texels, self.tiles_per_row
+        rows = -(-self.count // cols)
+        return 3 * n * cols, 2 * n * rows
+
+    @property
+    def sh_size(self) -> tuple[int, int]:
+        nx, ny, nz = self.dims
+        return SH_COEFFS * nx, ny * nz
+
+    @property
+    def state_size(self) -> tuple[int, int]:
+        nx, ny, nz = self.dims
+        return nx, ny * nz
+
+    def face_origin(self, probe: int, face: int) -> tuple[int, int]:
+        """The atlas texel (x, y) of the face's texel (0, 0)."""
+        n, cols = self.face_texels, self.tiles_per_row
+        return 3 * n * (probe % cols) + n * (face % 3), 2 * n * (probe // cols) + n * (face // 3)
+
+    def uniforms(self) -> dict:
+        """What the probe shaders need of the grid (probe.glsl)."""
+        return {"probe_first": self.first_m, "probe_spacing": self.spacing_m, "probe_dims": self.dims,
+                "face_texels": self.face_texels, "tiles_per_row": self.tiles_per_row}
+
+
+def texel_directions(n: int) -> np.ndarray:
+    """(6, n, n, 3) unit directions of every face texel's centre, [face, row j, column i]."""
+    c = 2.0 * (np.arange(n) + 0.5) / n - 1.0
+    t, s = np.meshgrid(c, c, indexing="ij")
+    f, r, u = FACE_FRAMES[:, 0], FACE_FRAMES[:, 1], FACE_FRAMES[:, 2]
+    d = f[:, None, None] + s[None, ..., None] * r[:, None, None] + t[None, ..., None] * u[:, None, None]
+    return d / np.linalg.norm(d, axis=-1, keepdims=True)
+
+
+def _corner_area(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Solid angle of the face-plane rectangle [0, x] x [0, y] at distance 1: atan2(xy, sqrt(x^2+y^2+1))."""
+    return np.arctan2(x * y, np.sqrt(x * x + y * y + 1.0))
+
+
+def texel_solid_angles(n: int) -> np.ndarray:
+    """(n, n) exact solid angle (sr) of each texel of an n x n face, [row j, column i]: the paper's closed
+    form A(x1, y1) - A(x0, y1) - A(x1, y0) + A(x0, y0). Six faces sum to 4 pi."""
+    e = 2.0 * np.arange(n + 1) / n - 1.0
+    x0, x1 = e[:-1][None, :], e[1:][None, :]
+    y0, y1 = e[:-1][:, None], e[1:][:, None]
+    return _corner_area(x1, y1) - _corner_area(x0, y1) - _corner_area(x1, y0) + _corner_area(x0, y0)
+
+
+def face_view_projection(center_m: np.ndarray, face: int, near_m: float, far_m: float) -> np.ndarray:
+    """4x4 (column vectors) mapping a world point to the face's clip space: x_ndc = v.right / v.forward,
+    y_ndc = v.up / v.forward (v = p - center), depth the usual perspective depth in [near, far]."""
+    f, r, u = FACE_FRAMES[face]
+    c = np.asarray(center_m, np.float64)
+    a = (far_m + near_m) / (far_m - near_m)
+    b = -2.0 * far_m * near_m / (far_m - near_m)
+    m = np.zeros((4, 4))
+    m[0, :3], m[0, 3] = r, -r @ c
+    m[1, :3], m[1, 3] = u, -u @ c
+    m[2, :3], m[2, 3] = a * f, -a * (f @ c) + b
+    m[3, :3], m[3, 3] = f, -f @ c
+    return m

@@ -1,0 +1,92 @@
+// The probe grid and its atlas (addon/engine/probe_grid.py is the numpy twin; docs/PROBES.md).
+// Uniforms: probe_first (m, probe (0,0,0)), probe_spacing (m), probe_dims, face_texels (n),
+// tiles_per_row. Probe p = ix + nx (iy + ny iz) owns a 3n x 2n tile, face f at column f % 3, row f / 3.
+// Face f = 2 axis + (negative ? 1 : 0) looks along `forward`; its texel (i, j) along
+// forward + s right + t up, s = 2 (i + 0.5) / n - 1, t likewise from j.
+
+int probe_count() {
+    return probe_dims.x * probe_dims.y * probe_dims.z;
+}
+
+int probe_index(ivec3 q) {
+    return q.x + probe_dims.x * (q.y + probe_dims.y * q.z);
+}
+
+ivec3 probe_cell(int p) {
+    return ivec3(p % probe_dims.x, (p / probe_dims.x) % probe_dims.y, p / (probe_dims.x * probe_dims.y));
+}
+
+// A macro, not a function: shaders that never place a probe (the projection, the classification) do
+// not declare probe_first and probe_spacing.
+#define probe_position(q) (probe_first + vec3(q) * probe_spacing)
+
+// The SH table's / state texture's row of a probe: iy + ny iz.
+int probe_row(ivec3 q) {
+    return q.y + probe_dims.y * q.z;
+}
+
+ivec2 face_origin(int p, int face) {
+    int n = face_texels;
+    return ivec2(3 * n * (p % tiles_per_row) + n * (face % 3), 2 * n * (p / tiles_per_row) + n * (face / 3));
+}
+
+void face_frame(int face, out vec3 forward, out vec3 right, out vec3 up) {
+    float sgn = (face % 2 == 0) ? 1.0 : -1.0;
+    int axis = face / 2;
+    if (axis == 0) {
+        forward = vec3(sgn, 0.0, 0.0);
+        right = vec3(0.0, sgn, 0.0);
+        up = vec3(0.0, 0.0, 1.0);
+    } else if (axis == 1) {
+        forward = vec3(0.0, sgn, 0.0);
+        right = vec3(0.0, 0.0, sgn);
+        up = vec3(1.0, 0.0, 0.0);
+    } else {
+        forward = vec3(0.0, 0.0, sgn);
+        right = vec3(sgn, 0.0, 0.0);
+        up = vec3(0.0, 1.0, 0.0);
+    }
+}
+
+// Unit direction of face coordinates st in [-1, 1]^2.
+vec3 face_direction(int face, vec2 st) {
+    vec3 f, r, u;
+    face_frame(face, f, r, u);
+    return normalize(f + st.x * r + st.y * u);
+}
+
+vec2 texel_st(ivec2 ij) {
+    return (vec2(ij) + 0.5) * (2.0 / float(face_texels)) - 1.0;
+}
+
+// Solid angle of the face-plane rectangle [0, x] x [0, y] at distance 1.
+float corner_area(float x, float y) {
+    return atan(x * y, sqrt(x * x + y * y + 1.0));
+}
+
+// Exact solid angle (sr) of texel ij of an n x n face (the paper's closed form).
+float texel_solid_angle(ivec2 ij) {
+    float h = 2.0 / float(face_texels);
+    vec2 lo = vec2(ij) * h - 1.0;
+    vec2 hi = lo + h;
+    return corner_area(hi.x, hi.y) - corner_area(lo.x, hi.y) - corner_area(hi.x, lo.y) + corner_area(lo.x, lo.y);
+}
+
+// The face a direction falls on and its face coordinates st in [-1, 1]^2 (the major axis, as the
+// rasterized faces partition directions).
+int direction_face(vec3 d, out vec2 st) {
+    vec3 a = abs(d);
+    int face;
+    if (a.x >= a.y && a.x >= a.z) {
+        face = d.x >= 0.0 ? 0 : 1;
+    } else if (a.y >= a.z) {
+        face = d.y >= 0.0 ? 2 : 3;
+    } else {
+        face = d.z >= 0.0 ? 4 : 5;
+    }
+    vec3 f, r, u;
+    face_frame(face, f, r, u);
+    float w = dot(d, f);
+    st = vec2(dot(d, r), dot(d, u)) / max(w, 1e-12);
+    return face;
+}

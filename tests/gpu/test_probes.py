@@ -1,0 +1,130 @@
+"""The `probes` passes (probe_capture, probe_project, probe_lookup) against closed-form answers.
+
+fp32 sums of 6 n^2 = 384 texel terms of order 1 round to ~1e-6 relative; RTOL = 1e-5 is several times
+that, and any wrong face, frame, solid angle or weight changes the values by > 1e-2 relative.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from addon.engine.config import ProbesConfig
+from addon.engine.passes import probe_capture, probe_lookup, probe_project
+from addon.engine.probe_grid import ProbeGrid
+
+pytestmark = pytest.mark.gpu
+
+RTOL = 1e-5
+N = 8  # face texels
+
+
+def textures(gl, grid: ProbeGrid):
+    size = grid.atlas_size
+    atlas = {p.name: gl.texture(size) for p in probe_capture.ATLAS}
+    target = gl.target(list(atlas.values()), gl.depth_texture(size))
+    return atlas, target
+
+
+def capture(gl, grid, triangles=None):
+    """The atlas G-buffer, moments and state of `grid` around `triangles` ((t, 3, 3) positions, or None:
+    an empty world)."""
+    atlas, target = textures(gl, grid)
+    mesh = None
+    if triangles is not None:
+        tris = np.asarray(triangles, np.float32)
+        normals = np.repeat(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), 3, axis=0)
+        normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+        attrs = {"pos_ws": tris.reshape(-1, 3), "normal_ws": normals, "albedo": np.full((len(normals), 3), 0.5)}
+        mesh = gl.mesh(gl.program(probe_capture.SPEC), attrs, "triangles")
+    probe_capture.run(gl, target, atlas, mesh, grid, probe_capture.face_matrices(grid, 100.0))
+    moments, state = gl.texture(grid.atlas_size), gl.texture(grid.state_size)
+    probe_capture.moments(gl, atlas, moments, state, grid, backface_share=1.0)
+    return atlas, moments, state
+
+
+def constant_sh(gl, grid, radiance_per_probe):
+    """An SH table holding, for each probe, the exact L2 projection of a constant radiance (rgb):
+    c_0 = L / Y00 = 2 sqrt(pi) L, the rest 0."""
+    table = np.zeros((grid.sh_size[1], grid.sh_size[0], 4), np.float32)
+    for p, radiance in enumerate(radiance_per_probe):
+        ix, row = p % grid.dims[0], p // grid.dims[0]
+        table[row, ix, :3] = np.asarray(radiance) * 2.0 * math.sqrt(math.pi)
+    return gl.texture(grid.sh_size, data=table)
+
+
+def test_constant_radiance_projects_to_exact_sh(gl):
+    # Every texel of two probes sees a surface of albedo 0.5 lit with Diffuse Direct D = (1, 2, 4):
+    # L = 0.5 D everywhere, so c_0 = 2 sqrt(pi) L (the texels' exact solid angles sum to 4 pi) and the other
+    # eight coefficients are 0 by the cube's symmetry.
+    grid = ProbeGrid(np.zeros(3), 1.0, (2, 1, 1), N)
+    size = grid.atlas_size
+    atlas = {"albedo": gl.texture(size, data=np.broadcast_to(np.float32([0.5, 0.5, 0.5, 1.0]), (size[1], size[0], 4)))}
+    direct = gl.texture(size, data=np.broadcast_to(np.float32([1.0, 2.0, 4.0, 0.0]), (size[1], size[0], 4)))
+    sh = gl.texture(grid.sh_size)
+    probe_project.run(gl, atlas, direct, sh, grid)
+    table = gl.read(sh)  # (rows ny nz, 9 nx, 4)
+    radiance = np.array([0.5, 1.0, 2.0])
+    for probe in range(2):
+        coeffs = table[0, probe::2, :3]  # coefficient i of probe ix at column i nx + ix
+        np.testing.assert_allclose(coeffs[0], 2.0 * math.sqrt(math.pi) * radiance, rtol=RTOL)
+        assert np.abs(coeffs[1:]).max() <= RTOL * coeffs[0].max()
+
+
+def test_one_probe_in_a_uniform_environment_gives_e_pi_l(gl):
+    # A single probe whose every direction brings radiance L = (0.3, 0.6, 1.2), projected by the GPU;
+    # receivers anywhere around it, with any normal: E = pi L, so Diffuse Indirect = E / pi = L exactly
+    # (the clamped cosine's band-0 factor pi times Y00 times c_0 = 2 sqrt(pi) L).
+    grid = ProbeGrid(np.zeros(3), 1.0, (1, 1, 1), N)
+    atlas, moments, state = capture(gl, grid)  # an empty world: no occluder, every probe on
+    size = grid.atlas_size
+    albedo = gl.texture(size, data=np.broadcast_to(np.float32([1.0, 1.0, 1.0, 1.0]), (size[1], size[0], 4)))
+    direct = gl.texture(size, data=np.broadcast_to(np.float32([0.3, 0.6, 1.2, 0.0]), (size[1], size[0], 4)))
+    sh = gl.texture(grid.sh_size)
+    probe_project.run(gl, {"albedo": albedo}, direct, sh, grid)
+    rng = np.random.default_rng(3)
+    pos = np.c_[rng.uniform(-0.7, 0.7, (16, 3)), np.ones(16)].astype(np.float32).reshape(4, 4, 4)
+    nrm = rng.normal(size=(16, 3))
+    nrm = np.c_[nrm / np.linalg.norm(nrm, axis=1, keepdims=True), np.zeros(16)].astype(np.float32).reshape(4, 4, 4)
+    out = gl.texture((4, 4))
+    probe_lookup.run(gl, gl.texture((4, 4), data=pos), gl.texture((4, 4), data=nrm),
+                     {"sh": sh, "moments": moments, "state": state}, out, grid, ProbesConfig())
+    got = gl.read(out)[..., :3].reshape(-1, 3)
+    np.testing.assert_allclose(got, np.broadcast_to([0.3, 0.6, 1.2], got.shape), rtol=RTOL)
+
+
+WALL = [[[0.0, -3.0, -3.0], [0.0, 3.0, -3.0], [0.0, 3.0, 3.0]], [[0.0, -3.0, -3.0], [0.0, 3.0, 3.0], [0.0, -3.0, 3.0]]]
+
+
+@pytest.mark.parametrize("wall", [False, True])
+def test_a_wall_between_a_probe_and_a_receiver_gives_it_zero_weight(gl, wall):
+    # Probes A at x = -0.5 (radiance 1 everywhere) and B at x = +0.5 (radiance 0); a receiver at
+    # (0.25, 0, 0) with normal +z. Its lookup point moves normal_bias x spacing = 0.25 m up: trilinear
+    # weights 0.25 (A) and 0.75 (B); the back-face terms are equal ((1 + 0) / 2)^2 + 0.2 = 0.45 (both
+    # probes lie in the receiver's tangent plane). Without a wall: indirect = 0.25 x 1 exactly. With a wall
+    # at x = 0, A sees it 0.53 m away towards the lookup point at 0.79 m: its visibility is exactly 0, and
+    # the receiver reads B alone: 0.
+    grid = ProbeGrid(np.array([-0.5, 0.0, 0.0]), 1.0, (2, 1, 1), N)
+    _, moments, state = capture(gl, grid, WALL if wall else None)
+    sh = constant_sh(gl, grid, [(1.0, 1.0, 1.0), (0.0, 0.0, 0.0)])
+    pos = gl.texture((1, 1), data=np.float32([[[0.25, 0.0, 0.0, 1.0]]]))
+    nrm = gl.texture((1, 1), data=np.float32([[[0.0, 0.0, 1.0, 0.0]]]))
+    out = gl.texture((1, 1))
+    probe_lookup.run(gl, pos, nrm, {"sh": sh, "moments": moments, "state": state}, out, grid, ProbesConfig())
+    got = gl.read(out)[0, 0, :3]
+    if wall:
+        assert np.all(got == 0.0), got
+    else:
+        np.testing.assert_allclose(got, 0.25, rtol=RTOL)
+
+
+def test_capture_sees_the_wall_at_its_distance(gl):
+    # Probe A at x = -0.5 looks along +x (face 0) at the wall x = 0: its centre texels hold positions on the
+    # wall at distance 0.5 / cos; the moments' mean over a 3 x 3 window is within the window's spread.
+    grid = ProbeGrid(np.array([-0.5, 0.0, 0.0]), 1.0, (2, 1, 1), N)
+    atlas, moments, _ = capture(gl, grid, WALL)
+    x, y = grid.face_origin(0, 0)
+    pos = gl.read(atlas["position"])[y:y + N, x:x + N]
+    assert np.all(pos[..., 3] == 1.0) and np.allclose(pos[..., 0], 0.0, atol=1e-6)
+    mean = gl.read(moments)[y + N // 2, x + N // 2, 0]
+    assert 0.5 <= mean <= 0.5 / math.cos(math.atan(1.5 * 2.0 / N * math.sqrt(2.0)))

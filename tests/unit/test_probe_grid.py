@@ -1,0 +1,107 @@
+"""The probe grid's numpy reference (addon/engine/probe_grid.py): placement, the faces' frames and
+projections, and the closed-form texel solid angles that the SH projection weighs texels by."""
+
+import math
+
+import numpy as np
+import pytest
+
+from addon.engine import sh
+from addon.engine.probe_grid import FACE_FRAMES, ProbeGrid, face_view_projection, texel_directions, texel_solid_angles
+
+
+@pytest.mark.parametrize("n", [1, 2, 7, 16, 64])
+def test_texel_solid_angles_sum_to_the_sphere(n):
+    # Six faces partition the sphere: the exact areas sum to 4 pi; float64 rounding of ~6 n^2 atan terms.
+    assert 6.0 * texel_solid_angles(n).sum() == pytest.approx(4.0 * math.pi, abs=1e-12)
+
+
+def test_one_texel_faces_are_a_sixth_of_the_sphere():
+    assert texel_solid_angles(1)[0, 0] == pytest.approx(4.0 * math.pi / 6.0, abs=1e-14)
+
+
+def test_texel_solid_angle_matches_a_fine_subdivision():
+    # The corner texel of a 4 x 4 face against 400 x 400 sub-texels of dA cos / r^2 = dA / (1 + x^2 + y^2)^1.5
+    # (midpoint rule: error ~1e-6 of the value, bound 1e-5).
+    m = 400
+    u = -1.0 + (np.arange(m) + 0.5) * (0.5 / m)
+    x, y = np.meshgrid(u, u)
+    fine = np.sum((0.5 / m) ** 2 / (1.0 + x * x + y * y) ** 1.5)
+    assert texel_solid_angles(4)[0, 0] == pytest.approx(fine, rel=1e-5)
+
+
+def test_frames_are_right_handed_and_partition_by_major_axis():
+    for face, (f, r, u) in enumerate(FACE_FRAMES):
+        assert np.allclose(np.cross(r, u), f)
+        assert np.argmax(np.abs(f)) == face // 2 and (f.sum() < 0) == (face % 2 == 1)
+    d = texel_directions(8)
+    for face in range(6):
+        axis = np.argmax(np.abs(d[face]), axis=-1)
+        assert np.all(axis == face // 2)
+
+
+def test_constant_radiance_projects_to_exact_sh():
+    # L = 1 everywhere: c_0 = Y00 * 4 pi = 2 sqrt(pi) exactly (the areas are exact), every other
+    # coefficient 0 by the cube's symmetry; float64 sums of 6 n^2 terms: 1e-12.
+    n = 16
+    dirs = texel_directions(n).reshape(-1, 3)
+    weights = np.tile(texel_solid_angles(n).ravel(), 6)
+    c = sh.project(np.ones(len(dirs)), dirs, weights, order=2)
+    assert c[0] == pytest.approx(2.0 * math.sqrt(math.pi), abs=1e-12)
+    assert np.abs(c[1:]).max() < 1e-12
+
+
+def test_projection_recovers_an_l2_function():
+    # L(w) = 1 + w.z + (3 z^2 - 1): its coefficients are exact sums of Y's; texel-centre sampling errs by
+    # O(1 / n^2): 3e-3 of the largest coefficient at n = 16 (bound 1e-2).
+    n = 16
+    dirs = texel_directions(n).reshape(-1, 3)
+    weights = np.tile(texel_solid_angles(n).ravel(), 6)
+    radiance = 1.0 + dirs[:, 2] + (3.0 * dirs[:, 2] ** 2 - 1.0)
+    c = sh.project(radiance, dirs, weights, order=2)
+    exact = np.zeros(9)
+    exact[0] = 1.0 / sh.Y00
+    exact[2] = 1.0 / sh.Y1
+    exact[6] = 1.0 / sh.Y2_ZZ
+    assert np.abs(c - exact).max() < 1e-2 * np.abs(exact).max()
+
+
+def test_face_projection_maps_each_texel_direction_to_its_ndc():
+    # A point along texel (i, j)'s direction lands at NDC (s, t) of that texel centre, depth inside [-1, 1].
+    n, center = 8, np.array([0.3, -1.0, 2.0])
+    dirs = texel_directions(n)
+    st = 2.0 * (np.arange(n) + 0.5) / n - 1.0
+    for face in range(6):
+        m = face_view_projection(center, face, 0.01, 100.0)
+        p = np.c_[center + 3.0 * dirs[face].reshape(-1, 3), np.ones(n * n)]
+        clip = p @ m.T
+        ndc = clip[:, :3] / clip[:, 3:]
+        t, s = np.meshgrid(st, st, indexing="ij")
+        assert np.allclose(ndc[:, 0], s.ravel()) and np.allclose(ndc[:, 1], t.ravel())
+        assert np.all(np.abs(ndc[:, 2]) < 1.0)
+
+
+def test_grid_fits_the_bounds_and_is_flat_for_flat_scenes():
+    cube = ProbeGrid.fit(np.zeros(3), np.full(3, 4.0), probes_per_side=8, face_texels=16)
+    assert cube.dims == (8, 8, 8) and cube.spacing_m == 0.5
+    pos = cube.positions_m()
+    assert np.allclose(pos.min(axis=0), 0.25) and np.allclose(pos.max(axis=0), 3.75)  # half a spacing inside
+    flat = ProbeGrid.fit(np.zeros(3), np.array([10.0, 5.0, 0.0]), probes_per_side=4, face_texels=16)
+    assert flat.dims == (4, 2, 1)
+    assert flat.atlas_size[0] % (3 * 16) == 0 and flat.atlas_size[1] % (2 * 16) == 0
+    # Every probe's tile lies inside the atlas and no two overlap.
+    origins = {flat.face_origin(p, 0) for p in range(flat.count)}
+    assert len(origins) == flat.count
+    w, h = flat.atlas_size
+    assert all(x + 3 * 16 <= w and y + 2 * 16 <= h for x, y in origins)
+
+
+def test_a_large_scene_gets_fewer_probes_within_the_capture_budget():
+    # 1e6 triangles on a 20 m floor: 16 a side would draw 6 x 256 x 1e6 triangles; a budget of 5e7 leaves
+    # 2 a side (4 probes: 2.4e7), the first count that fits; a small scene keeps its 16.
+    lo, hi = np.array([-10.0, -10.0, 0.0]), np.array([10.0, 10.0, 0.0])
+    big = ProbeGrid.fit(lo, hi, 16, 8, triangles=1_000_000, max_triangle_draws=5e7)
+    assert big.dims == (2, 2, 1)
+    assert ProbeGrid.fit(lo, hi, 16, 8, triangles=3, max_triangle_draws=5e7).dims == (16, 16, 1)
+    mid = ProbeGrid.fit(np.zeros(3), np.full(3, 2.0), 16, 8, triangles=10_000, max_triangle_draws=5e7)
+    assert mid.dims == (9, 9, 9) and 6 * mid.count * 10_000 <= 5e7 < 6 * 10**3 * 10_000
