@@ -68,9 +68,9 @@ METHODS: tuple[MethodSpec, ...] = (
         reads=(*_IMAGE, "gi.bounces", *_LIGHT_VIEWS, "lpv.*"),
         # The published scheme as the baseline row, the improved transport at three grids, and at 32
         # without surface offsets (each cell's blocking split half and half), on one grid (no far field)
-        # and with emitter classes; the octree (docs/LPV.md, "Octree"): the paper's (k = 4, the finest
-        # level with light, every level blocked), the index merge with our epsilon and blocked levels at
-        # k = 4, the time merge at k = 4 and at its default k = 8.
+        # and with emitter classes; the octree (docs/LPV.md, "Octree"): the paper's (5 levels, k = 4, the
+        # finest level with light, every level blocked), the index merge with our epsilon and blocked
+        # levels at the paper's levels and k, and our defaults (time merge, 4 levels, k = 12).
         bench=({"lpv.variant": "classic", "lpv.geometry_volume": True},
                {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.grid_cells": 16},
                {"lpv.variant": "improved", "lpv.geometry_volume": True},
@@ -78,10 +78,10 @@ METHODS: tuple[MethodSpec, ...] = (
                {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.far_field": False},
                {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.emitter_classes": True},
                {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.grid_cells": 64},
-               {"lpv.variant": "octree", "lpv.octree_merge": "index", "lpv.octree_iterations": 4,
-                "lpv.octree_epsilon": 1e-6, "lpv.octree_blocked_levels": 5},
-               {"lpv.variant": "octree", "lpv.octree_merge": "index", "lpv.octree_iterations": 4},
-               {"lpv.variant": "octree", "lpv.octree_iterations": 4},
+               {"lpv.variant": "octree", "lpv.octree_merge": "index", "lpv.octree_levels": 5,
+                "lpv.octree_iterations": 4, "lpv.octree_epsilon": 1e-6, "lpv.octree_blocked_levels": 5},
+               {"lpv.variant": "octree", "lpv.octree_merge": "index", "lpv.octree_levels": 5,
+                "lpv.octree_iterations": 4},
                {"lpv.variant": "octree"})),
     MethodSpec(
         name="vct", summary="voxel cone tracing through a six-direction radiance pyramid, glossy cones",

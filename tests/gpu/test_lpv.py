@@ -1154,7 +1154,8 @@ def test_octree_time_merge_injects_every_level_itself(gl):
     # (0.6 of the level's cell in front of its surface) lies inside every level's grid. fp32 sums of
     # ~1000 splats: 1e-5 relative. Levels 3 and 4 (cells of 8 and 16 grid cells) are not blocked.
     method = LpvMethod(gl, GIConfig(method="lpv"), RsmConfig(resolution=32),
-                       LpvConfig(grid_cells=16, variant="octree", octree_merge="time"))
+                       LpvConfig(grid_cells=16, variant="octree", octree_merge="time", octree_levels=5,
+                                 octree_blocked_levels=3))
     method.set_scene(corner_scene())
     method.compute()
     top = method.levels[0]

@@ -194,7 +194,7 @@ def test_time_shares_count_every_flight_time_once(k, levels):
 
 
 def test_time_merge_point_source_against_inverse_square():
-    # The time merge (k = 8, 5 levels, the default) with an isotropic 1 W source at x = 4 of a 32^3
+    # The time merge (k = 8, 5 levels) with an isotropic 1 W source at x = 4 of a 32^3
     # grid, read along +x as point_source_profile does. Measured LPV / exact at 1, 2, 3, 4, 6, 8, 12,
     # 16, 20, 24, 27 cells: 0.76 1.53 1.67 1.44 1.08 1.38 1.26 1.52 1.38 1.22 1.34 (k = 4: 0.83 1.42
     # 0.95 0.85 1.11 0.92 1.10 0.80 0.71 0.67 0.72, the flight times the levels' short ramps miss).

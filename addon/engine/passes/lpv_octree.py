@@ -1,12 +1,14 @@
 """LPV octree (`lpv --variant octree`, paper 002, Olovsson): the grid as the finest level of a mip chain
 of grids, each twice the cell of the one below, propagated level by level and merged coarse to fine.
 
-Per update (LpvMethod.propagate): the injection into level 0 (lpv_inject, unchanged) is summed into every
-coarser level (`downsample`: a coarse cell emits what its 2 x 2 x 2 children emit, lpv_far_field.source's
-shader); every level runs its steps (`steps`) of the improved transport (lpv_propagate) through its own
-geometry volume (built once per voxelization: the level below's projected areas summed / 4 and offsets
-averaged, lpv_far_field.voxels, then lpv_propagate.blocking); then `merge` folds the levels from the
-coarsest down into level 0's accumulation, which the ordinary lookup reads. A level of cell 2^i h
+Per update (LpvMethod.fill_octree, LpvMethod.propagate): every coarser level gets its source, either its
+own injection of the VPLs (lpv_inject into its own atlas, `injects`) or level 0's source summed down the
+chain (`downsample`: a coarse cell emits what its 2 x 2 x 2 children emit, lpv_far_field.source's
+shader; the paper's way, and every later bounce's); every level runs its steps (`steps`) of the improved
+transport (lpv_propagate), the finest LpvConfig.octree_blocked_levels through their own geometry volume
+(built once per voxelization: the level below's projected areas summed / 4 and offsets averaged,
+lpv_far_field.voxels, then lpv_propagate.blocking); then `merge` folds the levels from the coarsest down
+into level 0's accumulation, which the ordinary lookup reads. A level of cell 2^i h
 carries light 2^i cells per step, so k steps reach k 2^i cells: the finest levels resolve the light
 near its sources, the coarsest carry it across the scene.
 
@@ -21,9 +23,9 @@ Two merges (LpvConfig.octree_merge):
   2^i, and it is accumulated with `time_share` = g_i(t) - g_{i-1}(t), g_i the far field's fine share
   with K_i = k 2^i near steps (1 up to K_i / 2, 0 from K_i; g_{-1} = 0, the coarsest level's g = 1).
   The shares telescope: at every time the levels count the light once in sum, and the merge adds them
-  (M_i = A_i + U). Light that a coarse cell straddling a wall lets through early is not counted: a
-  coarse level only counts flights longer than k 2^(i-2) fine steps, by which time the finer levels
-  have carried the near light around the wall.
+  (M_i = A_i + U). A coarse level counts only flights longer than k 2^(i-2) fine steps, so the light
+  a coarse cell straddling a wall lets through in its first steps is not counted; what it lets through
+  later is (thin-wall, docs/LPV.md "Octree").
 
 Inputs / outputs of `merge`: the merged coarser accumulation (keys acc_r/g/b; RGBA32F 3D, L1 SH, W/sr x
 cells, as lpv_propagate accumulates) -> the finer accumulation `acc_r/g/b` (read-write, every cell).
