@@ -1,6 +1,7 @@
 """The `diffusion` transport's measured limits on its numpy twin (addon/engine/diffusion_reference.py):
 the figures docs/DIFFUSION.md quotes, reproducible without a GPU.
 
+For each transfer (cone, the paper's; directional):
 1. A closed cube of N cells (one-cell walls, black: each bounce alone) whose floor has a lit patch of
    10 x 10 cells in its middle: the share of the patch's light absorbed after Y, 2Y, 4Y steps (Y = N),
    and where it lands: on the floor itself (exact 0: a plane cannot light itself) and on the ceiling
@@ -8,7 +9,7 @@ the figures docs/DIFFUSION.md quotes, reproducible without a GPU.
 2. An isotropic point source in an empty grid: r^2 x the irradiance on the +x axis at 2..12 cells
    (exact: 1 / (4 pi) at every r).
 
-Run: .venv/bin/python tools/diffusion_box.py [--cells 32]  (about 10 s at 32 cells)
+Run: .venv/bin/python tools/diffusion_box.py [--cells 32]  (both transfers; about a minute at 32 cells)
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ def closed_box(n: int) -> dict:
     return ref.cells(occ, normal, proj)
 
 
-def box_figures(n: int) -> None:
+def box_figures(n: int, transfer: str) -> None:
     cell = closed_box(n)
     lit = np.zeros((n, n, n))
     mid = n // 2
@@ -49,11 +50,12 @@ def box_figures(n: int) -> None:
     field = ref.emit(lit, np.zeros_like(lit), cell["normal"], cell["occupied"])
     total = ref.flux_w(field)
     absorbed = np.zeros_like(lit)
-    print(f"closed box of {n} cells, 10 x 10 lit floor patch (exact: floor 0, ceiling ~0.23 at 32 cells)")
+    print(f"{transfer}: closed box of {n} cells, 10 x 10 lit floor patch (exact: floor 0, ceiling ~0.23 at 32 "
+          "cells)")
     print("steps  absorbed  floor  ceiling  walls")
     done = 0
     for steps in (n, 2 * n, 4 * n):
-        field, plus, minus = ref.propagate(field, cell, steps - done)
+        field, plus, minus = ref.propagate(field, cell, steps - done, transfer)
         done = steps
         absorbed += plus + minus
         floor = absorbed[1, 2:-2, 2:-2].sum() / total
@@ -62,7 +64,7 @@ def box_figures(n: int) -> None:
         print(f"{steps:5d}  {share:8.3f}  {floor:5.3f}  {ceiling:7.3f}  {share - floor - ceiling:5.3f}")
 
 
-def point_source_figures(steps: int = 120, size: int = 41) -> None:
+def point_source_figures(transfer: str, steps: int = 120, size: int = 41) -> None:
     dims = (size, size, size)
     c = size // 2
     cell = ref.cells(np.zeros(dims, bool), np.zeros((*dims, 3)), np.zeros((*dims, 3)))
@@ -70,10 +72,10 @@ def point_source_figures(steps: int = 120, size: int = 41) -> None:
     field[c, c, c, 0] = 1.0 / ref.FLUX_PER_C0
     through = np.zeros(size)
     for _ in range(steps):
-        through += ref.inflow(ref.face_fluxes(field, cell["open"]))[c, c, :, 0]
-        field, _, _ = ref.step(field, cell)
+        through += ref.inflow(ref.face_fluxes(field, cell["open"], transfer))[c, c, :, 0]
+        field, _, _ = ref.step(field, cell, transfer)
     r = np.arange(2, 13)
-    print(f"point source, {steps} steps on {size}^3 cells: 4 pi r^2 E(r) on the axis (exact 1)")
+    print(f"{transfer}: point source, {steps} steps on {size}^3 cells: 4 pi r^2 E(r) on the axis (exact 1)")
     print("  ".join(f"r={k}: {v:.2f}" for k, v in zip(r, 4 * np.pi * r**2 * through[c + r], strict=True)))
 
 
@@ -81,8 +83,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cells", type=int, default=32)
     args = parser.parse_args()
-    box_figures(args.cells)
-    point_source_figures()
+    for transfer in ref.TRANSFERS:
+        box_figures(args.cells, transfer)
+        point_source_figures(transfer)
 
 
 if __name__ == "__main__":

@@ -101,27 +101,27 @@ VCT_KNOWN_DEFECTS = {
                                                       "partial opacity",
 }
 
-# Known defects of `diffusion` (defaults: 32 cells, 2 x the longest side steps per bounce), measured on
-# llvmpipe, 48 px (docs/DIFFUSION.md, "Known limits"). The face-cone transfer forgets where light came
-# from, so light leaving a surface diffuses back onto it, and a closed shape smaller than two cells has
-# no empty inside for its inner faces' light.
+# Known defects of `diffusion` (defaults: directional transfer, 32 cells, 2 x the longest side steps per
+# bounce), measured on llvmpipe, 48 px (docs/DIFFUSION.md, "Measured limits"); the paper's cone transfer
+# in brackets. Light scatters at every cell, so what leaves a plane partly diffuses back onto it, and a
+# closed shape smaller than two cells has no empty inside for its inner faces' light.
 DIFFUSION = "diffusion: "
 DIFFUSION_KNOWN_DEFECTS = {
-    "test_one_triangle[diffusion]": "indirect 0.44 where the exact answer is 0: the lit plane's light diffuses "
-                                    "back onto it",
-    "test_km_terrain_under_sun[diffusion]": "indirect 0.073 of direct on a flat terrain that cannot light itself "
-                                            "(its own light diffused back)",
-    "test_million_triangle_floor[diffusion]": "indirect up to 0.10 on a lone floor that cannot light itself "
-                                              "(its own light diffused back)",
-    "test_two_hundred_lights[diffusion]": "indirect 0.055 on a lone plane that cannot receive a bounce (its own "
-                                          "light diffused back)",
-    "test_white_closed_box_conserves_flux[diffusion]": "indirect flux 0.87 P in a closed white box (exact P, bound "
-                                                       "0.9..1.02): the light still in flight after each bounce's "
-                                                       "steps is lost",
-    "test_light_inside_closed_box_stays_inside[diffusion]": "indirect 0.45 x P/(6 pi) outside a closed box (exact "
+    "test_one_triangle[diffusion]": "indirect 0.15 where the exact answer is 0: the lit plane's light diffuses "
+                                    "back onto it (cone 0.44)",
+    "test_km_terrain_under_sun[diffusion]": "indirect 0.026 of direct on a flat terrain that cannot light itself "
+                                            "(its own light diffused back; cone 0.073)",
+    "test_million_triangle_floor[diffusion]": "indirect up to 0.023 on a lone floor that cannot light itself "
+                                              "(its own light diffused back; cone 0.10)",
+    "test_two_hundred_lights[diffusion]": "indirect 0.019 on a lone plane that cannot receive a bounce (its own "
+                                          "light diffused back; cone 0.055)",
+    "test_white_closed_box_conserves_flux[diffusion]": "indirect flux 0.896 P in a closed white box (exact P, "
+                                                       "bound 0.9..1.02): the light still in flight after each "
+                                                       "bounce's steps is lost (cone 0.87)",
+    "test_light_inside_closed_box_stays_inside[diffusion]": "indirect 0.36 x P/(6 pi) outside a closed box (exact "
                                                             "0): the 1 m box spans 3 cells, none of them empty, so "
                                                             "its inner faces' light leaves by the cells' outer "
-                                                            "faces",
+                                                            "faces (cone 0.45)",
 }
 
 
