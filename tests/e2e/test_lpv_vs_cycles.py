@@ -164,3 +164,35 @@ def test_surface_offsets_on_thin_wall(tmp_path):
     classes = errors["emitter classes"]
     assert classes["rel_rmse_8"] <= 0.13 and 0.9 <= classes["bias"] <= 1.1
     assert classes["rel_rmse_8"] < 0.6 * default["rel_rmse_8"]
+
+
+def test_lpv_octree_on_cornell(tmp_path):
+    """The octree variant (docs/LPV.md, "Octree") against Cycles on the Cornell box, 64 px, one bounce:
+    the paper's settings (5 levels, k = 4, the finest level with non-zero light, every level blocked), the
+    index merge at the paper's k with eps 0.5 and three blocked levels (the issue's target: rel_rmse_8
+    <= 0.40, bias 0.8..1.25 at k = 4), and the defaults (time merge, 4 levels, k = 12)."""
+    from addon.engine import metrics
+    from addon.engine.config import LpvConfig
+
+    blend, ref, mask = scene_and_reference(tmp_path, "cornell", bounces=1)
+    errors = {}
+    for name, cfg in {
+        "paper": LpvConfig(variant="octree", octree_merge="index", octree_levels=5, octree_iterations=4,
+                           octree_epsilon=1e-6, octree_blocked_levels=5),
+        "index": LpvConfig(variant="octree", octree_merge="index", octree_levels=5, octree_iterations=4),
+        "default": LpvConfig(variant="octree"),
+        "far field": LpvConfig(variant="improved", geometry_volume=True),
+    }.items():
+        ours, timings = render_lpv(blend, cfg)
+        errors[name] = metrics.compare(ours, ref, mask)
+        print(f"lpv octree {name} vs Cycles: {errors[name]}, propagate {timings['lpv_propagate']:.0f} ms")
+    paper, index, default = errors["paper"], errors["index"], errors["default"]
+    # Measured at 64 px (llvmpipe), rel_rmse_8 / bias: paper 0.942 / 0.205, index 0.342 / 0.899, default
+    # 0.290 / 0.800, far field (lpv's default) 0.326 / 0.928. Bounds: each figure plus llvmpipe's
+    # run-to-run spread (below 0.005) and a margin. The paper's rule is banded as measured, as dark as its
+    # frontier light winning the level switch makes it (a change either way shows); the default must stay
+    # below the far field's error on this scene, the one where it is better (docs/LPV.md, "Octree").
+    assert 0.8 <= paper["rel_rmse_8"] <= 1.2 and 0.1 <= paper["bias"] <= 0.4
+    assert index["rel_rmse_8"] <= 0.36 and 0.8 <= index["bias"] <= 1.25
+    assert default["rel_rmse_8"] <= 0.31 and 0.75 <= default["bias"] <= 1.25
+    assert default["rel_rmse_8"] < 0.95 * errors["far field"]["rel_rmse_8"]
