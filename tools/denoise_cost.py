@@ -4,7 +4,7 @@ vct's per-pixel noise.
     .venv/bin/python tools/denoise_cost.py out/cornell.blend --res 128 512 [--iterations 2 3]
         [--references DIR]
 
-Per resolution: the median wall time (GPU work finished) of a full vct update (`pipeline.update_costs`,
+Per resolution: the median wall time (GPU work finished) of a vct update (`updates.update_costs`' lights update,
 as `render --profile-updates` reports it: no read-back, no per-pass waits) and, per iteration count, of
 the filter run on that update's `indirect`, and their ratio (the target is <= 20 %). With --references,
 DIR/<res>/indirect.exr (`python -m addon reference BLEND --res <res> --out DIR/<res>`) is the Cycles
@@ -26,6 +26,7 @@ sys.path.insert(0, str(ROOT))
 
 from addon.engine import metrics  # noqa: E402
 from addon.engine.passes import denoise  # noqa: E402
+from addon.engine.updates import update_costs  # noqa: E402
 
 
 def filter_ms(method, out, scratch, params: denoise.Params, repeat: int) -> float:
@@ -64,7 +65,7 @@ def measure(blend: Path, res: int, iterations: list[int], repeat: int, reference
     method = methods.create(be, settings(gi=GIConfig(method="vct", resolution=res)))
     method.set_scene(scene)
     before = method.run().images["indirect"]  # also the warm-up
-    update_ms = pipeline.update_costs(method, repeat)["full"]
+    update_ms = update_costs(method, repeat)["lights"]  # the solve and the gathers: an update with no upload
     out, scratch = be.texture((width, height)), be.texture((width, height))
     reference = images.read_exr(references / str(res) / "indirect.exr") if references is not None else None
     row = {"res": res, "vct_update_ms": update_ms}

@@ -8,8 +8,10 @@ Two steps, because the GPU machine has no Blender:
     # anywhere with moderngl and an EGL OpenGL 4.3 context (the GPU machine; llvmpipe for a smoke test)
     python3 tools/gpu_timing.py run --scenes .gpubench --out DIR [--res 1920x1080] [--repeat 20]
 
-`run` times each (scene, method config) three ways after `set_scene` and 3 warm-up updates:
+`run` times each (scene, method config: every registry benchmark row and EXTRA_ROWS) after `set_scene`
+and 3 warm-up updates:
   wall_total   compute() with method.profile off, then one backend.finish(): what an update costs
+  update_ms    updates.update_costs: a geometry change, every light moved 1 cm, the camera moved 1 cm
   gpu_*        GL timestamp queries (glQueryCounter) around every pass, no waits between passes
   wall_pass_*  method.profile on: glFinish before and after every pass (stalls; per-pass upper bound)
   voxelize     a full re-voxelization (every layer redrawn: Voxelizer.invalidate, then run), GPU and wall
@@ -47,6 +49,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
+
+from addon.engine.updates import update_costs  # noqa: E402
 
 SCENES = ("cornell", "cornell-glossy", "sponza")
 SPONZA = Path("/work/shared/scenes/sponza/sponza.blend")
@@ -233,48 +237,38 @@ class GpuTimestamps:
 
 # --------------------------------------------------------------------------------------- runs
 
-def configs():
-    """(label, GIConfig kwargs, RsmConfig kwargs, LpvConfig kwargs, VctConfig kwargs)."""
-    return [
-        ("direct", {"method": "direct"}, {}, {}, {}),
-        ("rsm-256vpl", {"method": "rsm"}, {"vpl_samples": 256}, {}, {}),
-        ("rsm-256vpl-voxelvis64", {"method": "rsm"}, {"vpl_samples": 256, "visibility": "voxel",
-                                                       "voxel_cells": 64}, {}, {}),
-        ("lpv-improved-gv-32", {"method": "lpv"}, {}, {"grid_cells": 32, "variant": "improved",
-                                                      "geometry_volume": True}, {}),
-        ("lpv-improved-gv-64", {"method": "lpv"}, {}, {"grid_cells": 64, "variant": "improved",
-                                                      "geometry_volume": True}, {}),
-        # The defaults above run the far field (session 6); these are one grid, as timed in session 4.
-        ("lpv-improved-gv-32-one-grid", {"method": "lpv"}, {}, {"grid_cells": 32, "variant": "improved",
-                                                               "geometry_volume": True, "far_field": False}, {}),
-        ("lpv-improved-gv-64-one-grid", {"method": "lpv"}, {}, {"grid_cells": 64, "variant": "improved",
-                                                               "geometry_volume": True, "far_field": False}, {}),
-        # Emitter classes (session 7, off by default): six propagations; docs/LPV.md estimates ~2.7 ms.
-        ("lpv-improved-gv-32-classes", {"method": "lpv"}, {}, {"grid_cells": 32, "variant": "improved",
-                                                              "geometry_volume": True, "emitter_classes": True}, {}),
-        ("lpv-classic-32", {"method": "lpv"}, {}, {"grid_cells": 32, "variant": "classic"}, {}),
-        ("lpv-improved-gv-32-3cascades", {"method": "lpv"}, {}, {"grid_cells": 32, "variant": "improved",
-                                                                "geometry_volume": True, "cascades": 3}, {}),
-        ("vct-64", {"method": "vct"}, {}, {}, {"voxel_cells": 64}),
-        ("vct-64-6cones", {"method": "vct"}, {}, {}, {"voxel_cells": 64, "diffuse_cones": 6}),
-        ("vct-64-6cones-half", {"method": "vct"}, {}, {}, {"voxel_cells": 64, "diffuse_cones": 6,
-                                                           "gather_scale": 2}),
-        ("vct-64-6cones-quarter", {"method": "vct"}, {}, {}, {"voxel_cells": 64, "diffuse_cones": 6,
-                                                              "gather_scale": 4}),
-        ("vct-64-4specular", {"method": "vct"}, {}, {}, {"voxel_cells": 64, "specular_cones": 4}),
-        ("vct-128", {"method": "vct"}, {}, {}, {"voxel_cells": 128}),
-        ("vct-128-6cones", {"method": "vct"}, {}, {}, {"voxel_cells": 128, "diffuse_cones": 6}),
-        ("vct-128-6cones-half", {"method": "vct"}, {}, {}, {"voxel_cells": 128, "diffuse_cones": 6,
-                                                             "gather_scale": 2}),
-        ("vct-64-2bounces", {"method": "vct", "bounces": 2}, {}, {}, {"voxel_cells": 64}),
-    ]
+# GPU-only rows beside the registry's benchmark rows: vct's real-time settings (few cones, a coarser
+# gather), which the CPU benchmark does not run for their error but a GPU is timed on.
+EXTRA_ROWS = {
+    "vct": ({"vct.voxel_cells": 64, "vct.diffuse_cones": 6}, {"vct.voxel_cells": 64, "vct.diffuse_cones": 6,
+                                                              "vct.gather_scale": 2},
+            {"vct.voxel_cells": 128, "vct.diffuse_cones": 6, "vct.gather_scale": 2}),
+}
 
 
-def make_method(be, gi_kw: dict, rsm_kw: dict, lpv_kw: dict, vct_kw: dict, resolution: int):
-    from addon.engine import config, methods
+def row_label(method: str, row: dict) -> str:
+    """'lpv-grid_cells64-far_fieldFalse': the method and its row's settings, as a file-safe name."""
+    return "-".join([method, *(f"{k.split('.', 1)[1]}{v}" for k, v in row.items())])
 
-    return methods.create(be, {"gi": config.GIConfig(resolution=resolution, **gi_kw), "rsm": config.RsmConfig(**rsm_kw),
-                               "lpv": config.LpvConfig(**lpv_kw), "vct": config.VctConfig(**vct_kw)})
+
+def configs(resolution: int = 1080) -> list[tuple[str, dict]]:
+    """(label, {group: config}) of every method at every benchmark row of the registry (each method's
+    defaults included) and EXTRA_ROWS: the same list of methods as everything else."""
+    from addon.engine import choice, config, registry
+
+    out = []
+    for spec in registry.METHODS:
+        rows = [{}, *(r for r in spec.bench if r), *EXTRA_ROWS.get(spec.name, ())]
+        for row in rows:
+            base = config.settings(gi=config.GIConfig(method=spec.name, resolution=resolution))
+            out.append((row_label(spec.name, row), choice.apply_row(base, spec.name, row)))
+    return list(dict(out).items())  # a row equal to the defaults appears once
+
+
+def make_method(be, settings: dict):
+    from addon.engine import methods
+
+    return methods.create(be, settings)
 
 
 def summary(values: list[float]) -> dict:
@@ -315,6 +309,8 @@ def time_method(be, method, scene, warmup: int, repeat: int, stamps: GpuTimestam
         be.finish()
         totals.append((time.perf_counter() - t0) * 1e3)
     res["wall_total"] = summary(totals)
+    # the three kinds of update a user makes (a geometry change, lights moved, camera moved), medians
+    res["update_ms"] = update_costs(method, repeat)
 
     # 2. GPU timestamps per pass (no waits between passes)
     if stamps.available:
@@ -456,14 +452,14 @@ def run(scenes_dir: Path, out: Path, size: tuple[int, int], repeat: int, warmup:
         scene = load_scene(stem, size)
         entry = {"triangles": scene.triangle_count, "lights": [light.kind for light in scene.lights], "configs": {}}
         report["scenes"][stem.name] = entry
-        for label, gi_kw, rsm_kw, lpv_kw, vct_kw in configs():
+        for label, settings in configs(max(size)):
             if only_configs and label not in only_configs:
                 continue
             t0 = time.perf_counter()
             try:
-                method = make_method(be, gi_kw, rsm_kw, lpv_kw, vct_kw, max(size))
+                method = make_method(be, settings)
                 result = time_method(be, method, scene, warmup, repeat, stamps)
-                result["config"] = {"gi": gi_kw, "rsm": rsm_kw, "lpv": lpv_kw, "vct": vct_kw}
+                result["config"] = {group: cfg.to_dict() for group, cfg in settings.items()}
                 grid = getattr(method, "grid", None)
                 if grid is not None:
                     result["grid_dims"] = list(grid.dims)
@@ -521,6 +517,15 @@ def markdown(report: dict) -> str:
                 target = (f"voxelize+inject+pyramid {both:.3f}; gather {_fmt(gpu.get('vct_gather'))}")
             lines.append(f"| {scene} | {label} | {grid} | {r['set_scene_ms']:.1f} | {_fmt(r['wall_total'])} | "
                          f"{_fmt(gpu.get('total'))} | {target} | {_fmt(vox)} |")
+    lines += ["", "## The three updates (wall ms, medians: a geometry change / every light moved 1 cm / the camera "
+              "moved 1 cm; camera as a share of the geometry change)", "",
+              "| scene | config | full | lights | camera | camera / full |", "| --- | --- | --- | --- | --- | --- |"]
+    for scene, entry in report["scenes"].items():
+        for label, r in entry["configs"].items():
+            u = r.get("update_ms")
+            if u:
+                lines.append(f"| {scene} | {label} | {u['full']:.2f} | {u['lights']:.2f} | {u['camera']:.2f} | "
+                             f"{100 * u['camera'] / u['full']:.0f} % |")
     lines += ["", "## Passes of many dispatches, fed (fed_gpu_ms): GPU work | Python submission | GPU work queued "
               "ahead (ms, medians; the first is the pass's GPU work alone where the third exceeds the second)", ""]
     for scene, entry in report["scenes"].items():

@@ -8,7 +8,7 @@ alpha) and convert its rel_rmse_8 into a Cycles-equivalent speed-up along the cu
 product, and into a second one along the curve of Cycles + Open Image Denoise (every render of Cycles'
 curve denoised, anchors.py). With `--anchors ...,eevee` each scene also gets one EEVEE render at its best
 GI setting, and each row our time against EEVEE's where our error is as low or lower. Each row also
-times the three kinds of update (`pipeline.update_costs`: everything, lights moved, camera moved).
+times the three kinds of update (`updates.update_costs`: a geometry change, lights moved, camera moved).
 Writes a Markdown report, one log-log plot per scene and `results.json` (one record per scene x method x
 setting, `results_json`), the report and the JSON from the same result.
 
@@ -395,7 +395,7 @@ class Options:
     res: int = 128
     ref_spp: int | None = None  # None: REF_SPP, or QUICK_REF_SPP with quick
     bounces: int = 1
-    update_costs: bool = True  # time full / lights / camera updates per row (pipeline.update_costs)
+    update_costs: bool = True  # time full / lights / camera updates per row (updates.update_costs)
     row_filter: str = "all"  # ROW_FILTERS: which registry rows of each method run
     anchors: tuple[str, ...] = DEFAULT_ANCHORS  # anchors.ANCHORS measured besides raw Cycles
     out: Path = Path("benchmarks")

@@ -8,18 +8,16 @@ from __future__ import annotations
 
 import json
 import statistics
-import time
 from collections.abc import Callable
-from dataclasses import replace
 from pathlib import Path
 
 import bpy
-import numpy as np
 
 from ..engine import choice, methods, metrics, registry
 from ..engine.backends.moderngl_backend import ModernGLBackend
 from ..engine.config import settings as complete_settings
 from ..engine.errors import SceneError
+from ..engine.updates import update_costs
 from . import images
 from .capture import SceneCache, define_light_switch, image_size
 
@@ -39,52 +37,6 @@ def open_blend(path: Path) -> None:
         bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
     except RuntimeError as exc:
         raise SceneError(f"cannot open {path}: {str(exc).strip().splitlines()[-1]}") from None
-
-
-UPDATE_STEP_M = 0.01  # how far update_costs moves the lights or the camera per update
-
-
-def update_costs(method, repeat: int) -> dict[str, float]:
-    """Median wall time in ms (GPU work finished, no read-back) of the three kinds of update a user
-    makes, each right after its change, alternately moving by UPDATE_STEP_M and back:
-    - full: a geometry change, everything: the upload and the setup passes (set_scene: voxelization,
-      blocking volumes), the G-buffer, the light views, the solve, the gathers;
-    - lights: every light moved UPDATE_STEP_M along z: the light views, the solve and the gathers
-      (the G-buffer is still valid);
-    - camera: the camera moved UPDATE_STEP_M along its right axis: the G-buffer and the gathers
-      (the solve too where the method cannot keep its light field: `keeps_light_field`).
-    Per-pass waits are off, as in the viewport; the method is left as it was found."""
-    be, source, profile = method.backend, method.source, method.profile
-    lights, camera = list(source.lights), source.camera
-    moved_lights = [replace(light, position_m=light.position_m + np.array([0.0, 0.0, UPDATE_STEP_M]))
-                    for light in lights]
-    view = camera.view.copy()
-    view[0, 3] -= UPDATE_STEP_M  # x in camera space: its right axis
-    moved_camera = replace(camera, view=view)
-
-    def timed(update) -> float:
-        be.finish()
-        t0 = time.perf_counter()
-        update()
-        be.finish()
-        return (time.perf_counter() - t0) * 1e3
-
-    method.profile = False
-    samples = {"full": [], "lights": [], "camera": []}
-    try:
-        for i in range(repeat):
-            away = i % 2 == 0
-            samples["full"].append(timed(lambda: (method.set_scene(method.source), method.compute())))
-            method.set_lights(moved_lights if away else lights)
-            samples["lights"].append(timed(lambda: method.compute(run_gbuffer=False)))
-            method.set_camera(moved_camera if away else camera)
-            samples["camera"].append(timed(method.compute))
-        method.set_lights(lights)
-        method.set_camera(camera)
-        method.compute()  # the products of the state the caller set
-    finally:
-        method.profile = profile
-    return {kind: statistics.median(ms) for kind, ms in samples.items()}
 
 
 def run_self_check(be, captured, settings: dict, decided: dict, written: dict) -> dict:

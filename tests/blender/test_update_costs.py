@@ -1,4 +1,4 @@
-"""pipeline.update_costs: what each of the three kinds of update re-runs (render --profile-updates)."""
+"""engine.updates.update_costs: what each of the three kinds of update re-runs (render --profile-updates)."""
 
 import pytest
 
@@ -12,9 +12,9 @@ def test_full_is_a_geometry_change_lights_and_camera_are_not(gl):
     # gathers. Counted: set_scene once per full update only, a solve per full and per lights update.
     from addon.bridge import scenes
     from addon.bridge.capture import SceneCache
-    from addon.bridge.pipeline import update_costs
     from addon.engine import methods
     from addon.engine.config import GIConfig, LpvConfig, RsmConfig
+    from addon.engine.updates import update_costs
 
     scenes.build("cornell")
     scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 24, 24)

@@ -59,3 +59,20 @@ def test_per_pass_sums_the_lpv_target_passes():
     assert out["lpv_inject+propagate+lookup"]["median"] == 3.0
     assert out["total"]["median"] == 4.0 and out["total"]["n"] == 2
     assert "vct_inject+pyramid" not in out
+
+
+def test_configs_are_every_registry_row_and_the_gpu_extras():
+    # Every method of the registry at its defaults and at each benchmark row, labels unique; each
+    # settings dict builds the method it names (the same list of methods as everything else).
+    from addon.engine import registry
+
+    rows = gpu_timing.configs(360)
+    labels = [label for label, _ in rows]
+    assert len(labels) == len(set(labels))
+    for spec in registry.METHODS:
+        assert spec.name in labels  # the defaults
+        for row in spec.bench:
+            assert gpu_timing.row_label(spec.name, row) in labels
+    for label, settings in rows:
+        assert label.split("-")[0] == settings["gi"].method and settings["gi"].resolution == 360
+    assert "vct-voxel_cells64-diffuse_cones6-gather_scale2" in labels
