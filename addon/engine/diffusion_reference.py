@@ -61,6 +61,10 @@ def cells(occupied: np.ndarray, vox_normal: np.ndarray, vox_projected: np.ndarra
     - `open` (6, bool): the faces light may leave through: every face of an empty cell, and of an
       occupied one those to empty cells or out of the grid (a surface's light goes into open space: two
       coplanar cells of a floor do not light each other);
+    - `receives` (2, bool): whether light can reach the plus / minus side at all: some face on that side
+      (d . n > 0 for plus, < 0 for minus) leads to an empty cell in the grid; the cell where a floor
+      meets a wall touches no empty cell on its room side, so nothing arrives there and the lookup
+      must not read its 0 as the light of that side;
     - `area` (cells^2): each side's receiving area, sum over axes of block x (1 where the normal has a
       component along the axis, else 1/2): the flux a uniform radiance L puts on a side is pi L x area
       x h^2, so the lookup's flux / area is exact in a uniform field whatever the cell holds.
@@ -81,7 +85,19 @@ def cells(occupied: np.ndarray, vox_normal: np.ndarray, vox_projected: np.ndarra
         zyx = 2 - axis
         shift[zyx] = slice(1 + int(sign), padded.shape[zyx] - 1 + int(sign))
         open_faces[..., f] = ~occ | ~padded[tuple(shift)]
-    return {"normal": normal, "block": block, "open": open_faces, "area": area, "occupied": occ}
+    inside = np.pad(np.ones(occ.shape, bool), 1)
+    receives = np.zeros((*occ.shape, 2), bool)
+    for axis, sign in AXES:
+        shift = [slice(1, -1)] * 3
+        zyx = 2 - axis
+        shift[zyx] = slice(1 + int(sign), padded.shape[zyx] - 1 + int(sign))
+        source = inside[tuple(shift)] & ~padded[tuple(shift)]  # an empty cell in the grid
+        dn = normal[..., axis] * sign
+        receives[..., 0] |= source & (dn > SIDE_EPSILON)
+        receives[..., 1] |= source & (dn < -SIDE_EPSILON)
+    receives &= occ[..., None]
+    return {"normal": normal, "block": block, "open": open_faces, "area": area, "occupied": occ,
+            "receives": receives}
 
 
 # -- emitters ------------------------------------------------------------------------------------------
@@ -224,8 +240,9 @@ def lookup(points_cells: np.ndarray, normals: np.ndarray, cell: dict, flux_plus:
     normals (n, 3). Over the 8 cells whose centres surround the point, each occupied one (in the grid)
     gives the irradiance of its side facing n, flux / (area x h^2), weighted by its trilinear weight
     times |n . n_cell| (the surface it holds faces the point's way: a wall's cell does not light the
-    floor beside it) and renormalised; where those weights are all 0 but a neighbour is occupied the
-    trilinear weights alone; where none is, 0 (no surface near: no light known)."""
+    floor beside it) and renormalised, over the cells whose side facing n can receive light at all
+    (`receives`); where those weights are all 0 but such a neighbour exists the trilinear weights alone;
+    where none does, 0 (no surface near: no light known)."""
     p = np.asarray(points_cells, np.float64) - 0.5
     base = np.floor(p).astype(int)
     frac = p - base
@@ -241,9 +258,9 @@ def lookup(points_cells: np.ndarray, normals: np.ndarray, cell: dict, flux_plus:
         inside = np.all((c >= 0) & (c < dims_zyx[::-1]), axis=1)
         cz = np.clip(c, 0, dims_zyx[::-1] - 1)
         idx = (cz[:, 2], cz[:, 1], cz[:, 0])
-        occ = inside & cell["occupied"][idx]
         n_c = cell["normal"][idx]
         dn = np.sum(normals * n_c, axis=1)
+        occ = inside & cell["occupied"][idx] & cell["receives"][idx][np.arange(len(p)), np.where(dn >= 0.0, 0, 1)]
         area = np.maximum(cell["area"][idx], 1e-6) * cell_area_m2
         e = np.where(dn >= 0.0, flux_plus[idx], flux_minus[idx]) / area
         w = np.where(occ, t * np.abs(dn), 0.0)

@@ -1,7 +1,7 @@
 // The diffusion transport's cells and face cones (addon/engine/diffusion_reference.py is the twin).
 // Faces f = 0..5 are +x -x +y -y +z -z. cell_block (diffusion/cells.comp.glsl): xyz = per axis the share
 // of a face's inflow the cell's surface absorbs, w = 0 for an empty cell, else 1 + the mask of the faces
-// light may leave it by (bit f).
+// light may leave it by (bit f) and of the sides light can reach (bit 6 plus, 7 minus).
 
 const float DIFFUSION_FLUX_PER_C0 = 3.54490770;   // 2 sqrt(pi): W per unit of c0
 const float DIFFUSION_TRANSFER_NORM = 0.47746483; // 3 / (2 pi): 1 / a face cone's solid angle
@@ -27,6 +27,14 @@ bool diffusion_occupied(vec4 block) {
 
 bool diffusion_face_open(vec4 block, int f) {
     return block.w <= 0.0 || ((int(block.w) - 1) >> f & 1) != 0;
+}
+
+const int DIFFUSION_RECEIVES_PLUS = 64;
+const int DIFFUSION_RECEIVES_MINUS = 128;
+
+// Whether light can reach the plus (or minus) side of an occupied cell's plane at all.
+bool diffusion_receives(vec4 block, bool plus) {
+    return ((int(block.w) - 1) & (plus ? DIFFUSION_RECEIVES_PLUS : DIFFUSION_RECEIVES_MINUS)) != 0;
 }
 
 bool diffusion_inside(ivec3 c) {

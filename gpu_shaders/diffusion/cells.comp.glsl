@@ -3,7 +3,8 @@
 // wall in one cell -- the axis the surfaces project the most along; w = each side's receiving area,
 // sum over axes of block x (1 where the normal has a component along it, else 1/2), cells^2) and
 // cell_block (xyz = per axis min(1, projected area), the share of a face's inflow absorbed; w = 0 empty,
-// else 1 + the mask of open faces: those to empty cells or out of the grid).
+// else 1 + the mask of open faces, those to empty cells or out of the grid (bits 0-5), and of the sides
+// light can reach at all, those with a face to an empty cell in the grid (bit 6 plus, 7 minus).
 #include "diffusion/cell.glsl"
 
 void main() {
@@ -25,9 +26,16 @@ void main() {
     vec3 share = mix(vec3(0.5), vec3(1.0), greaterThan(abs(n), vec3(DIFFUSION_SIDE_EPSILON)));
     int mask = 0;
     for (int f = 0; f < 6; f++) {
-        ivec3 nb = c + ivec3(diffusion_direction(f));
-        if (!diffusion_inside(nb) || texelFetch(vox_albedo, nb, 0).a <= 0.0) {
+        vec3 d = diffusion_direction(f);
+        ivec3 nb = c + ivec3(d);
+        bool inside = diffusion_inside(nb);
+        if (!inside || texelFetch(vox_albedo, nb, 0).a <= 0.0) {
             mask |= 1 << f;
+            if (inside) {  // an empty cell in the grid: light can arrive from it on its side
+                float dn = dot(d, n);
+                mask |= dn > DIFFUSION_SIDE_EPSILON ? DIFFUSION_RECEIVES_PLUS
+                      : (dn < -DIFFUSION_SIDE_EPSILON ? DIFFUSION_RECEIVES_MINUS : 0);
+            }
         }
     }
     imageStore(cell_normal, c, vec4(n, dot(block, share)));

@@ -1,5 +1,6 @@
 // Diffusion reconstruction (diffusion_reference.lookup): at each G-buffer point, over the 8 cells whose
-// centres surround it, every occupied one gives the irradiance of its side facing the normal, flux /
+// centres surround it, every occupied one whose side facing the normal light can reach (cell.glsl's
+// diffusion_receives) gives the irradiance of that side, flux /
 // (area x h^2), weighted by its trilinear weight x |n . n_cell| and renormalised; with those weights all 0
 // the trilinear weights of the occupied cells alone; with no occupied cell 0. Written as E / pi:
 // Cycles' Diffuse Indirect.
@@ -25,13 +26,17 @@ void main() {
     for (int k = 0; k < 8; k++) {
         ivec3 o = ivec3(k & 1, (k >> 1) & 1, k >> 2);
         ivec3 c = ivec3(base) + o;
-        if (!diffusion_inside(c) || !diffusion_occupied(texelFetch(cell_block, c, 0))) {
+        if (!diffusion_inside(c)) {
             continue;
+        }
+        vec4 block = texelFetch(cell_block, c, 0);
+        vec4 plane = texelFetch(cell_normal, c, 0);
+        float dn = dot(n, plane.xyz);
+        if (!diffusion_occupied(block) || !diffusion_receives(block, dn >= 0.0)) {
+            continue;  // no surface, or its side facing n no light can reach (a room's edge cell)
         }
         vec3 w3 = mix(1.0 - frac, frac, vec3(o));
         float t = w3.x * w3.y * w3.z;
-        vec4 plane = texelFetch(cell_normal, c, 0);
-        float dn = dot(n, plane.xyz);
         vec3 flux = dn >= 0.0 ? texelFetch(flux_plus, c, 0).rgb : texelFetch(flux_minus, c, 0).rgb;
         vec3 e = flux / (max(plane.w, 1e-6) * cell_size * cell_size);
         float w = t * abs(dn);

@@ -57,7 +57,9 @@ def ref_cells(voxels):
 
 
 def open_mask(cell):
-    return np.sum(cell["open"] * (1 << np.arange(6)), axis=-1)
+    """The twin's open faces (bits 0-5) and receiving sides (bit 6 plus, 7 minus) as cells.comp.glsl packs them."""
+    return np.sum(cell["open"] * (1 << np.arange(6)), axis=-1) + 64 * cell["receives"][..., 0] \
+        + 128 * cell["receives"][..., 1]
 
 
 def test_cells_are_the_twins(gl):
@@ -70,7 +72,7 @@ def test_cells_are_the_twins(gl):
     np.testing.assert_allclose(normal[..., :3], want["normal"], rtol=0, atol=1e-6)
     np.testing.assert_allclose(normal[..., 3], want["area"], rtol=0, atol=1e-6)
     np.testing.assert_allclose(block[..., :3], want["block"], rtol=0, atol=1e-7)
-    # w: 0 empty, else 1 + the open-face mask, exactly (small integers in fp32).
+    # w: 0 empty, else 1 + the mask, exactly (small integers in fp32).
     np.testing.assert_array_equal(block[..., 3], np.where(want["occupied"], 1 + open_mask(want), 0))
 
 

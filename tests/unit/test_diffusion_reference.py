@@ -151,10 +151,14 @@ def test_an_emitter_against_a_floor_sends_its_light_up_only():
 
 
 def lookup_cells(occupied, normal_z=1.0):
+    """Cells of floors (normal +z) where `occupied`, both sides of each able to receive light (here no
+    empty cell need lie beside them: the lookup's weights are what is tested)."""
     dims = occupied.shape
     normal = np.zeros((*dims, 3))
     normal[occupied] = (0.0, 0.0, normal_z)
-    return ref.cells(occupied, normal, np.where(occupied[..., None], [0.0, 0.0, 1.0], 0.0))
+    cell = ref.cells(occupied, normal, np.where(occupied[..., None], [0.0, 0.0, 1.0], 0.0))
+    cell["receives"] = np.repeat(occupied[..., None], 2, axis=-1)
+    return cell
 
 
 def test_the_lookup_renormalises_over_occupied_cells():
@@ -255,3 +259,30 @@ def test_a_point_sources_light_leaves_it_at_one_cell_per_step():
     flux, in_flight = point_source_axis_irradiance(steps=3, size=21)
     assert not flux[4:].any() and flux[3] > 0
     assert in_flight == pytest.approx(1.0, rel=1e-12)
+
+
+def test_the_lookup_skips_a_side_no_light_can_reach():
+    # A floor (z = 0 layer, normal +z) meets a wall (x = 0 column, normal +x) in an edge cell holding both
+    # (normal (x + z) / sqrt(2)). Its room side touches no empty cell (floor beside it, wall above), so
+    # no light can reach it and its 0 is no reading: a floor point beside it reads the floor cells alone,
+    # exactly their irradiance; the edge cell's outer side (empty cells outside the room) can receive.
+    dims = (3, 3, 3)
+    occ = np.zeros(dims, bool)
+    occ[0, :, :] = True
+    occ[:, :, 0] = True
+    normal = np.zeros((*dims, 3))
+    normal[0, :, :] = (0.0, 0.0, 1.0)
+    normal[:, :, 0] = (1.0, 0.0, 0.0)
+    normal[0, :, 0] = np.array([1.0, 0.0, 1.0]) / np.sqrt(2.0)
+    proj = np.zeros((*dims, 3))
+    proj[0, :, :, 2] = 1.0
+    proj[:, :, 0, 0] = 1.0
+    proj[0, :, 0] = (0.5, 0.0, 0.5)
+    cell = ref.cells(occ, normal, proj)
+    assert cell["receives"][0, 1, 0].tolist() == [False, False]  # (-x, -z are out of the grid here)
+    assert cell["receives"][0, 1, 1].tolist() == [True, False] and cell["receives"][1, 1, 0].tolist() == [True, False]
+    flux = np.where(occ, 2.0, 0.0)
+    flux[0, :, 0] = 0.0  # the edge cell received nothing
+    # A floor point between the edge cell (x = 0) and the floor cell x = 1, at the floor's height.
+    value = ref.lookup(np.array([[0.9, 1.5, 0.5]]), np.array([[0.0, 0.0, 1.0]]), cell, flux, np.zeros(dims), 1.0)
+    assert value[0] == pytest.approx(2.0 / np.pi, rel=1e-14)
