@@ -166,12 +166,17 @@ class ProbesConfig(_Validated):
     """Probe grid with L2 SH and distance moments (method `probes`, paper 004): docs/PROBES.md."""
 
     # Cornell at 128 px against Cycles (docs/PROBES.md), rel_rmse_8: 4 probes a side 0.35, 8 0.20,
-    # 12 0.16, 16 0.124 at 8^2 texels a face (8 at 16^2: 0.198, the same as at 8^2 within 0.01): the
-    # error is the probes' spacing, not their faces' resolution. Cost: 6 draws of the scene per probe
-    # per geometry change, 6 face_texels^2 texels per probe re-shaded per light change.
+    # 12 0.16, 16 0.124 at 8^2 texels a face; at 16 a side 4^2 faces 0.22, 6^2 0.17 (the visibility
+    # moments' resolution). Cost: 6 draws of the scene per probe per geometry change, 6 face_texels^2
+    # texels per probe re-shaded per light change.
     probes_per_side: int = _num(16, 2, 64, "probes along the bounds' longest side (spacing = that side / n)")
     face_texels: int = _num(8, 4, 64, "texels per side of each of a probe's six captured faces")
     normal_bias: float = _num(0.25, 0.0, 1.0, "lookup point moved off its surface along the normal, x spacing")
+    # sh: the paper's nine coefficients per colour; irradiance: a cube map of exact clamped-cosine
+    # irradiance per probe (DDGI's irradiance map, in the capture's cube layout), no SH ringing: Cornell
+    # rel_rmse_8 0.101 against 0.124, but its convolution made the solve ~6x slower (docs/PROBES.md).
+    encoding: str = _choice("sh", ("sh", "irradiance"), "probe light: L2 SH (the paper's) or an irradiance "
+                            "cube map per probe (exact cosine convolution)")
     chebyshev_visibility: bool = field(default=True, metadata={
         "doc": "weigh probes by Chebyshev visibility from their distance moments (no light through walls)"})
     # The capture draws the whole scene 6 times per probe: 1e6 triangles at 16 a side (256 probes on a

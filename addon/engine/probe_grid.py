@@ -82,7 +82,11 @@ class ProbeGrid:
 
     @property
     def atlas_size(self) -> tuple[int, int]:
-        n, cols = self.face_texels, self.tiles_per_row
+        return self.tiled_size(self.face_texels)
+
+    def tiled_size(self, n: int) -> tuple[int, int]:
+        """An atlas of every probe's six n x n faces in the capture's tile layout."""
+        cols = self.tiles_per_row
         rows = -(-self.count // cols)
         return 3 * n * cols, 2 * n * rows
 

@@ -9,20 +9,17 @@
 // with var = max(m2 - m1^2, min_variance_m2), remapped to (c - VIS_CUTOFF) / (1 - VIS_CUTOFF) and
 // clamped at 0, so a wall between the probe and the point gives exactly 0 (continuously). Each probe's
 // irradiance is the clamped-cosine convolution of its L2 SH about n, clamped at 0: E = max(0, sum_i
-// c_i A_l Y_i(n)); the output is E / pi, Cycles' Diffuse Indirect (alpha 0).
+// c_i A_l Y_i(n)), or with IRRADIANCE its irradiance cube map read at n; the output is E / pi, Cycles'
+// Diffuse Indirect (alpha 0).
 const float VIS_CUTOFF = 1e-3;
 const float MIN_TOTAL_WEIGHT = 1e-3;
 #include "common/sh.glsl"
 #include "probes/probe.glsl"
 
 vec2 probe_moments(int p, vec3 d) {
-    vec2 st;
-    int face = direction_face(d, st);
-    int n = face_texels;
-    vec2 uv = clamp((st + 1.0) * (0.5 * float(n)) - 0.5, vec2(0.0), vec2(float(n - 1)));
-    ivec2 i0 = ivec2(floor(uv));
-    ivec2 i1 = min(i0 + 1, ivec2(n - 1));
-    vec2 f = uv - vec2(i0);
+    ivec2 i0, i1;
+    vec2 f;
+    int face = face_bilinear(d, face_texels, i0, i1, f);
     ivec2 o = face_origin(p, face);
     vec2 m00 = texelFetch(moments, o + i0, 0).xy;
     vec2 m10 = texelFetch(moments, o + ivec2(i1.x, i0.y), 0).xy;
@@ -41,6 +38,21 @@ float chebyshev(vec2 m, float r) {
     return max(w * w * w - VIS_CUTOFF, 0.0) / (1.0 - VIS_CUTOFF);
 }
 
+#ifdef IRRADIANCE
+// The irradiance encoding: the probe's irradiance cube map (probes/convolve.comp.glsl) at normal n.
+vec3 probe_irradiance(ivec3 q, vec3 n) {
+    ivec2 i0, i1;
+    vec2 f;
+    int face = face_bilinear(n, irradiance_texels, i0, i1, f);
+    ivec2 o = tile_origin(probe_index(q), face, irradiance_texels);
+    vec3 e00 = texelFetch(irradiance, o + i0, 0).rgb;
+    vec3 e10 = texelFetch(irradiance, o + ivec2(i1.x, i0.y), 0).rgb;
+    vec3 e01 = texelFetch(irradiance, o + ivec2(i0.x, i1.y), 0).rgb;
+    vec3 e11 = texelFetch(irradiance, o + i1, 0).rgb;
+    return mix(mix(e00, e10, f.x), mix(e01, e11, f.x), f.y);
+}
+#else
+// The SH encoding: the clamped-cosine convolution of the probe's L2 SH about n, clamped at 0.
 vec3 probe_irradiance(ivec3 q, vec3 n) {
     vec3 e = vec3(0.0);
     for (int c = 0; c < 9; ++c) {
@@ -48,6 +60,7 @@ vec3 probe_irradiance(ivec3 q, vec3 n) {
     }
     return max(e, vec3(0.0));
 }
+#endif
 
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);

@@ -25,9 +25,13 @@ int probe_row(ivec3 q) {
     return q.y + probe_dims.y * q.z;
 }
 
-ivec2 face_origin(int p, int face) {
-    int n = face_texels;
+// Texel (0, 0) of face `face` of probe p in an atlas of n x n faces (the capture's: n = face_texels).
+ivec2 tile_origin(int p, int face, int n) {
     return ivec2(3 * n * (p % tiles_per_row) + n * (face % 3), 2 * n * (p / tiles_per_row) + n * (face / 3));
+}
+
+ivec2 face_origin(int p, int face) {
+    return tile_origin(p, face, face_texels);
 }
 
 void face_frame(int face, out vec3 forward, out vec3 right, out vec3 up) {
@@ -88,5 +92,17 @@ int direction_face(vec3 d, out vec2 st) {
     face_frame(face, f, r, u);
     float w = dot(d, f);
     st = vec2(dot(d, r), dot(d, u)) / max(w, 1e-12);
+    return face;
+}
+
+// Bilinear interpolation of an n x n face at direction d, within the face (clamped at its edges, no
+// blend across faces): the face, the texels i0 and i1 (in the face) and the weights f of i1.
+int face_bilinear(vec3 d, int n, out ivec2 i0, out ivec2 i1, out vec2 f) {
+    vec2 st;
+    int face = direction_face(d, st);
+    vec2 uv = clamp((st + 1.0) * (0.5 * float(n)) - 0.5, vec2(0.0), vec2(float(n - 1)));
+    i0 = ivec2(floor(uv));
+    i1 = min(i0 + 1, ivec2(n - 1));
+    f = uv - vec2(i0);
     return face;
 }

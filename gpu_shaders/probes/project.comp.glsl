@@ -1,13 +1,11 @@
 // Shade every texel of a probe and project onto L2 SH (paper 004, eq. 3): one invocation per probe,
-// c_i = sum over faces and texels of L(w) Y_i(w) dw, w the texel's centre direction and dw its exact
-// solid angle. L = albedo x (direct + indirect): the radiance a Lambertian surface reflects, direct =
-// irradiance / pi from the direct pass, indirect (with BOUNCE) the previous bounce's irradiance / pi
-// read from the probe field. Directions that see no geometry bring nothing: the world's light is
-// direct light, not a bounce.
+// c_i = sum over faces and texels of L(w) Y_i(w) dw, w the texel's centre direction, dw its exact
+// solid angle, L its radiance (probes/radiance.glsl).
 // Output: texel (i nx + ix, iy + ny iz) rgb = coefficient i of the incoming radiance (W/m^2/sr) by
 // direction of arrival (from the probe towards the surface it sees).
 #include "common/sh.glsl"
 #include "probes/probe.glsl"
+#include "probes/radiance.glsl"
 
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
@@ -25,18 +23,13 @@ void main() {
         ivec2 origin = face_origin(p, face);
         for (int j = 0; j < n; ++j) {
             for (int i = 0; i < n; ++i) {
-                ivec2 t = origin + ivec2(i, j);
-                vec4 albedo = texelFetch(atlas_albedo, t, 0);
-                if (albedo.w == 0.0) {
+                ivec2 ij = ivec2(i, j);
+                vec3 radiance = texel_radiance(origin + ij);
+                if (all(equal(radiance, vec3(0.0)))) {
                     continue;
                 }
-                vec3 light = texelFetch(atlas_direct, t, 0).rgb;
-#ifdef BOUNCE
-                light += texelFetch(atlas_indirect, t, 0).rgb;
-#endif
-                ivec2 ij = ivec2(i, j);
                 vec3 w = face_direction(face, texel_st(ij));
-                vec3 l = albedo.rgb * light * texel_solid_angle(ij);
+                vec3 l = radiance * texel_solid_angle(ij);
                 for (int k = 0; k < 9; ++k) {
                     c[k] += l * sh2_basis(k, w);
                 }

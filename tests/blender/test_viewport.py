@@ -198,7 +198,8 @@ def test_navigating_gives_preview_then_full_quality(cornell):
 
 
 @pytest.mark.parametrize("name", ["direct", "rsm", "lpv", "lpv-far-field", "lpv-emitter-classes", "lpv-octree",
-                                  "lpv-octree-index", "vct", "vct-filtered", "diffusion", "probes"])
+                                  "lpv-octree-index", "vct", "vct-filtered", "diffusion", "probes",
+                                  "probes-irradiance"])
 def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, name):
     # lpv at 16 cells runs one grid; "lpv-far-field" at 32 cells adds the far field's passes;
     # "lpv-emitter-classes" (16 cells) the classes' injection, unpacks and own-light lookups;
@@ -223,7 +224,8 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
         vct = VctConfig(voxel_cells=16, diffuse_cones=6, filtered_injection=name == "vct-filtered")
         method = methods.create(be, {"gi": gi, "rsm": rsm, "lpv": lpv, "vct": vct,
                                      "diffusion": DiffusionConfig(grid_cells=16),
-                                     "probes": ProbesConfig(probes_per_side=6)})
+                                     "probes": ProbesConfig(probes_per_side=6, encoding="irradiance"
+                                                            if name == "probes-irradiance" else "sh")})
         method.set_scene(scene)
         results.append(method.run().images)
     a, b = results

@@ -26,9 +26,11 @@ class ProbesMethod(OneBounceMethod):
     spec = registry.get("probes")
     PASSES = declare.extend(
         OneBounceMethod.PASSES, setup=(probe_capture.CAPTURE_DECL, probe_capture.MOMENTS_DECL),
+        # The SH encoding's passes, then the irradiance encoding's (ProbesConfig.encoding picks one).
         solve=(probe_project.SHADE_DECL, probe_project.PROJECT_DECL, probe_lookup.BOUNCE_DECL,
-               probe_project.REPROJECT_DECL),
-        gather=(probe_lookup.DECL,))
+               probe_project.REPROJECT_DECL, probe_project.CONVOLVE_DECL, probe_lookup.IRRADIANCE_BOUNCE_DECL,
+               probe_project.RECONVOLVE_DECL),
+        gather=(probe_lookup.DECL, probe_lookup.IRRADIANCE_DECL))
 
     def __init__(self, backend, gi, rsm_config, probes_config: ProbesConfig | None = None):
         super().__init__(backend, gi, rsm_config)
@@ -45,9 +47,11 @@ class ProbesMethod(OneBounceMethod):
         self._atlas_target = be.target(list(self.atlas.values()), be.depth_texture(size))
         self.atlas_direct = be.texture(size)
         self.atlas_indirect = be.texture(size) if self.gi.bounces > 1 else None
-        # Two SH tables: a bounce reads one while the next projection writes the other.
-        self._sh = [be.texture(grid.sh_size) for _ in range(2 if self.gi.bounces > 1 else 1)]
-        self.sh = self._sh[0]
+        # Two light tables (SH, or irradiance maps): a bounce reads one while the next pass writes the other.
+        self.irradiance_encoding = cfg.encoding == "irradiance"
+        table = grid.tiled_size(probe_project.IRRADIANCE_TEXELS) if self.irradiance_encoding else grid.sh_size
+        self._light = [be.texture(table) for _ in range(2 if self.gi.bounces > 1 else 1)]
+        self.light = self._light[0]
         self.moments = be.texture(size)
         self.state = be.texture(grid.state_size)
         far = probe_capture.far_m(self.bounds_m)
@@ -58,7 +62,8 @@ class ProbesMethod(OneBounceMethod):
 
     def field(self) -> dict:
         """The light field the lookup reads."""
-        return {"sh": self.sh, "moments": self.moments, "state": self.state}
+        return {"irradiance" if self.irradiance_encoding else "sh": self.light, "moments": self.moments,
+                "state": self.state}
 
     def begin_solve(self, timings: dict[str, float]) -> None:
         zero.images(self.backend, [self.atlas_direct])
@@ -70,16 +75,23 @@ class ProbesMethod(OneBounceMethod):
 
     def finish_solve(self, timings: dict[str, float]) -> None:
         be, grid = self.backend, self.grid
-        self.sh = self._sh[0]
-        with self.step(timings, probe_project.PROJECT_DECL):
-            probe_project.run(be, self.atlas, self.atlas_direct, self.sh, grid)
+        # (first bounce's pass, later bounces' pass, the bounce lookup, the encoding's function)
+        if self.irradiance_encoding:
+            first, later, bounce_decl, encode = (probe_project.CONVOLVE_DECL, probe_project.RECONVOLVE_DECL,
+                                                 probe_lookup.IRRADIANCE_BOUNCE_DECL, probe_project.convolve)
+        else:
+            first, later, bounce_decl, encode = (probe_project.PROJECT_DECL, probe_project.REPROJECT_DECL,
+                                                 probe_lookup.BOUNCE_DECL, probe_project.run)
+        self.light = self._light[0]
+        with self.step(timings, first):
+            encode(be, self.atlas, self.atlas_direct, self.light, grid)
         for bounce in range(2, self.gi.bounces + 1):
-            with self.step(timings, probe_lookup.BOUNCE_DECL):
+            with self.step(timings, bounce_decl):
                 probe_lookup.run(be, self.atlas["position"], self.atlas["normal"], self.field(), self.atlas_indirect,
                                  grid, self.probes_config)
-            self.sh = self._sh[(bounce - 1) % 2]
-            with self.step(timings, probe_project.REPROJECT_DECL):
-                probe_project.run(be, self.atlas, self.atlas_direct, self.sh, grid, self.atlas_indirect)
+            self.light = self._light[(bounce - 1) % 2]
+            with self.step(timings, later):
+                encode(be, self.atlas, self.atlas_direct, self.light, grid, self.atlas_indirect)
 
     def gather_pixels(self, timings: dict[str, float]) -> None:
         with self.step(timings, probe_lookup.DECL):

@@ -6,13 +6,16 @@ probe sees. probe_project: per probe (one invocation each, all 9 coefficients fr
 texels), c_i = sum over its 6 n^2 texels of
 albedo x (direct [+ indirect]) x Y_i(w) x dw, w a texel's centre direction, dw its exact solid angle
 (probe_grid.texel_solid_angles): the L2 SH of the radiance arriving at the probe (W/m^2/sr), by
-direction of arrival. probe_reproject adds the previous bounce's indirect (probe_lookup.bounce), so the
-N-th projection holds bounces 1..N. Output `sh` (RGBA32F, 9 nx x ny nz; probe_grid.py), rgb.
+direction of arrival. probe_reproject adds the previous bounce's indirect (probe_lookup.BOUNCE_DECL), so
+the N-th projection holds bounces 1..N. Output `sh` (RGBA32F, 9 nx x ny nz; probe_grid.py), rgb.
+With the irradiance encoding, probe_convolve / probe_reconvolve write instead each probe's irradiance
+cube map: E(n) = sum over its texels of L max(0, n . w) dw at IRRADIANCE_TEXELS^2 normals a face, in
+the capture's tile layout (grid.tiled_size), W/m^2.
 """
 
 from __future__ import annotations
 
-from ..backends.base import Backend, Image, Sampler, ShaderSpec, group_count
+from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..probe_grid import ProbeGrid
 from . import direct_light
 from .declare import EMITTERS, LIGHT_VIEWS, RSM_POSITION, PassDecl, Port
@@ -24,6 +27,10 @@ ATLAS_INDIRECT = Port("probes", "indirect", "RGBA32F", "probe_atlas",
                       "the previous bounce's indirect irradiance / pi there (probe_lookup.bounce)")
 SH = Port("probes", "sh", "RGBA32F", "probes", "L2 SH of incoming radiance (W/m^2/sr), coefficient i at i nx + ix")
 
+IRRADIANCE = Port("probes", "irradiance", "RGBA32F", "probe_atlas",
+                  "irradiance (W/m^2) per probe at 6 m^2 normals (the irradiance encoding)")
+IRRADIANCE_TEXELS = 4  # m: each face of a probe's irradiance cube map is m x m normals
+
 SHADE_DECL = PassDecl("probe_direct", "solve", (ATLAS_POSITION, ATLAS_NORMAL, RSM_POSITION, LIGHT_VIEWS, EMITTERS),
                       (ATLAS_DIRECT,), "one light face's shadow-mapped direct light on the probe atlas, added")
 PROJECT_DECL = PassDecl("probe_project", "solve", (ATLAS_ALBEDO, ATLAS_DIRECT), (SH,),
@@ -32,7 +39,24 @@ REPROJECT_DECL = PassDecl("probe_reproject", "solve", (ATLAS_ALBEDO, ATLAS_DIREC
                           "the atlas re-shaded with the previous bounce and projected (bounces 2..N)")
 
 
-def _spec(bounce: bool) -> ShaderSpec:
+CONVOLVE_DECL = PassDecl("probe_convolve", "solve", (ATLAS_ALBEDO, ATLAS_DIRECT), (IRRADIANCE,),
+                         "the atlas shaded and convolved to irradiance cube maps (first bounce)")
+RECONVOLVE_DECL = PassDecl("probe_reconvolve", "solve", (ATLAS_ALBEDO, ATLAS_DIRECT, ATLAS_INDIRECT), (IRRADIANCE,),
+                           "the atlas re-shaded with the previous bounce and convolved (bounces 2..N)")
+
+
+def _spec(bounce: bool, encoding: str = "sh") -> ShaderSpec:
+    if encoding == "irradiance":
+        return ShaderSpec(
+            name="probe_convolve" + ("_bounce" if bounce else ""),
+            compute="probes/convolve.comp.glsl",
+            local_size=(8, 8, 1),
+            samplers=(Sampler("atlas_albedo", "2D"), Sampler("atlas_direct", "2D"))
+            + ((Sampler("atlas_indirect", "2D"),) if bounce else ()),
+            images=(Image("irradiance", "2D", "RGBA32F", "write"),),
+            uniforms=(*ATLAS_UNIFORMS, Var("irradiance_texels", "int")),
+            defines=(("BOUNCE", "1"),) if bounce else (),
+        )
     return ShaderSpec(
         name="probe_project" + ("_bounce" if bounce else ""),
         compute="probes/project.comp.glsl",
@@ -45,7 +69,7 @@ def _spec(bounce: bool) -> ShaderSpec:
     )
 
 
-SPECS = {bounce: _spec(bounce) for bounce in (False, True)}
+SPECS = {(bounce, encoding): _spec(bounce, encoding) for bounce in (False, True) for encoding in ("sh", "irradiance")}
 
 
 def shade(backend: Backend, atlas: dict, atlas_direct, rsm_position, view: LightView, shadow_bias_texels: float,
@@ -57,10 +81,22 @@ def shade(backend: Backend, atlas: dict, atlas_direct, rsm_position, view: Light
 
 def run(backend: Backend, atlas: dict, atlas_direct, sh, grid: ProbeGrid, atlas_indirect=None) -> None:
     """sh := the projection of albedo x (direct [+ atlas_indirect]) for every probe."""
-    spec = SPECS[atlas_indirect is not None]
+    spec = SPECS[(atlas_indirect is not None, "sh")]
+    _dispatch(backend, spec, atlas, atlas_direct, atlas_indirect, {"sh": sh}, grid.state_size,
+              grid_uniforms(spec, grid))
+
+
+def convolve(backend: Backend, atlas: dict, atlas_direct, irradiance, grid: ProbeGrid, atlas_indirect=None) -> None:
+    """irradiance := every probe's irradiance cube map (IRRADIANCE_TEXELS a face, the capture's tile layout,
+    grid.tiled_size) of albedo x (direct [+ atlas_indirect])."""
+    spec = SPECS[(atlas_indirect is not None, "irradiance")]
+    _dispatch(backend, spec, atlas, atlas_direct, atlas_indirect, {"irradiance": irradiance}, irradiance.size,
+              {**grid_uniforms(spec, grid), "irradiance_texels": IRRADIANCE_TEXELS})
+
+
+def _dispatch(backend, spec, atlas, atlas_direct, atlas_indirect, images, size, uniforms) -> None:
     samplers = {"atlas_albedo": atlas["albedo"], "atlas_direct": atlas_direct}
     if atlas_indirect is not None:
         samplers["atlas_indirect"] = atlas_indirect
-    backend.dispatch(backend.program(spec), group_count(grid.state_size, spec.local_size),
-                     uniforms=grid_uniforms(spec, grid),
-                     samplers=samplers, images={"sh": sh})
+    backend.dispatch(backend.program(spec), group_count(size, spec.local_size), uniforms=uniforms,
+                     samplers=samplers, images=images)
