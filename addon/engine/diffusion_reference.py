@@ -37,6 +37,7 @@ CONE_C0 = sh.Y00 * FACE_SOLID_ANGLE_SR
 CONE_C1 = sh.Y1 * 2.0 * np.sqrt(2.0) * np.arctan(1.0 / np.sqrt(2.0))
 _SLOT = (3, 1, 2)  # the coefficient index of axis x, y, z in (1, y, z, x)
 SIDE_EPSILON = 1e-3  # |d.n| below this: a face parallel to the surface feeds both sides half and half
+LOOKUP_WEIGHT_FLOOR = 1e-3  # added to every trilinear weight of the lookup (`lookup`)
 
 
 def cone(d: np.ndarray) -> np.ndarray:
@@ -242,7 +243,9 @@ def lookup(points_cells: np.ndarray, normals: np.ndarray, cell: dict, flux_plus:
     times |n . n_cell| (the surface it holds faces the point's way: a wall's cell does not light the
     floor beside it) and renormalised, over the cells whose side facing n can receive light at all
     (`receives`); where those weights are all 0 but such a neighbour exists the trilinear weights alone;
-    where none does, 0 (no surface near: no light known)."""
+    where none does, 0 (no surface near: no light known). Every trilinear weight is raised by
+    LOOKUP_WEIGHT_FLOOR, so a point at a cell's centre whose own cell cannot receive (a room's corner)
+    still reads its neighbours."""
     p = np.asarray(points_cells, np.float64) - 0.5
     base = np.floor(p).astype(int)
     frac = p - base
@@ -254,7 +257,7 @@ def lookup(points_cells: np.ndarray, normals: np.ndarray, cell: dict, flux_plus:
     for k in range(8):
         o = np.array([k & 1, (k >> 1) & 1, k >> 2])
         c = base + o
-        t = np.prod(np.where(o, frac, 1.0 - frac), axis=1)
+        t = np.prod(np.where(o, frac, 1.0 - frac), axis=1) + LOOKUP_WEIGHT_FLOOR
         inside = np.all((c >= 0) & (c < dims_zyx[::-1]), axis=1)
         cz = np.clip(c, 0, dims_zyx[::-1] - 1)
         idx = (cz[:, 2], cz[:, 1], cz[:, 0])

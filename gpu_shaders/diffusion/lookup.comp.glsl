@@ -36,7 +36,9 @@ void main() {
             continue;  // no surface, or its side facing n no light can reach (a room's edge cell)
         }
         vec3 w3 = mix(1.0 - frac, frac, vec3(o));
-        float t = w3.x * w3.y * w3.z;
+        // Raised by 1e-3 (diffusion_reference.LOOKUP_WEIGHT_FLOOR): at a cell's centre whose own cell
+        // cannot receive (a room's corner) its neighbours, whose trilinear weights are 0, still count.
+        float t = w3.x * w3.y * w3.z + 1e-3;
         vec3 flux = dn >= 0.0 ? texelFetch(flux_plus, c, 0).rgb : texelFetch(flux_minus, c, 0).rgb;
         vec3 e = flux / (max(plane.w, 1e-6) * cell_size * cell_size);
         float w = t * abs(dn);
