@@ -95,23 +95,23 @@ class LpvConfig(_Validated):
                            "octree (improved on a mip chain of grids, merged: paper 002)")
     geometry_volume: bool = field(default=True, metadata={"doc": "occlude propagation by the voxelized surfaces"})
     # On: a surface blocks the transfers on its side of the cell's centre (by where it lies in the cell),
-    # so light does not depend on how walls align with cells (thin-wall 0.68 -> 0.22); off: each cell's
-    # blocking is split half and half between entering and leaving (docs/LPV.md, "geometry volume").
+    # so light does not depend on how walls align with cells (thin-wall rel_rmse_8 0.22, 0.68 off); off:
+    # each cell's blocking is split half and half between entering and leaving (docs/LPV.md).
     # The improved variant's; classic, the published baseline, always splits half and half.
     surface_offsets: bool = field(default=True, metadata={
         "doc": "geometry volume: a surface blocks the transfers on its side of the cell's centre"})
     # On: the grid runs only its near steps and a grid of twice the cell carries the light further
-    # (docs/LPV.md, "Far field": Cornell 0.54 -> 0.38 at 32 cells, 4x fewer fine steps). Improved
-    # variant, grid_cells >= 32, on the coarsest grid (the only one without cascades).
+    # (docs/LPV.md, "Far field": Cornell rel_rmse_8 0.38, 0.54 on one grid, at 32 cells, 4x fewer fine
+    # steps). Improved variant, grid_cells >= 32, on the coarsest grid (the only one without cascades).
     far_field: bool = field(default=True, metadata={
         "doc": "carry light beyond the near steps on a grid of twice the cell size (faster, less on-axis excess)"})
     near_steps: int = _num(0, 0, 256, "far field: steps the fine grid runs (0: half of grid_cells)")
     # On: the VPLs are propagated in six sets by their normal's dominant signed axis, and a surface reads
     # every set but its own: a surface cannot light another facing its way, but in L1 SH the strong light
-    # leaving a lit floor cancels the weak light arriving at it (docs/LPV.md, "Emitter classes": error
-    # down on every scene but emissive, e.g. cornell 0.385 -> 0.338, thin-wall 0.280 -> 0.151). Off by
-    # default: six propagations instead of one (7x the propagation time on llvmpipe). The improved
-    # variant with one cascade, first bounce.
+    # leaving a lit floor cancels the weak light arriving at it (docs/LPV.md, "Emitter classes": lower
+    # error on every scene but emissive, e.g. cornell rel_rmse_8 0.338 (0.385 without), thin-wall 0.151
+    # (0.280)). Off by default: six propagations instead of one (7x the propagation time on llvmpipe).
+    # The improved variant with one cascade, first bounce.
     emitter_classes: bool = field(default=False, metadata={
         "doc": "a surface reads no light from surfaces facing its way (six propagations; one cascade)"})
     # Octree (variant octree, passes/lpv_octree.py): the grid is level 0 of a mip chain of grids, each
@@ -222,8 +222,8 @@ class GIConfig(_Validated):
     bounces: int = _num(1, 1, 8, "indirect diffuse bounces (Cycles diffuse_bounces)")
     resolution: int = _num(256, 8, 8192, "long side of the output image in pixels")
     # On: the products of the stochastic gathers (rsm's VPLs, vct's jittered cones) are filtered along
-    # their surfaces, guided by the G-buffer (passes/denoise.py): vct's per-pixel noise on cornell
-    # 0.60 -> 0.17 for 1-6 % of its update. Off: the raw gather, as the papers describe it.
+    # their surfaces, guided by the G-buffer (passes/denoise.py): vct's per-pixel rel_rmse on cornell
+    # 0.17 (0.60 unfiltered) for 1-6 % of its update. Off: the raw gather, as the papers describe it.
     # Progressive refinement: a render or bake averages this many gathers of the stochastic methods,
     # each with other VPLs / cone rotations (DirectMethod.refine; noise / sqrt(samples)); the viewport
     # keeps adding gathers while nothing changes.
