@@ -59,8 +59,9 @@ def update_costs_block(results: dict) -> str:
     percentage of full; then lpv's ratio against the issue's target."""
     records = _default_records(results)
     lines = ["**Update costs** of each method at its default settings.", "",
-             _produced_by(results) + f" Medians of {results['repeat']} updates of each kind; lights = every light "
-             "moved 1 cm, camera = the camera moved 1 cm.", "",
+             _produced_by(results) + f" Medians of {results['repeat']} updates of each kind; full = a geometry "
+             "change (the upload, the setup passes and everything after), lights = every light moved 1 cm, camera = "
+             "the camera moved 1 cm.", "",
              "| scene | size | method | full ms | lights ms | camera ms | camera / full |",
              "| --- | --- | --- | --- | --- | --- | --- |"]
     for r in records:
