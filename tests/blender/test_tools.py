@@ -65,3 +65,15 @@ def test_fit_choice_fits_judges_and_writes(tmp_path):
 
     fitted = choice.Model.from_json(json.loads(model.read_text()))
     assert set(fitted.rows) == {"rsm vpl_samples=256", "lpv grid_cells=16"}
+
+
+def test_diffusion_box_prints_both_transfers():
+    out = tool("tools/diffusion_box.py", "--cells", "12")
+    for transfer in ("cone", "directional"):
+        assert f"{transfer}: closed box of 12 cells" in out and f"{transfer}: point source" in out
+
+
+def test_diffusion_step_time_prints_each_method():
+    out = tool("tools/diffusion_step_time.py", "--cells", "8")
+    lines = [line for line in out.splitlines() if "ms per step at 8^3" in line]
+    assert len(lines) >= 2 and "renderer:" in out
