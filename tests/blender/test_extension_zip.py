@@ -76,11 +76,11 @@ def test_linux_zip_installs_enables_and_disables(tmp_path):
         pytest.skip(f"cannot fetch wheels (no registry?): {build.stderr.strip().splitlines()[-1]}")
     assert build.returncode == 0, build.stdout + build.stderr
 
-    zip_path = dist / "bounce-0.1.0-linux_x64.zip"
+    zip_path = dist / "bounce-0.2.0-linux_x64.zip"
     assert sorted(p.name for p in dist.glob("*.zip")) == [
-        "bounce-0.1.0-linux_x64.zip",
-        "bounce-0.1.0-macos_arm64.zip",
-        "bounce-0.1.0-windows_x64.zip",
+        "bounce-0.2.0-linux_x64.zip",
+        "bounce-0.2.0-macos_arm64.zip",
+        "bounce-0.2.0-windows_x64.zip",
     ]
     names = zipfile.ZipFile(zip_path).namelist()
     assert {"__init__.py", "blender_manifest.toml", "addon/registration.py", "operators/about.py"} <= set(names)

@@ -38,7 +38,7 @@ def test_blender_ext_validate_accepts_manifest():
 
 def test_manifest_identity_and_only_files_permission():
     manifest = _manifest()
-    assert (manifest["id"], manifest["type"], manifest["version"]) == ("bounce", "add-on", "0.1.0")
+    assert (manifest["id"], manifest["type"], manifest["version"]) == ("bounce", "add-on", "0.2.0")
     assert manifest["blender_version_min"] == "4.2.0"
     assert list(manifest["permissions"]) == ["files"]
     assert manifest["permissions"]["files"].strip()
