@@ -159,7 +159,7 @@ def summary(judged: dict) -> dict:
                   <= ESTIMATE_FACTOR)
         checks = {(e["scene"], e["row"]): e for e in judged.get("agreement", [])}
         self_est = sum(1 for r in rows if r["measured"] and (r["scene"], r["choice"]) in checks
-                       and 1 / ESTIMATE_FACTOR <= checks[(r["scene"], r["choice"])]["blend"] / r["measured"]
+                       and 1 / ESTIMATE_FACTOR <= checks[(r["scene"], r["choice"])]["agree"] / r["measured"]
                        <= ESTIMATE_FACTOR)
         s[budget] = {"scenes": n, "met": met, "possible": possible, "within_2x": fast, "estimate_within_1.5x": est,
                      "self_check_within_1.5x": self_est}
@@ -181,8 +181,8 @@ def report(results_path: str, judged: dict, summ: dict, model: choice.Model) -> 
              "Each scene judged by a model fitted without it. met: the choice's measured rel_rmse_8 is within the "
              "budget; possible: some measured setting is; within 2x: met, and its time at most twice the fastest "
              "setting measured within the budget; estimate: the choice's predicted error within a factor 1.5 of "
-             "its measured one; self-check: `render --self-check`'s estimate (the geometric mean of the model's and "
-             "of the difference from another method's image) within that factor.", "",
+             "its measured one; self-check: `render --self-check`'s estimate (the difference from the image of the "
+             "row of another method the model expects most accurate) within that factor.", "",
              "| budget | scenes | met | possible | within 2x | estimate within 1.5x | self-check within 1.5x |",
              "| --- | --- | --- | --- | --- | --- | --- |"]
     for budget in map(str, BUDGETS):
