@@ -65,18 +65,10 @@ def box_figures(n: int, transfer: str) -> None:
 
 
 def point_source_figures(transfer: str, steps: int = 120, size: int = 41) -> None:
-    dims = (size, size, size)
-    c = size // 2
-    cell = ref.cells(np.zeros(dims, bool), np.zeros((*dims, 3)), np.zeros((*dims, 3)))
-    field = np.zeros((*dims, 4))
-    field[c, c, c, 0] = 1.0 / ref.FLUX_PER_C0
-    through = np.zeros(size)
-    for _ in range(steps):
-        through += ref.inflow(ref.face_fluxes(field, cell["open"], transfer))[c, c, :, 0]
-        field, _, _ = ref.step(field, cell, transfer)
+    through, _ = ref.point_source_axis_irradiance(steps, size, transfer)
     r = np.arange(2, 13)
     print(f"{transfer}: point source, {steps} steps on {size}^3 cells: 4 pi r^2 E(r) on the axis (exact 1)")
-    print("  ".join(f"r={k}: {v:.2f}" for k, v in zip(r, 4 * np.pi * r**2 * through[c + r], strict=True)))
+    print("  ".join(f"r={k}: {v:.2f}" for k, v in zip(r, 4 * np.pi * r**2 * through[r], strict=True)))
 
 
 def main() -> None:

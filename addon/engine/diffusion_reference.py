@@ -275,3 +275,19 @@ def lookup(points_cells: np.ndarray, normals: np.ndarray, cell: dict, flux_plus:
     value = np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0),
                      np.where(den_t > 0.0, num_t / np.where(den_t > 0.0, den_t, 1.0), 0.0))
     return value / np.pi
+
+
+def point_source_axis_irradiance(steps=120, size=41, transfer="cone"):
+    """An isotropic point source of 1 W in the centre cell of an empty grid: per distance r (cells) along
+    +x, the flux entering that cell through its -x face over `steps` steps, which a small receiver facing
+    the source absorbs (its irradiance x its area), and the flux still in flight at the end."""
+    dims = (size, size, size)
+    c = size // 2
+    cell = cells(np.zeros(dims, bool), np.zeros((*dims, 3)), np.zeros((*dims, 3)))
+    field = np.zeros((*dims, 4))
+    field[c, c, c, 0] = 1.0 / FLUX_PER_C0
+    through = np.zeros(size)
+    for _ in range(steps):
+        through += inflow(face_fluxes(field, cell["open"], transfer))[c, c, :, 0]
+        field, _, _ = step(field, cell, transfer)
+    return through[c:], flux_w(field)

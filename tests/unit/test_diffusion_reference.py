@@ -217,22 +217,6 @@ def test_a_uniform_radiance_gives_its_irradiance_on_any_surface():
     np.testing.assert_allclose(value, radiance, rtol=1e-12)
 
 
-def point_source_axis_irradiance(steps=120, size=41, transfer="cone"):
-    """An isotropic point source of 1 W in the centre cell of an empty grid: per distance r (cells) along
-    +x, the flux entering that cell through its -x face over `steps` steps, which a small receiver facing
-    the source absorbs (its irradiance x its area), and the flux still in flight at the end."""
-    dims = (size, size, size)
-    c = size // 2
-    cell = ref.cells(np.zeros(dims, bool), np.zeros((*dims, 3)), np.zeros((*dims, 3)))
-    field = np.zeros((*dims, 4))
-    field[c, c, c, 0] = 1.0 / ref.FLUX_PER_C0
-    through = np.zeros(size)
-    for _ in range(steps):
-        through += ref.inflow(ref.face_fluxes(field, cell["open"], transfer))[c, c, :, 0]
-        field, _, _ = ref.step(field, cell, transfer)
-    return through[c:], ref.flux_w(field)
-
-
 def _point_source_defect(transfer, measured):
     return pytest.param(transfer, marks=pytest.mark.xfail(strict=True, reason=(
         f"measured: 4 pi r^2 E on the axis falls from {measured} between 4 and 12 cells: light scatters at "
@@ -247,7 +231,7 @@ def test_a_point_sources_irradiance_falls_as_inverse_square(transfer):
     # Exact: E(r) = (1 W / 4 pi) / (r h)^2 facing the source, so r^2 x the flux a unit-area receiver takes
     # is 1 / (4 pi) at every r; beyond 4 cells (the source's own cell and its neighbours are not a point)
     # to 12 (light from the 41-cell grid's edge, 20 cells out, does not come back) within 10 %.
-    flux, _ = point_source_axis_irradiance(transfer=transfer)
+    flux, _ = ref.point_source_axis_irradiance(transfer=transfer)
     r = np.arange(4, 13)
     np.testing.assert_allclose(4.0 * np.pi * r**2 * flux[r], 1.0, rtol=0.10)
 
@@ -256,7 +240,7 @@ def test_a_point_sources_light_leaves_it_at_one_cell_per_step():
     # What the transport does hold: every watt is either in flight or has crossed the face of the
     # source's neighbourhood (conservation; the grid's edge is 20 cells out and nothing comes back from
     # outside), and no light travels faster than a cell per step: after 3 steps nothing is 4 cells out.
-    flux, in_flight = point_source_axis_irradiance(steps=3, size=21)
+    flux, in_flight = ref.point_source_axis_irradiance(steps=3, size=21)
     assert not flux[4:].any() and flux[3] > 0
     assert in_flight == pytest.approx(1.0, rel=1e-12)
 
