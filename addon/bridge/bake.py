@@ -27,7 +27,17 @@ import numpy as np
 from ..engine import choice, methods
 from ..engine.config import settings as complete_settings
 from ..engine.errors import ConfigError, SceneError
-from ..engine.lightmap import PASSES, TARGETS, check_choice, dilate, output_path, safe_name, shard, uv_problems
+from ..engine.lightmap import (
+    PASSES,
+    TARGETS,
+    VOLUME_TARGETS,
+    check_choice,
+    dilate,
+    output_path,
+    safe_name,
+    shard,
+    uv_problems,
+)
 from ..engine.scene import Camera
 from . import images
 from .bake_raster import TexelBaker
@@ -333,8 +343,8 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
 
     check_choice(pass_name, PASSES, "--pass")
     check_choice(target, TARGETS, "--target")
-    if target == "volume":
-        raise ConfigError("a volume is one per scene, not per object: use bake_volume (--target volume)")
+    if target in VOLUME_TARGETS:
+        raise ConfigError(f"--target {target} is one per scene, not per object: use bake_volume / bake_probes")
     size = IMAGE_SIZE_TEXELS if size is None else size
     if not 8 <= size <= 8192:
         raise ConfigError(f"--size must be in 8..8192, got {size}")
@@ -459,9 +469,6 @@ def bake_volume(blend: Path, out_dir: Path, settings: dict, overwrite: bool = Fa
     (plain trilinear where all are 0): a cell holding a surface facing the receiver holds light its own
     geometry half-blocked (docs/LPV.md, "Lookup"). The finest cascade is written when there are several.
     """
-    from .pipeline import backend as default_backend
-    from .pipeline import open_blend
-
     settings = complete_settings(**settings)
     gi = settings["gi"]
     if gi.method != "lpv":
@@ -470,28 +477,93 @@ def bake_volume(blend: Path, out_dir: Path, settings: dict, overwrite: bool = Fa
     path = out_dir / f"{safe_name(Path(blend).stem)}_lpv_sh.npz"
     if path.exists() and not overwrite:
         raise SceneError(f"{path} exists (use --overwrite)")
-    say = _stderr_lines(progress)
-    say(f"bake: opening {blend}")
-    open_blend(blend)
-    define_light_switch()
     t0 = time.perf_counter()
-    say("bake: capturing the scene, propagating the LPV")
-    # The light field is solved without a camera: the volume depends on no view.
-    scene = replace(SceneCache().update(bpy.context.evaluated_depsgraph_get(), 1, 1), camera=None)
-    be = backend or default_backend()
-    method = methods.create(be, settings)
-    method.set_scene(scene)
+    be, scene, method = _scene_without_camera(blend, settings, backend, _stderr_lines(progress),
+                                              "capturing the scene, propagating the LPV")
     timings = method.solve_volume()
     sh = {f"sh_{c}": be.read(method.accumulated[f"acc_{c}"]) for c in "rgb"}
     grid = method.grid
     extra = {} if method.vox_normal is None else {"vox_normal": be.read(method.vox_normal)}
     np.savez_compressed(path, **sh, **extra, origin_m=grid.origin_m + method.origin_m,
                         cell_size_m=grid.cell_size_m, dims=np.array(grid.dims))
+    summary = {"blend": str(blend), "file": str(path), "dims": list(grid.dims), "cell_size_m": grid.cell_size_m,
+               "time_ms": round((time.perf_counter() - t0) * 1e3, 2), "config": {"lpv": method.lpv_config.to_dict()},
+               "solves": method.solves, "solve_ms": round(timings["solve"], 2),
+               "warnings": _volume_warnings(blend, scene)}
+    print(f"{Path(blend).name}: volume {grid.dims[0]}x{grid.dims[1]}x{grid.dims[2]} -> {path}")
+    return summary
+
+
+def bake_probes(blend: Path, out_dir: Path, settings: dict, overwrite: bool = False,
+                backend=None, progress: bool = True) -> dict:
+    """Method `probes`' solved probe volume for engines (engine/probe_export.py; docs/BAKE.md):
+    DIR/<stem>_probes.json (the layout: grid, faces, tiles, units, files) and three EXR atlases,
+    <stem>_probes_sh.exr, <stem>_probes_irradiance.exr and <stem>_probes_moments.exr. Every bounce the
+    settings ask for is in them; no camera is involved. Returns the summary (also in bake.json's form)."""
+    from ..engine import probe_export
+    from ..engine.passes.probe_project import IRRADIANCE_TEXELS
+
+    settings = complete_settings(**settings)
+    gi = settings["gi"]
+    if gi.method != "probes":
+        raise ConfigError(f"--target probes bakes the probe grid: use --method probes (got {gi.method})")
+    out_dir = check_output_dir(Path(out_dir))
+    stem = safe_name(Path(blend).stem)
+    paths = {k: out_dir / f"{stem}_probes_{k}.exr" for k in ("sh", "irradiance", "moments")}
+    layout_path = out_dir / f"{stem}_probes.json"
+    existing = [str(p) for p in (*paths.values(), layout_path) if p.exists()]
+    if existing and not overwrite:
+        raise SceneError(f"{existing[0]} exists (use --overwrite)")
+    t0 = time.perf_counter()
+    be, scene, method = _scene_without_camera(blend, settings, backend, _stderr_lines(progress),
+                                              "capturing the scene, solving the probes")
+    timings = method.solve_light_field()
+    grid = method.grid
+    light = be.read(method.light)
+    if method.irradiance_encoding:
+        irradiance = light[..., :3]
+        coeffs = probe_export.sh_from_irradiance(grid, irradiance, IRRADIANCE_TEXELS)
+    else:
+        coeffs = probe_export.sh_grid(grid, light)
+        irradiance = probe_export.irradiance_from_sh(grid, coeffs, IRRADIANCE_TEXELS)
+    moments = be.read(method.moments)[..., :3].copy()
+    moments[..., 2] = 0.0
+    atlases = {"sh": probe_export.sh_table(grid, coeffs), "irradiance": irradiance, "moments": moments}
+    for key, atlas in atlases.items():
+        images.write_exr(paths[key], np.asarray(atlas, np.float32)[::-1])  # EXR row 0 = the atlas's top
+    probes_off = np.flatnonzero(be.read(method.state)[..., 0].ravel() < 0.5)
+    doc = probe_export.layout(grid, method.origin_m, method.probes_config.encoding, IRRADIANCE_TEXELS,
+                              probes_off.tolist(), {k: p.name for k, p in paths.items()})
+    layout_path.write_text(json.dumps(doc, indent=2))
+    summary = {"blend": str(blend), "file": str(layout_path), "files": [str(p) for p in paths.values()],
+               "dims": list(grid.dims), "spacing_m": grid.spacing_m, "probes_off": len(probes_off),
+               "time_ms": round((time.perf_counter() - t0) * 1e3, 2),
+               "config": {"probes": method.probes_config.to_dict(), "bounces": gi.bounces},
+               "solves": method.solves, "solve_ms": round(timings["solve"], 2),
+               "warnings": _volume_warnings(blend, scene)}
+    print(f"{Path(blend).name}: probes {grid.dims[0]}x{grid.dims[1]}x{grid.dims[2]} -> {layout_path}")
+    return summary
+
+
+def _scene_without_camera(blend: Path, settings: dict, backend, say, doing: str):
+    """Open `blend`, capture it without a camera (a volume depends on no view) and set it on a new
+    method: (backend, scene, method)."""
+    from .pipeline import backend as default_backend
+    from .pipeline import open_blend
+
+    say(f"bake: opening {blend}")
+    open_blend(blend)
+    define_light_switch()
+    say(f"bake: {doing}")
+    scene = replace(SceneCache().update(bpy.context.evaluated_depsgraph_get(), 1, 1), camera=None)
+    be = backend or default_backend()
+    method = methods.create(be, settings)
+    method.set_scene(scene)
+    return be, scene, method
+
+
+def _volume_warnings(blend: Path, scene) -> list[str]:
     warnings = [w for w in [empty_light_warning(scene)] if w]
     for warning in warnings:
         print(f"warning: {Path(blend).name}: {warning}", file=sys.stderr)
-    summary = {"blend": str(blend), "file": str(path), "dims": list(grid.dims), "cell_size_m": grid.cell_size_m,
-               "time_ms": round((time.perf_counter() - t0) * 1e3, 2), "config": {"lpv": method.lpv_config.to_dict()},
-               "solves": method.solves, "solve_ms": round(timings["solve"], 2), "warnings": warnings}
-    print(f"{Path(blend).name}: volume {grid.dims[0]}x{grid.dims[1]}x{grid.dims[2]} -> {path}")
-    return summary
+    return warnings

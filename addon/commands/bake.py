@@ -1,5 +1,5 @@
 """`python -m addon bake F.blend [G.blend ...] --out DIR ...`: lightmaps (EXR per object), vertex
-colours, or the LPV's SH volume. With several files each gets its own DIR/<file stem>/ and bake.json,
+colours, the LPV's SH volume, or the probe grid. With several files each gets its own DIR/<file stem>/ and bake.json,
 and DIR/bake.json lists them: one run bakes a whole set of .blend files (a farm job shards objects).
 
 Every config field has a flag (commands/_settings.py) with the scene settings' default. Every argument
@@ -13,14 +13,13 @@ from pathlib import Path
 
 from ..engine.config import GIConfig
 from ..engine.errors import ConfigError, SceneError
-from ..engine.lightmap import PASSES, TARGETS, check_choice, parse_shard, safe_name
+from ..engine.lightmap import PASSES, TARGETS, VOLUME_TARGETS, check_choice, parse_shard, safe_name
 from ._args import existing_blend
 from ._settings import add_budget_flags, add_config_flags, budget, check_bounces, configs, given
 
 NAME = "bake"
 HELP = ("bake direct/indirect light per texel (DIR/<object>_<pass>.exr) or per mesh corner (colour attribute "
         "bounce_<pass>); DIR/bake.json summarises")
-VOLUME_METHOD = "lpv"  # the volume is the LPV's SH grid
 
 
 def add_arguments(p) -> None:
@@ -31,8 +30,9 @@ def add_arguments(p) -> None:
                    help="lightmap side in texels (default: 512; --target image and vertex-colors' G-buffer)")
     p.add_argument("--pass", dest="pass_name", default="indirect", help="indirect, direct or combined (= both)")
     p.add_argument("--target", default="image",
-                   help="image (EXR per object), vertex-colors (needs --save-blend), or volume (the LPV's SH "
-                        "grid: --method lpv, the default there)")
+                   help="image (EXR per object), vertex-colors (needs --save-blend), volume (the LPV's SH grid: "
+                        "--method lpv, the default there) or probes (the probe grid's EXR atlases and layout: "
+                        "--method probes, the default there)")
     p.add_argument("--overwrite", action="store_true", help="replace existing files (default: skip them)")
     p.add_argument("--shard", default=None, help="i/n: bake every n-th object (sorted names) starting at i")
     p.add_argument("--save-blend", default=None, help="vertex-colors: save a copy of the .blend with the attributes")
@@ -53,12 +53,14 @@ def _objects(text: str | None) -> list[str] | None:
 
 def _check_target(args) -> None:
     """What a target needs, refused once before anything is loaded."""
-    if args.target == "volume":
-        if given(args, "method") and args.method != VOLUME_METHOD:
-            raise ConfigError(f"--target volume bakes the LPV's grid: use --method {VOLUME_METHOD} "
+    if args.target in VOLUME_TARGETS:
+        method = VOLUME_TARGETS[args.target]
+        what = {"volume": "the LPV's grid", "probes": "the probe grid"}[args.target]
+        if given(args, "method") and args.method != method:
+            raise ConfigError(f"--target {args.target} bakes {what}: use --method {method} "
                               f"(got --method {args.method})")
         if args.size is not None:
-            raise ConfigError("--size has no meaning with --target volume (the grid's size is --grid-cells)")
+            raise ConfigError(f"--size has no meaning with --target {args.target} (one {what} per scene)")
     elif args.target == "vertex-colors" and not args.save_blend:
         raise ConfigError("--target vertex-colors writes colour attributes into a copy of the .blend: "
                           "give --save-blend OUT.blend (the input file is never modified)")
@@ -77,9 +79,9 @@ def run(args) -> int:
     check_choice(args.target, TARGETS, "--target")
     _check_target(args)
     index, count = parse_shard(args.shard)
-    volume = args.target == "volume"
+    volume = VOLUME_TARGETS.get(args.target)  # the method a per-scene target bakes, else None
     chosen_for = budget(args)
-    settings = configs(args, **({"method": VOLUME_METHOD} if volume else {}))
+    settings = configs(args, **({"method": volume} if volume else {}))
     gi = settings["gi"]
     if chosen_for is None:
         check_bounces(gi)
@@ -93,12 +95,13 @@ def run(args) -> int:
     if len(blends) > 1 and args.save_blend:
         raise SceneError("--save-blend takes one input file")
     objects = _objects(args.objects)
-    from ..bridge.bake import bake_file, bake_volume  # imports bpy: only when actually baking
+    from ..bridge.bake import bake_file, bake_probes, bake_volume  # imports bpy: only when actually baking
 
     out = Path(args.out)
     if volume:
+        bake = bake_volume if args.target == "volume" else bake_probes
         for blend in blends:
-            bake_volume(blend, out, settings, args.overwrite, progress=not args.quiet)
+            bake(blend, out, settings, args.overwrite, progress=not args.quiet)
         return 0
     failed, files = [], {}
     for blend in blends:

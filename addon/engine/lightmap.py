@@ -14,7 +14,9 @@ import numpy as np
 from .errors import ConfigError
 
 PASSES = ("indirect", "direct", "combined")
-TARGETS = ("image", "vertex-colors", "volume")
+TARGETS = ("image", "vertex-colors", "volume", "probes")
+# Targets baked once per scene, not per object, and the method each bakes: the LPV's SH grid, the probes.
+VOLUME_TARGETS = {"volume": "lpv", "probes": "probes"}
 
 
 def dilate(image: np.ndarray, covered: np.ndarray, iterations: int = 16) -> tuple[np.ndarray, np.ndarray]:

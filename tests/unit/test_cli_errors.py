@@ -59,6 +59,8 @@ def test_bad_setting_names_the_flag(capsys, tmp_path, blend, command, flags, lin
     (["--target", "vertex-colors"], ["--target vertex-colors", "--save-blend"]),
     (["--target", "volume", "--method", "rsm"], ["--target volume", "--method lpv", "rsm"]),
     (["--target", "volume", "--size", "64"], ["--size", "--target volume"]),
+    (["--target", "probes", "--method", "vct"], ["--target probes", "--method probes", "vct"]),
+    (["--target", "probes", "--size", "64"], ["--size", "--target probes"]),
     (["--method", "direct"], ["--pass indirect", "--method direct"]),
     (["--method", "direct", "--pass", "combined"], ["--pass combined", "--method direct"]),
     (["--size", "4"], ["--size 4: out of range"]),
