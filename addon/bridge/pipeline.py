@@ -136,6 +136,7 @@ def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
         "runs": repeat,
         "samples": gi.samples,
         "refine_ms": refine_ms,  # the gathers after the first, all together
+        "work": method.work(),  # the method's own counts of its work (e.g. lpv's propagation cell-steps)
         **({"update_ms": update_ms} if update_ms is not None else {}),
         **{k: v for k, v in decided.items() if k != "features"},
         "scene_features": decided.get("features"),

@@ -346,7 +346,7 @@ def test_quick_bench_on_cornell(tmp_path):
 
     # results.json: one record per run, the report's numbers, update costs timed by default
     results = json.loads((out / "results.json").read_text())
-    assert results["schema"] == bench.RESULTS_SCHEMA == 2 and results["command"] == result["command"]
+    assert results["schema"] == bench.RESULTS_SCHEMA == 3 and results["command"] == result["command"]
     assert set(results["machine"]) >= {"cpu", "bounce_renderer", "blender", "date", "commit", "dirty",
                                           "load_average_1min"}
     assert [(r["scene"], r["method"], r["setting"], r["default"]) for r in results["records"]] == \
@@ -359,6 +359,7 @@ def test_quick_bench_on_cornell(tmp_path):
                                                                      r["total_ms"])
         assert rec["speedup_oidn"] is None and rec["vs_eevee"] is None
         assert rec["full"] is None  # direct has no indirect light: no full image to compare
+        assert rec["work"] == {}  # direct counts no work of its own (lpv: tests/gpu/test_lpv.py)
         assert set(rec["update_ms"]) == {"full", "lights", "camera"}
         assert all(math.isfinite(ms) and ms > 0 for ms in rec["update_ms"].values()), rec["update_ms"]
     assert all(sc["noise_floor"]["direct"][k] is not None for k in ("rel_rmse", "rel_rmse_8", "bias"))

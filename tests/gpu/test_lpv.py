@@ -1117,6 +1117,18 @@ def octree_method(gl, merge, levels=3, k=4):
 
 
 @pytest.mark.parametrize("merge", ["index", "time"])
+def test_octree_work_counts_every_levels_cells_times_steps(gl, merge):
+    # work() is the benchmarks' machine-independent cost: sum over levels of cells x steps, exactly the
+    # steps lpv_octree.steps gives each level of this 16^3 chain (k = 4, three levels).
+    method = octree_method(gl, merge)
+    method.run()
+    grids = [method.levels[0].grid, *[lv.grid for lv in method.levels[0].octree]]
+    span = min(256, sum(grids[-1].dims) - 3)
+    want = sum(lpv_octree.steps(i, 4, 3, merge, span) * int(np.prod(g.dims)) for i, g in enumerate(grids))
+    assert method.work() == {"propagation_cell_steps": want} and want > 0
+
+
+@pytest.mark.parametrize("merge", ["index", "time"])
 def test_octree_propagation_equals_numpy(gl, merge):
     # The method's own path (fill_octree summing the source down the chain, each level's steps with
     # its shares, the merges) against lpv_octree_reference from one isotropic source and one lobe in

@@ -253,6 +253,11 @@ class DirectMethod:
         self._emitter_rows = table
         self.emitters = self.backend.texture((table.shape[1], table.shape[0]), data=table)
 
+    def work(self) -> dict[str, int]:
+        """Counts of what the last solve (and the bounces after it) did, for benchmarks: the method's own
+        measure of work beside its times ({} when it has none; stats.json and results.json `work`)."""
+        return {}
+
     def keeps_light_field(self) -> bool:
         """Whether the light field stays valid when only the camera or the G-buffer changes (methods
         whose solve depends on the camera, or whose gather consumes its light field, say no)."""

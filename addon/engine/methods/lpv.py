@@ -177,6 +177,7 @@ class LpvMethod(OneBounceMethod):
         self.lpv_config = lpv_config if lpv_config is not None else LpvConfig()
         self.levels: list[LpvVolume] = []
         self.classes = uses_emitter_classes(self.lpv_config)  # fixed with the config
+        self.cell_steps = 0  # propagation work since the last solve began: cells x steps, over every grid
 
     # The finest grid's textures (the only grid when cascades = 1).
     grid = property(lambda self: self.levels[0].grid)
@@ -251,6 +252,7 @@ class LpvMethod(OneBounceMethod):
         return super().keeps_light_field() and self.lpv_config.cascades == 1 and self.gi.bounces == 1
 
     def begin_solve(self, timings: dict[str, float]) -> None:
+        self.cell_steps = 0
         if len(self.levels) > 1:
             with self.step(timings, lpv_cascade.PLACE_DECL):
                 self.follow_camera()
@@ -316,10 +318,16 @@ class LpvMethod(OneBounceMethod):
             lpv_octree.merge(self.backend, accs[i + 1], chain[i + 1].grid, accs[i], chain[i].grid, mode,
                              cfg.octree_epsilon)
 
+    def work(self) -> dict[str, int]:
+        """Propagation cell-steps (cells x steps summed over grids, levels and bounces): what the transport
+        costs independently of the machine (docs/LPV.md's octree table)."""
+        return {"propagation_cell_steps": self.cell_steps}
+
     def _steps(self, level: LpvVolume, n: int, acc: dict, share=None) -> None:
         """n propagation steps of `level` from its snapshot set 0, accumulated into acc (overwritten),
         step s (1-based) weighted by share(s) when given."""
         sets = level.snapshots
+        self.cell_steps += n * int(np.prod(level.grid.dims))
         for i in range(n):
             src = sets[0] if i == 0 else sets[2 - i % 2]
             lpv_propagate.run(self.backend, src, sets[1 + i % 2], acc, level.grid, transport(self.lpv_config),
