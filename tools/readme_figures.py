@@ -1,6 +1,6 @@
-"""Rewrite README.md's generated figure blocks from the benchmarks' results.json files.
+"""Rewrite the generated figure blocks of README.md and docs/ from the benchmarks' results.json files.
 
-    .venv/bin/python tools/readme_figures.py            # rewrite the blocks in README.md
+    .venv/bin/python tools/readme_figures.py            # rewrite the blocks (README.md, docs/LPV.md)
     .venv/bin/python tools/readme_figures.py --check    # exit 1 if a block differs from its results.json
 
 A block is the text between `<!-- figures:NAME:begin -->` and `<!-- figures:NAME:end -->`; everything
@@ -22,6 +22,8 @@ ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
 UPDATES_JSON = ROOT / "benchmarks" / "updates" / "results.json"
 DEFAULTS_JSON = ROOT / "benchmarks" / "defaults" / "results.json"
+LPV_DOC = ROOT / "docs" / "LPV.md"
+OCTREE_JSON = ROOT / "benchmarks" / "octree" / "results.json"
 LPV_CAMERA_TARGET_PCT = 15  # the issue's target: lpv's camera update <= 15 % of its full update
 _BLOCK = re.compile(r"(<!-- figures:(?P<name>[a-z0-9-]+):begin -->\n)(?P<body>.*?)(<!-- figures:(?P=name):end -->)",
                     re.S)
@@ -152,40 +154,113 @@ def methods_block(results: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-# block name -> (its results.json, the function that formats it)
-BLOCKS: dict[str, tuple[Path, Callable[[dict], str]]] = {
-    "update-costs": (UPDATES_JSON, update_costs_block),
-    "accuracy": (DEFAULTS_JSON, accuracy_block),
-    "methods": (DEFAULTS_JSON, methods_block),
+# The octree table's columns: each a registry benchmark row of lpv (registry.METHODS), matched exactly.
+OCTREE_COLUMNS = (
+    ("far field (default)", None),
+    ("one grid", {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.far_field": False}),
+    ("octree, paper (index, eps -> 0, 5 levels blocked, k = 4)",
+     {"lpv.variant": "octree", "lpv.octree_merge": "index", "lpv.octree_levels": 5, "lpv.octree_iterations": 4,
+      "lpv.octree_epsilon": 1e-6, "lpv.octree_blocked_levels": 5}),
+    ("octree, index (eps 0.5, 3 blocked, k = 4)",
+     {"lpv.variant": "octree", "lpv.octree_merge": "index", "lpv.octree_levels": 5, "lpv.octree_iterations": 4}),
+    ("octree, ours (time, its defaults)", {"lpv.variant": "octree"}),
+)
+# The passes that move light through the grids (the far field's add and the octree's merges included).
+PROPAGATION_PASSES = ("lpv_inflow", "lpv_propagate", "lpv_far_field", "lpv_octree")
+
+
+def _propagation_ms(record: dict) -> float:
+    return sum(record["timings_ms"].get(k, 0.0) for k in PROPAGATION_PASSES)
+
+
+def octree_block(results: dict) -> str:
+    """Table: per scene, lpv's far field (its default), one grid and the three octree rows side by side:
+    rel_rmse_8 / bias, propagation ms and cell-steps (results.json `work`); then, per octree row, on how
+    many scenes it beats one grid and the far field, and its propagation time against one grid's."""
+    lpv = [r for r in results["records"] if r["method"] == "lpv"]
+    def pick(scene: str, setting: dict | None) -> dict | None:
+        return next((r for r in lpv if r["scene"] == scene
+                     and (r["default"] if setting is None else r["setting"] == setting)), None)
+
+    scenes = list(dict.fromkeys(r["scene"] for r in lpv))
+    lines = ["**lpv: the octree against the far field and one grid.**", "",
+             _produced_by(results) + f" {results['res']} px long side, Cycles reference {results['ref_spp']} spp, "
+             f"one bounce. Cells: rel_rmse_8 / bias, propagation ms (the passes {', '.join(PROPAGATION_PASSES)}; "
+             f"medians of {results['repeat']} updates), cell-steps in thousands (cells x steps over every grid "
+             "and level).", "",
+             "| scene | " + " | ".join(title for title, _ in OCTREE_COLUMNS) + " |",
+             "| --- " * (1 + len(OCTREE_COLUMNS)) + "|"]
+    for scene in scenes:
+        cells = []
+        for _, setting in OCTREE_COLUMNS:
+            r = pick(scene, setting)
+            if r is None or r["rel_rmse_8"] is None:
+                cells.append("–")
+                continue
+            steps = r.get("work", {}).get("propagation_cell_steps")
+            cells.append(f"{r['rel_rmse_8']:.3f} / {r['bias']:.2f}, {_propagation_ms(r):.0f} ms"
+                         + (f", {steps / 1e3:.0f}k" if steps is not None else ""))
+        lines.append(f"| {scene} | " + " | ".join(cells) + " |")
+    lines.append("")
+    for title, setting in OCTREE_COLUMNS[2:]:
+        pairs = [(pick(s, setting), pick(s, OCTREE_COLUMNS[1][1]), pick(s, None)) for s in scenes]
+        pairs = [(o, g, f) for o, g, f in pairs if o and g and f and None not in
+                 (o["rel_rmse_8"], g["rel_rmse_8"], f["rel_rmse_8"])]
+        if not pairs:
+            continue
+        below_grid = sum(o["rel_rmse_8"] <= g["rel_rmse_8"] for o, g, _ in pairs)
+        below_far = sum(o["rel_rmse_8"] <= f["rel_rmse_8"] for o, _, f in pairs)
+        ratio = _median([_propagation_ms(o) / _propagation_ms(g) for o, g, _ in pairs if _propagation_ms(g) > 0])
+        lines.append(f"- {title}: error at most one grid's on {below_grid} of {len(pairs)} scenes and at most the "
+                     f"far field's on {below_far}; propagation time a median {100 * ratio:.0f} % of one grid's.")
+    return "\n".join(lines) + "\n"
+
+
+# block name -> (the file it is in, its results.json, the function that formats it)
+BLOCKS: dict[str, tuple[Path, Path, Callable[[dict], str]]] = {
+    "update-costs": (README, UPDATES_JSON, update_costs_block),
+    "accuracy": (README, DEFAULTS_JSON, accuracy_block),
+    "methods": (README, DEFAULTS_JSON, methods_block),
+    "lpv-octree": (LPV_DOC, OCTREE_JSON, octree_block),
 }
 
 
-def render_blocks() -> dict[str, str]:
-    return {name: fmt(load(path)) for name, (path, fmt) in BLOCKS.items()}
+def documents() -> list[Path]:
+    """The files that hold generated blocks."""
+    return list(dict.fromkeys(doc for doc, _, _ in BLOCKS.values()))
+
+
+def render_blocks(doc: Path = README) -> dict[str, str]:
+    """The bodies of `doc`'s blocks, from their results.json files."""
+    return {name: fmt(load(path)) for name, (where, path, fmt) in BLOCKS.items() if where == doc}
 
 
 def rewrite(text: str, blocks: dict[str, str]) -> str:
     """`text` with the body of every block named in `blocks` replaced; a named block missing from the
-    text is an error (a README edit removed its markers)."""
+    text is an error (an edit removed its markers)."""
     missing = set(blocks) - {m["name"] for m in _BLOCK.finditer(text)}
     if missing:
-        raise ValueError(f"README has no markers for block(s): {', '.join(sorted(missing))}")
+        raise ValueError(f"the text has no markers for block(s): {', '.join(sorted(missing))}")
     return _BLOCK.sub(lambda m: m[1] + blocks.get(m["name"], m["body"]) + m[4], text)
 
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--check", action="store_true", help="exit 1 if README.md's blocks are not up to date")
+    p.add_argument("--check", action="store_true", help="exit 1 if a generated block is not up to date")
     args = p.parse_args(argv)
-    text = README.read_text()
-    new = rewrite(text, render_blocks())
-    if args.check:
+    stale = []
+    for doc in documents():
+        text = doc.read_text()
+        new = rewrite(text, render_blocks(doc))
         if new != text:
-            print("README.md's figure blocks differ from benchmarks' results.json: run tools/readme_figures.py",
-                  file=sys.stderr)
-            return 1
-        return 0
-    README.write_text(new)
+            stale.append(doc)
+            if not args.check:
+                doc.write_text(new)
+    if args.check and stale:
+        names = ", ".join(str(d.relative_to(ROOT)) for d in stale)
+        print(f"{names}: figure blocks differ from benchmarks' results.json: run tools/readme_figures.py",
+              file=sys.stderr)
+        return 1
     return 0
 
 
