@@ -1,10 +1,12 @@
 """One `diffusion` propagation step (both transfers) against one `lpv` step (improved, geometry volume: its
 defaults), on
 the same backend in the same run, on a grid of N^3 cells a third of which hold surfaces (docs/DIFFUSION.md,
-"Speed"). Each figure: the median over 5 rounds of (32 steps, finish()) / 32, alternating the methods so
-both see the same load.
+"Speed"). Each figure: the median over the rounds of (32 steps, finish()) / 32, alternating the methods so
+all see the same load; wall-clock ms and the process's CPU ms (llvmpipe runs the shaders on this
+process's threads, so its CPU time is the work done, which other processes on a shared machine move much
+less than the wall clock), and each against lpv's.
 
-Run: .venv/bin/python tools/diffusion_step_time.py [--cells 32]
+Run: .venv/bin/python tools/diffusion_step_time.py [--cells 32] [--rounds 5]
 """
 
 from __future__ import annotations
@@ -23,13 +25,15 @@ from addon.engine.backends.moderngl_backend import ModernGLBackend  # noqa: E402
 from addon.engine.grid import Grid  # noqa: E402
 from addon.engine.passes import diffusion_cells, diffusion_propagate, lpv_propagate  # noqa: E402
 
-STEPS, ROUNDS = 32, 5
+STEPS = 32
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cells", type=int, default=32)
-    n = parser.parse_args().cells
+    parser.add_argument("--rounds", type=int, default=5)
+    args = parser.parse_args()
+    n, rounds = args.cells, args.rounds
     be = ModernGLBackend()
     grid = Grid(np.zeros(3), 0.1, (n, n, n))
     rng = np.random.default_rng(0)
@@ -62,17 +66,21 @@ def main() -> None:
             lpv_propagate.run(be, sets[i % 2], sets[(i + 1) % 2], acc, grid, "improved", i == 0, blocking)
 
     runs = {"diffusion (cone)": diffusion("cone"), "diffusion (directional)": diffusion("directional"), "lpv": lpv}
-    times = {name: [] for name in runs}
-    for round_ in range(ROUNDS + 1):  # the first round compiles and warms up
+    wall = {name: [] for name in runs}
+    cpu = {name: [] for name in runs}
+    for round_ in range(rounds + 1):  # the first round compiles and warms up
         for name, steps in runs.items():
             be.finish()
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             steps()
             be.finish()
             if round_:
-                times[name].append((time.perf_counter() - t0) * 1e3 / STEPS)
-    for name, t in times.items():
-        print(f"{name}: {statistics.median(t):.2f} ms per step at {n}^3 (median of {ROUNDS} x {STEPS} steps)")
+                wall[name].append((time.perf_counter() - t0) * 1e3 / STEPS)
+                cpu[name].append((time.process_time() - c0) * 1e3 / STEPS)
+    for name in runs:
+        w, c = statistics.median(wall[name]), statistics.median(cpu[name])
+        print(f"{name}: {w:.2f} ms per step at {n}^3 ({w / statistics.median(wall['lpv']):.2f}x lpv), "
+              f"{c:.2f} CPU ms ({c / statistics.median(cpu['lpv']):.2f}x lpv) (median of {rounds} x {STEPS} steps)")
     print("renderer:", be.renderer)
 
 

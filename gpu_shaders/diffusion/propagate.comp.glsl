@@ -33,8 +33,9 @@ vec4 directional(vec4 c, int f) {
 #endif
 
 // Of one channel's field c: the flux sent through `face` once clamped, masked by the open faces and
-// scaled to the cell's flux; `shape` = the SH it arrives as per W.
-float channel_outflow(vec4 c, vec3 open_plus, vec3 open_minus, int face, out vec4 shape) {
+// scaled to the cell's flux (returned, W); `carried` = the SH that flux arrives as (the transfer's shape
+// times the flux; DIRECTIONAL: M_d c x open x scale, which is M_d c / raw x the flux without dividing).
+float channel_outflow(vec4 c, vec3 open_plus, vec3 open_minus, int face, out vec4 carried) {
     vec3 along = c.wyz;  // the coefficients of x, y, z
     vec3 raw_plus = RAW_K0 * c.x + RAW_K1 * along;
     vec3 raw_minus = RAW_K0 * c.x - RAW_K1 * along;
@@ -44,19 +45,21 @@ float channel_outflow(vec4 c, vec3 open_plus, vec3 open_minus, int face, out vec
     int axis = face >> 1;
     bool positive = (face & 1) == 0;
     float through = positive ? plus[axis] : minus[axis];
-#ifdef DIRECTIONAL
-    float raw = positive ? raw_plus[axis] : raw_minus[axis];
-    shape = directional(c, face) / (raw > 0.0 ? raw : 1.0);
-#else
-    shape = diffusion_cone(face) * DIFFUSION_TRANSFER_NORM;
-#endif
     float total = max(DIFFUSION_FLUX_PER_C0 * c.x, 0.0);
-    return sum > 0.0 ? through * (total / sum) : 0.0;
+    float scale = sum > 0.0 ? total / sum : 0.0;
+#ifdef DIRECTIONAL
+    float open = positive ? open_plus[axis] : open_minus[axis];
+    float raw = positive ? raw_plus[axis] : raw_minus[axis];
+    carried = (raw > 0.0 ? open * scale : 0.0) * directional(c, face);
+#else
+    carried = (through * scale * DIFFUSION_TRANSFER_NORM) * diffusion_cone(face);
+#endif
+    return through * scale;
 }
 
-// The flux neighbour i sends through `face` (per colour, W) and, per colour, the SH it arrives as per W.
-vec3 outflow(ivec3 i, int face, out vec4 shape_r, out vec4 shape_g, out vec4 shape_b) {
-    shape_r = shape_g = shape_b = vec4(0.0);
+// The flux neighbour i sends through `face` (per colour, W) and, per colour, the SH it arrives as.
+vec3 outflow(ivec3 i, int face, out vec4 carried_r, out vec4 carried_g, out vec4 carried_b) {
+    carried_r = carried_g = carried_b = vec4(0.0);
     if (!diffusion_inside(i)) {
         return vec3(0.0);
     }
@@ -64,9 +67,28 @@ vec3 outflow(ivec3 i, int face, out vec4 shape_r, out vec4 shape_g, out vec4 sha
     int mask = block.w <= 0.0 ? 63 : int(block.w) - 1;
     vec3 open_plus = vec3(notEqual(ivec3(mask & 1, mask & 4, mask & 16), ivec3(0)));
     vec3 open_minus = vec3(notEqual(ivec3(mask & 2, mask & 8, mask & 32), ivec3(0)));
-    return vec3(channel_outflow(texelFetch(src_r, i, 0), open_plus, open_minus, face, shape_r),
-                channel_outflow(texelFetch(src_g, i, 0), open_plus, open_minus, face, shape_g),
-                channel_outflow(texelFetch(src_b, i, 0), open_plus, open_minus, face, shape_b));
+    return vec3(channel_outflow(texelFetch(src_r, i, 0), open_plus, open_minus, face, carried_r),
+                channel_outflow(texelFetch(src_g, i, 0), open_plus, open_minus, face, carried_g),
+                channel_outflow(texelFetch(src_b, i, 0), open_plus, open_minus, face, carried_b));
+}
+
+// Face f's inflow into cell c: absorbed by c's surface (plus / minus: the side it lands on) or carried.
+// Called with a constant f for each face (main): the indices into vectors then fold at compile time,
+// where a loop over f indexed them at run time (llvmpipe: the step took 1.3x lpv's; docs/DIFFUSION.md).
+void inflow(ivec3 c, int f, bool occupied, vec4 block, vec3 n, inout vec3 plus, inout vec3 minus,
+            inout vec4 r, inout vec4 g, inout vec4 b) {
+    vec3 d = diffusion_direction(f);
+    vec4 carried_r, carried_g, carried_b;
+    vec3 a = outflow(c - ivec3(d), f, carried_r, carried_g, carried_b);
+    float absorb = occupied ? block[f >> 1] : 0.0;
+    vec3 absorbed = a * absorb;
+    float dn = dot(d, n);
+    float to_plus = dn < -DIFFUSION_SIDE_EPSILON ? 1.0 : (dn > DIFFUSION_SIDE_EPSILON ? 0.0 : 0.5);
+    plus += absorbed * to_plus;
+    minus += absorbed * (1.0 - to_plus);
+    r += (1.0 - absorb) * carried_r;
+    g += (1.0 - absorb) * carried_g;
+    b += (1.0 - absorb) * carried_b;
 }
 
 void main() {
@@ -79,21 +101,12 @@ void main() {
     vec3 n = texelFetch(cell_normal, c, 0).xyz;
     vec4 r = vec4(0.0), g = vec4(0.0), b = vec4(0.0);
     vec3 plus = vec3(0.0), minus = vec3(0.0);
-    for (int f = 0; f < 6; f++) {
-        vec3 d = diffusion_direction(f);
-        vec4 shape_r, shape_g, shape_b;
-        vec3 a = outflow(c - ivec3(d), f, shape_r, shape_g, shape_b);
-        float absorb = occupied ? block[f >> 1] : 0.0;
-        vec3 absorbed = a * absorb;
-        vec3 carried = a - absorbed;
-        float dn = dot(d, n);
-        float to_plus = dn < -DIFFUSION_SIDE_EPSILON ? 1.0 : (dn > DIFFUSION_SIDE_EPSILON ? 0.0 : 0.5);
-        plus += absorbed * to_plus;
-        minus += absorbed * (1.0 - to_plus);
-        r += carried.r * shape_r;
-        g += carried.g * shape_g;
-        b += carried.b * shape_b;
-    }
+    inflow(c, 0, occupied, block, n, plus, minus, r, g, b);
+    inflow(c, 1, occupied, block, n, plus, minus, r, g, b);
+    inflow(c, 2, occupied, block, n, plus, minus, r, g, b);
+    inflow(c, 3, occupied, block, n, plus, minus, r, g, b);
+    inflow(c, 4, occupied, block, n, plus, minus, r, g, b);
+    inflow(c, 5, occupied, block, n, plus, minus, r, g, b);
     imageStore(dst_r, c, r);
     imageStore(dst_g, c, g);
     imageStore(dst_b, c, b);
