@@ -507,6 +507,8 @@ def bake_probes(blend: Path, out_dir: Path, settings: dict, overwrite: bool = Fa
     gi = settings["gi"]
     if gi.method != "probes":
         raise ConfigError(f"--target probes bakes the probe grid: use --method probes (got {gi.method})")
+    # Every probe: an engine lights dynamic objects in the space no static surface's lookup reads.
+    settings["probes"] = replace(settings["probes"], only_read_probes=False)
     out_dir = check_output_dir(Path(out_dir))
     stem = safe_name(Path(blend).stem)
     paths = {k: out_dir / f"{stem}_probes_{k}.exr" for k in ("sh", "irradiance", "moments")}

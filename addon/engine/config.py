@@ -188,6 +188,12 @@ class ProbesConfig(_Validated):
     # is the inside's, so it is switched off (1: never).
     backface_share: float = _num(1.0, 0.0, 1.0, "probe switched off when back faces fill more than this "
                                  "share of its sphere")
+    # Only the probes some lookup reads (the corners of cells within the normal bias of a triangle,
+    # probe_grid.ProbeGrid.read_by) are captured and lit; the images are the same (tested), and the
+    # others are off. Cornell at 16 a side: 2872 of 4096 probes (docs/PROBES.md). A volume for
+    # engines (`bake --target probes`) wants every probe: dynamic objects move through empty space.
+    only_read_probes: bool = field(default=True, metadata={
+        "doc": "capture and light only the probes a surface's lookup reads (off: every probe)"})
 
 
 @dataclass(frozen=True)

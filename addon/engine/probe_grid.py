@@ -105,6 +105,32 @@ class ProbeGrid:
         n, cols = self.face_texels, self.tiles_per_row
         return 3 * n * (probe % cols) + n * (face % 3), 2 * n * (probe // cols) + n * (face // 3)
 
+    def read_by(self, lo_m: np.ndarray, hi_m: np.ndarray, margin_m: float) -> np.ndarray:
+        """(count,) bool in probe order: the probes a lookup at a point of some box [lo_m[i], hi_m[i]]
+        (triangles' bounds) moved up to margin_m (the normal bias) can read, i.e. the corners of every
+        probe cell such a point falls in, with the lookup's own clamping of cells to [0, dims - 2]
+        (probes/lookup.comp.glsl). Every other probe is never weighted: capturing and lighting it is
+        wasted. Conservative: a box stands for its triangle, and the margin is widened by 1e-4 spacing
+        so the GPU's float32 rounding at a cell border cannot reach a probe left out."""
+        dims = np.array(self.dims)
+        needed = np.zeros(self.count, bool)
+        if len(lo_m) == 0:
+            return needed
+        pad = margin_m + 1e-4 * self.spacing_m
+        top = np.maximum(dims - 2, 0)
+        cell = lambda x: np.clip(np.floor((x - self.first_m) / self.spacing_m), 0, top).astype(int)  # noqa: E731
+        i0 = cell(np.asarray(lo_m, np.float64) - pad)
+        i1 = np.minimum(cell(np.asarray(hi_m, np.float64) + pad) + 1, dims - 1)  # + 1: a cell's far corners
+        # Mark every box's probe range at once: a 3D difference array, summed along each axis.
+        marks = np.zeros(tuple(dims[::-1] + 1), np.int64)  # (z, y, x)
+        for corner in range(8):
+            bits = [(corner >> axis) & 1 for axis in range(3)]
+            idx = [np.where(b, i1[:, axis] + 1, i0[:, axis]) for axis, b in enumerate(bits)]
+            np.add.at(marks, (idx[2], idx[1], idx[0]), (-1) ** sum(bits))
+        covered = marks.cumsum(0).cumsum(1).cumsum(2)[:-1, :-1, :-1] > 0
+        needed[:] = covered.ravel()  # (z, y, x) ravelled is probe order ix + nx (iy + ny iz)
+        return needed
+
     def uniforms(self) -> dict:
         """What the probe shaders need of the grid (probe.glsl)."""
         return {"probe_first": self.first_m, "probe_spacing": self.spacing_m, "probe_dims": self.dims,

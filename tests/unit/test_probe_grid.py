@@ -105,3 +105,32 @@ def test_a_large_scene_gets_fewer_probes_within_the_capture_budget():
     assert ProbeGrid.fit(lo, hi, 16, 8, triangles=3, max_triangle_draws=5e7).dims == (16, 16, 1)
     mid = ProbeGrid.fit(np.zeros(3), np.full(3, 2.0), 16, 8, triangles=10_000, max_triangle_draws=5e7)
     assert mid.dims == (9, 9, 9) and 6 * mid.count * 10_000 <= 5e7 < 6 * 10**3 * 10_000
+
+
+def _probes(grid, needed):
+    """The (ix, iy, iz) of the needed probes, sorted."""
+    return sorted(tuple(int(v) for v in q[::-1]) for q in np.argwhere(needed.reshape(grid.dims[::-1])))
+
+
+def test_read_by_marks_the_corners_of_every_cell_a_lookup_can_fall_in():
+    # Probes at integer points 0..4 x 0..3 x 0..2 (spacing 1). A point at (1.5, 1.5, 0.5) lies in cell
+    # (1, 1, 0): its 8 corners are read; a margin of 0.6 reaches cells 0..2 along each axis (clamped at
+    # the grid's last cell, dims - 2); a point far outside falls in the lookup's clamped edge cell.
+    grid = ProbeGrid(np.zeros(3), 1.0, (5, 4, 3), 8)
+    point = np.array([[1.5, 1.5, 0.5]])
+    assert _probes(grid, grid.read_by(point, point, 0.0)) == \
+        sorted((x, y, z) for x in (1, 2) for y in (1, 2) for z in (0, 1))
+    wide = _probes(grid, grid.read_by(point, point, 0.6))
+    assert wide == sorted((x, y, z) for x in range(4) for y in range(4) for z in range(3))
+    far = np.array([[-5.0, -5.0, -5.0]])
+    assert _probes(grid, grid.read_by(far, far, 0.0)) == \
+        sorted((x, y, z) for x in (0, 1) for y in (0, 1) for z in (0, 1))
+    # Several boxes at once: the union of each one's probes; none at all: no probe.
+    both = grid.read_by(np.r_[point, far], np.r_[point, far], 0.0)
+    union = grid.read_by(point, point, 0.0) | grid.read_by(far, far, 0.0)
+    assert (both == union).all() and both.sum() == 14  # the two cells share probes (1, 1, 0) and (1, 1, 1)
+    assert not grid.read_by(np.zeros((0, 3)), np.zeros((0, 3)), 0.0).any()
+    # A flat grid (one probe along z): its single layer is read wherever the point lies along z.
+    flat = ProbeGrid(np.zeros(3), 1.0, (3, 3, 1), 8)
+    assert _probes(flat, flat.read_by(np.array([[0.2, 0.2, 7.0]]), np.array([[0.2, 0.2, 7.0]]), 0.0)) == \
+        [(0, 0, 0), (0, 1, 0), (1, 0, 0), (1, 1, 0)]

@@ -36,6 +36,7 @@ class ProbesMethod(OneBounceMethod):
         super().__init__(backend, gi, rsm_config)
         self.probes_config = probes_config if probes_config is not None else ProbesConfig()
         self.grid: ProbeGrid | None = None
+        self.probes_lit = 0  # probes captured and lit (ProbesConfig.only_read_probes)
 
     def set_scene(self, scene) -> None:
         super().set_scene(scene)
@@ -57,8 +58,17 @@ class ProbesMethod(OneBounceMethod):
         far = probe_capture.far_m(self.bounds_m)
         attrs = triangle_attributes(self.scene)  # every triangle: emitters and camera-hidden objects block
         mesh = be.mesh(be.program(probe_capture.SPEC), attrs, "triangles") if attrs is not None else None
-        probe_capture.run(be, self._atlas_target, self.atlas, mesh, grid, probe_capture.face_matrices(grid, far))
-        probe_capture.moments(be, self.atlas, self.moments, self.state, grid, cfg.backface_share)
+        tri = self.scene.positions_m
+        needed = grid.read_by(tri.min(axis=1), tri.max(axis=1), cfg.normal_bias * grid.spacing_m) \
+            if cfg.only_read_probes else None
+        self.probes_lit = grid.count if needed is None else int(needed.sum())
+        probe_capture.run(be, self._atlas_target, self.atlas, mesh, grid, probe_capture.face_matrices(grid, far),
+                          needed)
+        probe_capture.moments(be, self.atlas, self.moments, self.state, grid, cfg.backface_share, needed)
+
+    def work(self) -> dict[str, int]:
+        """The probes the grid has, and those captured and lit (the rest no lookup reads)."""
+        return {"probes": self.grid.count if self.grid else 0, "probes_lit": self.probes_lit}
 
     def field(self) -> dict:
         """The light field the lookup reads."""

@@ -102,8 +102,11 @@ def face_matrices(grid: ProbeGrid, far: float) -> list[np.ndarray]:
     return [face_view_projection(c, f, near, far) for c in grid.positions_m() for f in range(6)]
 
 
-def run(backend: Backend, target, atlas: dict, mesh, grid: ProbeGrid, matrices: list[np.ndarray]) -> None:
-    """Fill the atlas G-buffer (`atlas` = the ATLAS textures, attached to `target` with a depth)."""
+def run(backend: Backend, target, atlas: dict, mesh, grid: ProbeGrid, matrices: list[np.ndarray],
+        needed: np.ndarray | None = None) -> None:
+    """Fill the atlas G-buffer (`atlas` = the ATLAS textures, attached to `target` with a depth); with
+    `needed` ((count,) bool, ProbeGrid.read_by) only those probes' faces: the others' texels stay empty,
+    so the per-light shading skips them too (it skips texels that see no geometry)."""
     zero.images(backend, [atlas[p.name] for p in ATLAS])
     backend.clear(target, color=None, depth=1.0)
     if mesh is None:
@@ -111,14 +114,16 @@ def run(backend: Backend, target, atlas: dict, mesh, grid: ProbeGrid, matrices: 
     program = backend.program(SPEC)
     n = grid.face_texels
     positions = grid.positions_m()
-    for p in range(grid.count):
+    for p in range(grid.count) if needed is None else np.flatnonzero(needed):
         for f in range(6):
             x, y = grid.face_origin(p, f)
             backend.draw(program, target, mesh, depth_test=True, viewport=(x, y, n, n),
                          uniforms={"view_projection": matrices[6 * p + f], "camera_pos_ws": positions[p]})
 
 
-def moments(backend: Backend, atlas: dict, out_moments, out_state, grid: ProbeGrid, backface_share: float) -> None:
+def moments(backend: Backend, atlas: dict, out_moments, out_state, grid: ProbeGrid, backface_share: float,
+            needed: np.ndarray | None = None) -> None:
+    """The distance moments and the probes' state; probes not `needed` (not captured) are off."""
     backend.dispatch(backend.program(MOMENTS_SPEC), group_count(out_moments.size, MOMENTS_SPEC.local_size),
                      uniforms={**grid_uniforms(MOMENTS_SPEC, grid), "moment_radius": MOMENT_RADIUS,
                                "max_distance_m": MAX_DISTANCE_RATIO * grid.spacing_m},
@@ -126,3 +131,7 @@ def moments(backend: Backend, atlas: dict, out_moments, out_state, grid: ProbeGr
     backend.dispatch(backend.program(CLASSIFY_SPEC), group_count(out_state.size, CLASSIFY_SPEC.local_size),
                      uniforms={**grid_uniforms(CLASSIFY_SPEC, grid), "backface_share": backface_share},
                      samplers={"atlas_normal": atlas["normal"]}, images={"state": out_state})
+    if needed is not None:  # state is (nx, ny nz): row iy + ny iz, column ix, as probe order ravels
+        state = backend.read(out_state)
+        state[..., 0] *= needed.reshape(state.shape[:2])
+        backend.write(out_state, state)
