@@ -53,15 +53,20 @@ def constant_map(radiance: np.ndarray, height: int = 16, width: int = 32) -> np.
     return np.broadcast_to(np.asarray(radiance, np.float32), (height, width, 3)).copy()
 
 
-def regions(power: np.ndarray, count: int) -> list[tuple[slice, slice]]:
+def regions(power: np.ndarray, count: int, solid_angle: np.ndarray | None = None) -> list[tuple[slice, slice]]:
     """Split the map (per-texel power (h, w)) into `count` rectangles of texels: the two hemispheres
     first, then repeatedly the region of largest power at its power median along its longer side
-    (in texels weighted by cos(lat) for longitude). Regions with no power are never split."""
+    (in texels weighted by cos(lat) for longitude). Regions with no power are never split.
+
+    With `solid_angle` (per texel, sr) the region split next is the one of largest power x sqrt(solid
+    angle): a shadow cast by one direction in place of a region errs by the region's light times its
+    angular width, so a dim but wide region (the ground seen through a window) is split too, not only
+    the bright sky."""
     h, w = power.shape
     rects = [(slice(0, h // 2), slice(0, w)), (slice(h // 2, h), slice(0, w))] if h >= 2 else [(slice(0, h),
                                                                                               slice(0, w))]
     while len(rects) < count:
-        totals = [power[r].sum() for r in rects]
+        totals = [power[r].sum() * (1.0 if solid_angle is None else np.sqrt(solid_angle[r].sum())) for r in rects]
         order = np.argsort(totals)[::-1]
         for i in order:
             split = _split(power, rects[i])
@@ -89,15 +94,16 @@ def _split(power: np.ndarray, rect: tuple[slice, slice]):
     return (rows, slice(cols.start, cols.start + cut)), (rows, slice(cols.start + cut, cols.stop))
 
 
-def world_suns(world_map: np.ndarray, count: int) -> list[Light]:
+def world_suns(world_map: np.ndarray, count: int, by_width: bool = False) -> list[Light]:
     """The map's light as at most `count` suns (module docstring): each region's vector irradiance V_c
-    per colour; the sun shines along -(luminance-weighted direction), strength |V| along it."""
+    per colour; the sun shines along -(luminance-weighted direction), strength |V| along it. by_width:
+    regions split by power x angular width (`regions`), as the sky's shadowed directions want."""
     radiance = np.asarray(world_map, np.float64)
     _, solid_angle = directions(*radiance.shape[:2])
     vectors = texel_vectors(*radiance.shape[:2])
     power = (radiance @ LUMA) * solid_angle
     suns = []
-    for rect in regions(power, count):
+    for rect in regions(power, count, solid_angle if by_width else None):
         vec = np.einsum("ijc,ijk->ck", radiance[rect], vectors[rect])  # (3 colours, xyz): V per colour
         luma_vec = LUMA @ vec
         norm = np.linalg.norm(luma_vec)
