@@ -11,7 +11,7 @@ const float NORMAL_OFFSET_TEXELS = 1.5;  // as the direct pass: the receiver doe
 // samples the penumbra (4 + 8 taps: window-sky direct rel_rmse_8 0.207; 16 + 16: 0.203).
 const int SEARCH_TAPS = 4;
 const int FILTER_TAPS = 8;
-const float MAX_SOFT_TEXELS = 8.0;  // the widest penumbra searched and filtered, in texels
+const float MAX_SOFT_TEXELS = float(BLOCK);  // the widest penumbra searched and filtered, in texels
 
 // Tap i of n on a Vogel spiral filling the unit disc.
 vec2 tap(int i, int n) {
@@ -45,8 +45,9 @@ void main() {
             continue;  // the direction lies below this surface's horizon
         }
         vec4 p_test = vec4(p + n * (NORMAL_OFFSET_TEXELS * axis_texel.w), 1.0);
-        vec2 ndc = vec2(dot(texelFetch(sky_table, ivec2(0, k), 0), p_test),
-                        dot(texelFetch(sky_table, ivec2(1, k), 0), p_test));
+        vec4 row_x = texelFetch(sky_table, ivec2(0, k), 0);
+        vec4 row_y = texelFetch(sky_table, ivec2(1, k), 0);
+        vec2 ndc = vec2(dot(row_x, p_test), dot(row_y, p_test));
         float receiver = dot(p_test.xyz, axis_texel.xyz);
         // Soft shadow (percentage-closer soft shadows, as a wide sun's in the direct pass): the region is
         // a cone of half-angle atan(tan_half); blockers found in a disc of the widest penumbra give its
@@ -59,23 +60,43 @@ void main() {
         ivec2 tile0 = ivec2(k % tiles_x, k / tiles_x) * tile_texels;
         float turn = float(k) * 2.39996323;
         mat2 rot = mat2(cos(turn), sin(turn), -sin(turn), cos(turn));
+        // The depth bounds of the disc's 3 x 3 blocks (bounds.comp.glsl) settle most directions in one
+        // fetch, with the answer the taps would give: the receiver in front of everything there is lit,
+        // behind everything blocked (from inside a room, most of the sky).
         float texel_m = axis_texel.w;
         float search = min(MAX_SOFT_TEXELS, tan_half * scene_diagonal_m / texel_m);
-        float blockers = 0.0;
-        float depth_sum = 0.0;
+        ivec2 block = clamp(ivec2(uv), ivec2(0), ivec2(tile_texels - 1)) / BLOCK + tile0 / BLOCK;
+        vec2 bounds = texelFetch(sky_bounds, block, 0).xy;
+        if (receiver <= bounds.x) {
+            sum += light_texel.rgb * cos_n;
+            continue;
+        }
+        if (receiver > bounds.y) {
+            continue;
+        }
+        // The blocker nearest the receiver sizes the penumbra (the centre's own texel included): a wall
+        // the receiver stands behind hardens it to half a texel. The mean blocker depth, as PCSS has it,
+        // let far blockers widen the disc until it reached past a closed box's walls at grazing
+        // directions (a closed box under a sky: 2 % of the sky's light along its inner edges).
+        float centre = sky_depth(tile0, ivec2(uv));
+        float nearest = centre < receiver ? centre : -1e30;
         for (int i = 0; i < SEARCH_TAPS; ++i) {
             float d = sky_depth(tile0, ivec2(uv + search * (rot * tap(i, SEARCH_TAPS))));
             if (d < receiver) {
-                blockers += 1.0;
-                depth_sum += d;
+                nearest = max(nearest, d);
             }
         }
         float lit = 1.0;
-        if (blockers > 0.0) {
-            float radius = clamp((receiver - depth_sum / blockers) * tan_half / texel_m, 0.5, MAX_SOFT_TEXELS);
+        if (nearest > -1e30) {
+            // A texel with no geometry lies outside everything the direction sees: taken as lit, it lets
+            // a disc reaching past a closed room's outer walls light the room's inside; it counts as the
+            // centre does.
+            float centre_lit = centre >= receiver ? 1.0 : 0.0;
+            float radius = clamp((receiver - nearest) * tan_half / texel_m, 0.5, MAX_SOFT_TEXELS);
             lit = 0.0;
             for (int i = 0; i < FILTER_TAPS; ++i) {
-                lit += sky_depth(tile0, ivec2(uv + radius * (rot * tap(i, FILTER_TAPS)))) >= receiver ? 1.0 : 0.0;
+                float d = sky_depth(tile0, ivec2(uv + radius * (rot * tap(i, FILTER_TAPS))));
+                lit += d >= 1e29 ? centre_lit : (d >= receiver ? 1.0 : 0.0);
             }
             lit /= float(FILTER_TAPS);
         }

@@ -84,7 +84,7 @@ class DirectMethod:
 
     # The passes of each half of an update (passes/declare.py), in the order they run: what the method
     # is, read as a list; tests check that it is what runs and that every input is written before.
-    PASSES = {"setup": (), "camera": (gbuffer.DECL,), "solve": (rsm.DECL, sky_light.SHADOW_DECL),
+    PASSES = {"setup": (), "camera": (gbuffer.DECL,), "solve": (rsm.DECL, sky_light.SHADOW_DECL, sky_light.BOUNDS_DECL),
               "gather": (sky_light.DIRECT_DECL, direct_light.DECL)}
     # Products of a stochastic gather, filtered after it when GIConfig.denoise (passes/denoise.py).
     NOISY: tuple[str, ...] = ()
@@ -188,11 +188,12 @@ class DirectMethod:
         if not self._sky_suns:
             return None
         if self._sky_key != self._world_key:
-            layout = sky_light.SkyLayout(len(self._sky_suns), self.rsm_config.sky_texels)
+            layout = sky_light.SkyLayout.of(len(self._sky_suns), self.rsm_config.sky_texels)
             rows, draws = sky_light.table(self._sky_suns, self.bounds_m, layout.tile_texels)
             be = self.backend
             if self._sky is None or self._sky[0] != layout:
                 self.sky_atlas = be.texture(layout.size)
+                self.sky_bounds = be.texture(layout.blocks)
                 self._sky_target = be.target([self.sky_atlas], be.depth_texture(layout.size))
             self._sky = (layout, be.texture((rows.shape[1], rows.shape[0]), data=rows), draws)
             self._sky_key = self._world_key
@@ -359,14 +360,16 @@ class DirectMethod:
             with self.step(timings, sky_light.SHADOW_DECL):
                 sky_light.shadow(self.backend, self._sky_target, self._meshes[sky_light.SHADOW_SPEC.name], sky[0],
                                  sky[2])
+            with self.step(timings, sky_light.BOUNDS_DECL):
+                sky_light.bounds(self.backend, self.sky_atlas, self.sky_bounds, sky[0])
 
     def _sky_direct(self, timings: dict[str, float]) -> None:
         """The sky's direct light of every direction, in one pass, into `direct` (gather half)."""
         sky = self.sky()
         if sky is not None:
             with self.step(timings, sky_light.DIRECT_DECL):
-                sky_light.direct(self.backend, self.gbuf["position"], self.gbuf["normal"], self.sky_atlas, sky[1],
-                                 self.direct, sky[0], float(np.linalg.norm(self.bounds_m[1] - self.bounds_m[0])))
+                sky_light.direct(self.backend, self.gbuf["position"], self.gbuf["normal"], self.sky_atlas, self.sky_bounds,
+                                 sky[1], self.direct, sky[0], float(np.linalg.norm(self.bounds_m[1] - self.bounds_m[0])))
 
     def _gather(self, views: list[LightView], timings: dict[str, float], slots, first: bool = True) -> None:
         self._bind_gather_targets()
