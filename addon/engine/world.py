@@ -120,3 +120,30 @@ def world_suns(world_map: np.ndarray, count: int, by_width: bool = False) -> lis
         suns.append(Light("SUN", toward * 1e3, -toward, strength / peak, sun_strength=peak, sun_angle_rad=angle,
                           name="world"))
     return suns
+
+
+AXES = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], np.float64)
+
+
+def sky_direction_count(world_lights: list[Light], lamps: list[Light], most: int, least: int,
+                        scene_radius_m: float) -> int:
+    """How many directions the sky's direct light gets: `most` times the world's share of the scene's
+    direct light, at least `least`. The share is E_world / (E_world + sum E_lamp), in luminance: E_world
+    the irradiance of the best-lit axis-facing surface under the world's suns (pi L for a floor under a
+    uniform sky), E_lamp a sun's strength, or a lamp's power / (4 pi r^2) at the scene's radius r. A
+    world that gives a small part of the light (Sponza's grey world beside its sun: 2.5 %) needs few
+    directions for the same error in the image; a sky lighting a room through its window, most of them.
+    """
+    if not world_lights:
+        return 0
+    toward = np.array([-s.direction for s in world_lights])
+    luma = np.array([s.sun_strength * float(s.color @ LUMA) for s in world_lights])
+    world_e = float(np.max(np.maximum(AXES @ toward.T, 0.0) @ luma))
+    lamps_e = 0.0
+    for lamp in lamps:
+        if lamp.kind == "SUN":
+            lamps_e += lamp.sun_strength * float(lamp.color @ LUMA)
+        else:
+            lamps_e += lamp.power_w * float(lamp.color @ LUMA) / (4.0 * np.pi * max(scene_radius_m, 1e-9) ** 2)
+    share = world_e / (world_e + lamps_e) if world_e > 0 else 0.0
+    return int(min(most, max(least, round(most * share))))

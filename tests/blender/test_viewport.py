@@ -197,8 +197,8 @@ def test_navigating_gives_preview_then_full_quality(cornell):
     np.testing.assert_array_equal(full.view, preview.view)
 
 
-@pytest.mark.parametrize("name", ["direct", "direct-world", "rsm", "lpv", "lpv-far-field", "lpv-emitter-classes", "lpv-octree",
-                                  "lpv-octree-index", "vct", "vct-filtered", "diffusion", "probes",
+@pytest.mark.parametrize("name", ["direct", "direct-world", "rsm", "lpv", "lpv-far-field", "lpv-emitter-classes",
+                                  "lpv-octree", "lpv-octree-index", "vct", "vct-filtered", "diffusion", "probes",
                                   "probes-irradiance"])
 def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, name):
     # lpv at 16 cells runs one grid; "lpv-far-field" at 32 cells adds the far field's passes;

@@ -37,6 +37,9 @@ from ..scene import Camera, Scene
 RSM_KEEP_BYTES = 256 * 2**20
 SEED_STRIDE = 1_000_003  # between the seeds of successive refinement gathers (a prime: no overlap pattern)
 RSM_BYTES_PER_TEXEL = 3 * 16 + 4
+# The fewest sky directions a world that lights at all gets (RsmConfig.sky_directions is the most):
+# as many as the world suns were before the sky pass.
+SKY_DIRECTIONS_LEAST = 16
 
 
 def world_key(scene: Scene) -> tuple:
@@ -139,6 +142,7 @@ class DirectMethod:
         self.rsm, self.rsm_target = self._rsm_slot(0)  # the face being drawn or read (hooks use it)
         self._emitter_rows = None  # the emitter table on the GPU (light_views)
         self._world_key, self._world_suns = None, []
+        self._world_map, self._sky_suns_key, self._sky_suns = None, None, []  # sky_suns()
         self._sky_key, self._sky = None, None  # the sky directions' table and atlas (sky())
         self.vpl_shares: dict[int, float] = {}
         self._solved_for = None  # lights_key of the light field on the GPU; None: none is
@@ -175,28 +179,41 @@ class DirectMethod:
             if world_map is None and np.any(self.source.world_color > 0):
                 world_map = world.constant_map(self.source.world_color)
             self._world_key = key
+            self._world_map = world_map if count else None
             self._world_suns = world.world_suns(world_map, count) if count and world_map is not None else []
-            directions = self.rsm_config.sky_directions
-            self._sky_suns = world.world_suns(world_map, directions, by_width=True) if count and world_map is not None else []
         return self._world_suns
+
+    def sky_suns(self) -> list:
+        """The sky's directions (world.py's regions split by power x width), as many as the world's
+        share of the scene's light asks (world.sky_direction_count), remade when that count or the
+        world changes."""
+        suns = self.world_suns()
+        lo, hi = self.bounds_m
+        count = world.sky_direction_count(suns, [*self.source.lights, *self.emissive], self.rsm_config.sky_directions,
+                                          min(SKY_DIRECTIONS_LEAST, self.rsm_config.sky_directions),
+                                          0.5 * float(np.linalg.norm(hi - lo)))
+        if (self._world_key, count) != self._sky_suns_key:
+            self._sky_suns_key = (self._world_key, count)
+            self._sky_suns = world.world_suns(self._world_map, count, by_width=True) if count else []
+        return self._sky_suns
 
     def sky(self) -> tuple[sky_light.SkyLayout, object, list] | None:
         """The sky's directions (world.py's regions, RsmConfig.sky_directions of them) as the sky pass
         needs them: (layout, table texture, shadow draws); None without a world. Remade when the world
         changes (the bounds change only with set_scene, which resets it)."""
-        self.world_suns()
-        if not self._sky_suns:
+        suns = self.sky_suns()
+        if not suns:
             return None
-        if self._sky_key != self._world_key:
-            layout = sky_light.SkyLayout.of(len(self._sky_suns), self.rsm_config.sky_texels)
-            rows, draws = sky_light.table(self._sky_suns, self.bounds_m, layout.tile_texels)
+        if self._sky_key != self._sky_suns_key:
+            layout = sky_light.SkyLayout.of(len(suns), self.rsm_config.sky_texels)
+            rows, draws = sky_light.table(suns, self.bounds_m, layout.tile_texels)
             be = self.backend
             if self._sky is None or self._sky[0] != layout:
                 self.sky_atlas = be.texture(layout.size)
                 self.sky_bounds = be.texture(layout.blocks)
                 self._sky_target = be.target([self.sky_atlas], be.depth_texture(layout.size))
             self._sky = (layout, be.texture((rows.shape[1], rows.shape[0]), data=rows), draws)
-            self._sky_key = self._world_key
+            self._sky_key = self._sky_suns_key
         return self._sky
 
     def light_key(self) -> tuple:
@@ -368,8 +385,9 @@ class DirectMethod:
         sky = self.sky()
         if sky is not None:
             with self.step(timings, sky_light.DIRECT_DECL):
-                sky_light.direct(self.backend, self.gbuf["position"], self.gbuf["normal"], self.sky_atlas, self.sky_bounds,
-                                 sky[1], self.direct, sky[0], float(np.linalg.norm(self.bounds_m[1] - self.bounds_m[0])))
+                diagonal_m = float(np.linalg.norm(self.bounds_m[1] - self.bounds_m[0]))
+                sky_light.direct(self.backend, self.gbuf["position"], self.gbuf["normal"], self.sky_atlas,
+                                 self.sky_bounds, sky[1], self.direct, sky[0], diagonal_m)
 
     def _gather(self, views: list[LightView], timings: dict[str, float], slots, first: bool = True) -> None:
         self._bind_gather_targets()

@@ -64,7 +64,8 @@ DIRECT_SPEC = ShaderSpec(
     samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("sky_depth_atlas", "2D"),
               Sampler("sky_bounds", "2D"), Sampler("sky_table", "2D")),
     images=(Image("direct", "2D", "RGBA32F", "read_write"),),
-    uniforms=(Var("sky_count", "int"), Var("tiles_x", "int"), Var("tile_texels", "int"), Var("scene_diagonal_m", "float")),
+    uniforms=(Var("sky_count", "int"), Var("tiles_x", "int"), Var("tile_texels", "int"),
+              Var("scene_diagonal_m", "float")),
 )
 
 SKY_TABLE = Port("scene", "sky_table", "RGBA32F", "table",
