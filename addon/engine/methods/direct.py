@@ -198,9 +198,10 @@ class DirectMethod:
         return self._sky_suns
 
     def sky(self) -> tuple[sky_light.SkyLayout, object, list] | None:
-        """The sky's directions (world.py's regions, RsmConfig.sky_directions of them) as the sky pass
-        needs them: (layout, table texture, shadow draws); None without a world. Remade when the world
-        changes (the bounds change only with set_scene, which resets it)."""
+        """The sky's directions (sky_suns) as the sky pass needs them: (layout, table texture, shadow
+        draws); None without a world. Remade when they change (the bounds change only with set_scene,
+        which resets them). The atlas (about 20 MB at 256 directions of 64^2 texels) is outside the
+        RSM_KEEP_BYTES budget."""
         suns = self.sky_suns()
         if not suns:
             return None
