@@ -75,10 +75,18 @@ class RsmConfig(_Validated):
     # with its exact unshadowed irradiance and the shadow of its centre (area_light.py): shadows soften
     # in that many steps; each patch costs its own RSM faces.
     area_patches: int = _num(2, 1, 8, "patches per side an area light is split into, each shadowed from its centre")
-    # The world (sky, HDRI, a constant colour) lights as this many suns, each a region of the sky with
-    # its exact vector irradiance (world.py) and its own shadow map, so each costs an RSM face: 16 kept
-    # Sponza's direct update near 0.7 s on llvmpipe (32: 1.4 s); 0 leaves the world out.
-    world_suns: int = _num(16, 0, 256, "suns the world's light is split into (0: the world does not light)")
+    # The world's bounce: this many suns, each a region of the sky with its exact vector irradiance
+    # (world.py) and its own RSM face (the VPLs every indirect method reads): 16 kept Sponza's update
+    # near 0.7 s on llvmpipe (32: 1.4 s); 0 leaves the world out (no direct light from it either).
+    world_suns: int = _num(16, 0, 256, "suns the world's bounce is split into (0: the world does not light)")
+    # The world's direct light: at most this many regions of the sky (the same importance-stratified
+    # split, finer), each shadowed by a sky_texels^2 tile of one atlas and all evaluated in one pass over
+    # the G-buffer (passes/sky_light.py). The count is this times the world's share of the scene's
+    # direct light, at least 16 (world.sky_direction_count): a sky lighting a room through its window
+    # gets most of them, a dim world beside a sun few (docs/DIRECT.md).
+    sky_directions: int = _num(256, 1, 1024, "most regions of the sky its direct light is split into, one pass "
+                               "for all (fewer when the world gives less of the light)")
+    sky_texels: int = _num(64, 16, 1024, "shadow map side in texels of each sky direction")
 
 
 @dataclass(frozen=True)

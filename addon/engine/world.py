@@ -53,15 +53,20 @@ def constant_map(radiance: np.ndarray, height: int = 16, width: int = 32) -> np.
     return np.broadcast_to(np.asarray(radiance, np.float32), (height, width, 3)).copy()
 
 
-def regions(power: np.ndarray, count: int) -> list[tuple[slice, slice]]:
+def regions(power: np.ndarray, count: int, solid_angle: np.ndarray | None = None) -> list[tuple[slice, slice]]:
     """Split the map (per-texel power (h, w)) into `count` rectangles of texels: the two hemispheres
     first, then repeatedly the region of largest power at its power median along its longer side
-    (in texels weighted by cos(lat) for longitude). Regions with no power are never split."""
+    (in texels weighted by cos(lat) for longitude). Regions with no power are never split.
+
+    With `solid_angle` (per texel, sr) the region split next is the one of largest power x sqrt(solid
+    angle): a shadow cast by one direction in place of a region errs by the region's light times its
+    angular width, so a dim but wide region (the ground seen through a window) is split too, not only
+    the bright sky."""
     h, w = power.shape
     rects = [(slice(0, h // 2), slice(0, w)), (slice(h // 2, h), slice(0, w))] if h >= 2 else [(slice(0, h),
                                                                                               slice(0, w))]
     while len(rects) < count:
-        totals = [power[r].sum() for r in rects]
+        totals = [power[r].sum() * (1.0 if solid_angle is None else np.sqrt(solid_angle[r].sum())) for r in rects]
         order = np.argsort(totals)[::-1]
         for i in order:
             split = _split(power, rects[i])
@@ -89,15 +94,16 @@ def _split(power: np.ndarray, rect: tuple[slice, slice]):
     return (rows, slice(cols.start, cols.start + cut)), (rows, slice(cols.start + cut, cols.stop))
 
 
-def world_suns(world_map: np.ndarray, count: int) -> list[Light]:
+def world_suns(world_map: np.ndarray, count: int, by_width: bool = False) -> list[Light]:
     """The map's light as at most `count` suns (module docstring): each region's vector irradiance V_c
-    per colour; the sun shines along -(luminance-weighted direction), strength |V| along it."""
+    per colour; the sun shines along -(luminance-weighted direction), strength |V| along it. by_width:
+    regions split by power x angular width (`regions`), as the sky's shadowed directions want."""
     radiance = np.asarray(world_map, np.float64)
     _, solid_angle = directions(*radiance.shape[:2])
     vectors = texel_vectors(*radiance.shape[:2])
     power = (radiance @ LUMA) * solid_angle
     suns = []
-    for rect in regions(power, count):
+    for rect in regions(power, count, solid_angle if by_width else None):
         vec = np.einsum("ijc,ijk->ck", radiance[rect], vectors[rect])  # (3 colours, xyz): V per colour
         luma_vec = LUMA @ vec
         norm = np.linalg.norm(luma_vec)
@@ -114,3 +120,30 @@ def world_suns(world_map: np.ndarray, count: int) -> list[Light]:
         suns.append(Light("SUN", toward * 1e3, -toward, strength / peak, sun_strength=peak, sun_angle_rad=angle,
                           name="world"))
     return suns
+
+
+AXES = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], np.float64)
+
+
+def sky_direction_count(world_lights: list[Light], lamps: list[Light], most: int, least: int,
+                        scene_radius_m: float) -> int:
+    """How many directions the sky's direct light gets: `most` times the world's share of the scene's
+    direct light, at least `least`. The share is E_world / (E_world + sum E_lamp), in luminance: E_world
+    the irradiance of the best-lit axis-facing surface under the world's suns (pi L for a floor under a
+    uniform sky), E_lamp a sun's strength, or a lamp's power / (4 pi r^2) at the scene's radius r. A
+    world that gives a small part of the light (Sponza's grey world beside its sun: 2.5 %) needs few
+    directions for the same error in the image; a sky lighting a room through its window, most of them.
+    """
+    if not world_lights:
+        return 0
+    toward = np.array([-s.direction for s in world_lights])
+    luma = np.array([s.sun_strength * float(s.color @ LUMA) for s in world_lights])
+    world_e = float(np.max(np.maximum(AXES @ toward.T, 0.0) @ luma))
+    lamps_e = 0.0
+    for lamp in lamps:
+        if lamp.kind == "SUN":
+            lamps_e += lamp.sun_strength * float(lamp.color @ LUMA)
+        else:
+            lamps_e += lamp.power_w * float(lamp.color @ LUMA) / (4.0 * np.pi * max(scene_radius_m, 1e-9) ** 2)
+    share = world_e / (world_e + lamps_e) if world_e > 0 else 0.0
+    return int(min(most, max(least, round(most * share))))

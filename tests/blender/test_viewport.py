@@ -197,21 +197,24 @@ def test_navigating_gives_preview_then_full_quality(cornell):
     np.testing.assert_array_equal(full.view, preview.view)
 
 
-@pytest.mark.parametrize("name", ["direct", "rsm", "lpv", "lpv-far-field", "lpv-emitter-classes", "lpv-octree",
-                                  "lpv-octree-index", "vct", "vct-filtered", "diffusion", "probes",
+@pytest.mark.parametrize("name", ["direct", "direct-world", "rsm", "lpv", "lpv-far-field", "lpv-emitter-classes",
+                                  "lpv-octree", "lpv-octree-index", "vct", "vct-filtered", "diffusion", "probes",
                                   "probes-irradiance"])
 def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, name):
     # lpv at 16 cells runs one grid; "lpv-far-field" at 32 cells adds the far field's passes;
     # "lpv-emitter-classes" (16 cells) the classes' injection, unpacks and own-light lookups;
     # "lpv-octree" (16 cells) every level's injection and the time merge, "lpv-octree-index" the
     # downsampling and the index merge's shader;
-    # "vct-filtered" the filtered injection (gl_VertexID, the projected-area fetches).
+    # "vct-filtered" the filtered injection (gl_VertexID, the projected-area fetches);
+    # "direct-world" the sky's shadow atlas (a draw per tile's viewport) and its fused direct pass.
     from addon.bridge import scenes
     from addon.bridge.capture import SceneCache
     from addon.engine import methods
     from addon.engine.config import DiffusionConfig, GIConfig, LpvConfig, ProbesConfig, RsmConfig, VctConfig
 
-    scenes.build("cornell-glossy" if name.startswith("vct") else "cornell")  # vct: its glossy product too
+    # vct: its glossy product too; direct-world: Blender's default grey world besides the spot.
+    scenes.build("cornell-glossy" if name.startswith("vct") else "cornell-grey-world" if name == "direct-world"
+                 else "cornell")
     scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 64, 48)
     method_name, grid_cells = ("lpv", 32) if name == "lpv-far-field" else (name.split("-")[0], 16)
     gi = GIConfig(method=method_name, resolution=64)
@@ -227,7 +230,9 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
                                      "probes": ProbesConfig(probes_per_side=6, encoding="irradiance"
                                                             if name == "probes-irradiance" else "sh")})
         method.set_scene(scene)
-        results.append(method.run().images)
+        result = method.run()
+        assert ("sky_direct" in result.timings_ms) == (name == "direct-world")  # the world lights, via the sky pass
+        results.append(result.images)
     a, b = results
     assert set(a) == set(b) == set(methods.get(method_name).products)
     for key in a:

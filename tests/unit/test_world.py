@@ -55,3 +55,29 @@ def test_regions_partition_the_map():
     for r in regions(power, 24):
         covered[r] += 1
     assert np.all(covered == 1)
+
+
+def test_regions_by_width_split_a_dim_wide_ground():
+    # A bright sky over a ground 100 times dimmer: split by power alone, the ground stays one region (its
+    # power never leads); weighed by angular width as well, it is split too (the shadow of one direction
+    # standing in for a region errs by the region's light times its width).
+    m = constant_map([1.0] * 3, 32, 64)
+    m[16:] = 0.01
+    _, omega = directions(32, 64)
+    power = m[..., 0] * omega
+    below = lambda rects: sum(1 for r in rects if r[0].start >= 16)  # noqa: E731
+    assert below(regions(power, 64)) == 1
+    assert below(regions(power, 64, omega)) > 1
+
+
+def test_sky_direction_count_follows_the_worlds_share():
+    from addon.engine.scene import Light
+    from addon.engine.world import sky_direction_count
+
+    sky = world_suns(constant_map([1.0] * 3), 16)  # a floor under it gets pi W/m^2
+    sun = Light("SUN", [0, 0, 10], [0, 0, -1], [1, 1, 1], sun_strength=3 * np.pi)
+    assert sky_direction_count(sky, [], 256, 16, 5.0) == 256  # the world is all the light
+    assert sky_direction_count(sky, [sun], 256, 16, 5.0) == 64  # a quarter of it: pi / (pi + 3 pi)
+    dim = world_suns(constant_map([1e-3] * 3), 16)
+    assert sky_direction_count(dim, [sun], 256, 16, 5.0) == 16  # never fewer than `least`
+    assert sky_direction_count([], [sun], 256, 16, 5.0) == 0  # no world, no directions

@@ -27,7 +27,7 @@ from ..area_light import emitter_table, split_area_light
 from ..backends.base import Backend
 from ..config import GIConfig, RsmConfig
 from ..errors import ConfigError
-from ..passes import accumulate, declare, denoise, direct_light, gbuffer, rsm, zero
+from ..passes import accumulate, declare, denoise, direct_light, gbuffer, rsm, sky_light, zero
 from ..passes.light_views import LightView, emissive_lights, reaches, views_for
 from ..scene import Camera, Scene
 
@@ -37,6 +37,9 @@ from ..scene import Camera, Scene
 RSM_KEEP_BYTES = 256 * 2**20
 SEED_STRIDE = 1_000_003  # between the seeds of successive refinement gathers (a prime: no overlap pattern)
 RSM_BYTES_PER_TEXEL = 3 * 16 + 4
+# The fewest sky directions a world that lights at all gets (RsmConfig.sky_directions is the most):
+# as many as the world suns were before the sky pass.
+SKY_DIRECTIONS_LEAST = 16
 
 
 def world_key(scene: Scene) -> tuple:
@@ -84,7 +87,8 @@ class DirectMethod:
 
     # The passes of each half of an update (passes/declare.py), in the order they run: what the method
     # is, read as a list; tests check that it is what runs and that every input is written before.
-    PASSES = {"setup": (), "camera": (gbuffer.DECL,), "solve": (rsm.DECL,), "gather": (direct_light.DECL,)}
+    PASSES = {"setup": (), "camera": (gbuffer.DECL,), "solve": (rsm.DECL, sky_light.SHADOW_DECL, sky_light.BOUNDS_DECL),
+              "gather": (sky_light.DIRECT_DECL, direct_light.DECL)}
     # Products of a stochastic gather, filtered after it when GIConfig.denoise (passes/denoise.py).
     NOISY: tuple[str, ...] = ()
 
@@ -126,7 +130,8 @@ class DirectMethod:
         # Emitters stay out of the RSMs: their lamps sit on or inside them (a sphere's lamp at its centre
         # would be shadowed by the sphere itself). They then cast no shadow for other lights either.
         not_emitting = ~np.any(self.scene.emission > 0, axis=1)
-        selections = {gbuffer.SPEC: self.scene.seen_by_camera(), rsm.SPEC: not_emitting}
+        selections = {gbuffer.SPEC: self.scene.seen_by_camera(), rsm.SPEC: not_emitting,
+                      sky_light.SHADOW_SPEC: not_emitting}
         self._meshes = {}
         for spec, select in selections.items():
             attrs = triangle_attributes(self.scene, select)
@@ -137,6 +142,8 @@ class DirectMethod:
         self.rsm, self.rsm_target = self._rsm_slot(0)  # the face being drawn or read (hooks use it)
         self._emitter_rows = None  # the emitter table on the GPU (light_views)
         self._world_key, self._world_suns = None, []
+        self._world_map, self._sky_suns_key, self._sky_suns = None, None, []  # sky_suns()
+        self._sky_key, self._sky = None, None  # the sky directions' table and atlas (sky())
         self.vpl_shares: dict[int, float] = {}
         self._solved_for = None  # lights_key of the light field on the GPU; None: none is
         self.solves = 0          # how many updates solved (bakes report it)
@@ -172,8 +179,43 @@ class DirectMethod:
             if world_map is None and np.any(self.source.world_color > 0):
                 world_map = world.constant_map(self.source.world_color)
             self._world_key = key
+            self._world_map = world_map if count else None
             self._world_suns = world.world_suns(world_map, count) if count and world_map is not None else []
         return self._world_suns
+
+    def sky_suns(self) -> list:
+        """The sky's directions (world.py's regions split by power x width), as many as the world's
+        share of the scene's light asks (world.sky_direction_count), remade when that count or the
+        world changes."""
+        suns = self.world_suns()
+        lo, hi = self.bounds_m
+        count = world.sky_direction_count(suns, [*self.source.lights, *self.emissive], self.rsm_config.sky_directions,
+                                          min(SKY_DIRECTIONS_LEAST, self.rsm_config.sky_directions),
+                                          0.5 * float(np.linalg.norm(hi - lo)))
+        if (self._world_key, count) != self._sky_suns_key:
+            self._sky_suns_key = (self._world_key, count)
+            self._sky_suns = world.world_suns(self._world_map, count, by_width=True) if count else []
+        return self._sky_suns
+
+    def sky(self) -> tuple[sky_light.SkyLayout, object, list] | None:
+        """The sky's directions (sky_suns) as the sky pass needs them: (layout, table texture, shadow
+        draws); None without a world. Remade when they change (the bounds change only with set_scene,
+        which resets them). The atlas (about 20 MB at 256 directions of 64^2 texels) is outside the
+        RSM_KEEP_BYTES budget."""
+        suns = self.sky_suns()
+        if not suns:
+            return None
+        if self._sky_key != self._sky_suns_key:
+            layout = sky_light.SkyLayout.of(len(suns), self.rsm_config.sky_texels)
+            rows, draws = sky_light.table(suns, self.bounds_m, layout.tile_texels)
+            be = self.backend
+            if self._sky is None or self._sky[0] != layout:
+                self.sky_atlas = be.texture(layout.size)
+                self.sky_bounds = be.texture(layout.blocks)
+                self._sky_target = be.target([self.sky_atlas], be.depth_texture(layout.size))
+            self._sky = (layout, be.texture((rows.shape[1], rows.shape[0]), data=rows), draws)
+            self._sky_key = self._sky_suns_key
+        return self._sky
 
     def light_key(self) -> tuple:
         """What a light field is solved for: the lights and the world."""
@@ -232,8 +274,10 @@ class DirectMethod:
             lights += split_area_light(local, self.rsm_config.area_patches) if local.kind == "AREA" else [local]
         lights += self.emissive
         # The world's suns share one light's VPL budget by power (vpl_shares: light index -> share): a
-        # gather of vpl_samples per face of each of 32 suns made rsm ten times slower on Sponza.
-        suns = self.world_suns()
+        # gather of vpl_samples per face of each of 32 suns made rsm ten times slower on Sponza. Their
+        # RSMs are the world's bounce only (its direct light is the sky pass's, `sky`): a method without
+        # indirect light draws none.
+        suns = self.world_suns() if "indirect" in self.products else []
         powers = np.array([s.sun_strength * float(s.color @ world.LUMA) for s in suns])
         self.vpl_shares = {len(lights) + i: p / powers.sum() for i, p in enumerate(powers)} if suns else {}
         lights += suns
@@ -291,9 +335,11 @@ class DirectMethod:
                     self._gather(views, timings, range(len(views)))
             else:  # one RSM for every face: each is drawn, solved and gathered in turn
                 with self.timed(timings, "solve"):
+                    self._draw_sky(timings)
                     self.begin_solve(timings)
                     self._bind_gather_targets()
                     self.clear_products()
+                    self._sky_direct(timings)
                     for view in views:
                         self._draw_rsm(view, 0, timings)
                         self.solve_view(view, timings)
@@ -323,15 +369,36 @@ class DirectMethod:
             rsm.run(self.backend, self.rsm_target, self._meshes[rsm.SPEC.name], view)
 
     def _solve(self, views: list[LightView], timings: dict[str, float], slots) -> None:
+        self._draw_sky(timings)
         self.begin_solve(timings)
         for view, slot in zip(views, slots, strict=True):
             self._draw_rsm(view, slot, timings)
             self.solve_view(view, timings)
         self.finish_solve(timings)
 
+    def _draw_sky(self, timings: dict[str, float]) -> None:
+        """Every sky direction's shadow map into the sky atlas (solve half); nothing without a world."""
+        sky = self.sky()
+        if sky is not None:
+            with self.step(timings, sky_light.SHADOW_DECL):
+                sky_light.shadow(self.backend, self._sky_target, self._meshes[sky_light.SHADOW_SPEC.name], sky[0],
+                                 sky[2])
+            with self.step(timings, sky_light.BOUNDS_DECL):
+                sky_light.bounds(self.backend, self.sky_atlas, self.sky_bounds, sky[0])
+
+    def _sky_direct(self, timings: dict[str, float]) -> None:
+        """The sky's direct light of every direction, in one pass, into `direct` (gather half)."""
+        sky = self.sky()
+        if sky is not None:
+            with self.step(timings, sky_light.DIRECT_DECL):
+                diagonal_m = float(np.linalg.norm(self.bounds_m[1] - self.bounds_m[0]))
+                sky_light.direct(self.backend, self.gbuf["position"], self.gbuf["normal"], self.sky_atlas,
+                                 self.sky_bounds, sky[1], self.direct, sky[0], diagonal_m)
+
     def _gather(self, views: list[LightView], timings: dict[str, float], slots, first: bool = True) -> None:
         self._bind_gather_targets()
         self.clear_products()
+        self._sky_direct(timings)
         for view, slot in zip(views, slots, strict=True):
             self.rsm, self.rsm_target = self._rsm_slot(slot)
             self._gather_view(view, timings)
@@ -384,6 +451,9 @@ class DirectMethod:
         return timings
 
     def _gather_view(self, view: LightView, timings: dict[str, float]) -> None:
+        if view.light_index in self.vpl_shares:  # a world sun: its direct light is the sky pass's
+            self.gather_view(view, timings)
+            return
         with self.step(timings, direct_light.DECL):
             direct_light.run(self.backend, self.gbuf["position"], self.gbuf["normal"], self.rsm["position"],
                              self.direct, view, self.rsm_config.shadow_bias_texels, self.emitters)

@@ -1,0 +1,158 @@
+"""The sky's direct light (world.py's regions, many of them) from one atlas of small shadow maps and one
+fused pass over the G-buffer.
+
+Why: each world sun as its own RSM face and direct pass costs one G-buffer sweep per sun; a sky seen
+through a window needs a hundred directions or more (docs/DIRECT.md). Sky shadows are soft, so each
+direction's shadow map can be small: every direction is drawn into its tile of one atlas (the draw's
+viewport, as the probe capture does), and one compute pass loops over the directions per pixel, the
+G-buffer read once.
+
+shadow (solve half): per direction, the scene (orthographic, fitted to the bounds as a sun's RSM)
+drawn into tile k = (k % tiles_x, k // tiles_x) of `tile_texels`^2 texels; each texel holds the depth
+along the direction's axis (m), w = 1 where geometry.
+bounds (solve half): per block of BLOCK_TEXELS^2 texels, the least and greatest depth of the 3 x 3
+blocks around it: a receiver in front of all of them is lit, behind all of them shadowed, in one fetch.
+direct (gather half): per G-buffer pixel, sum over directions of E_k max(0, n . l_k) x the bilinear
+percentage-closer visibility of its tile, / pi, added to `direct`.
+The table (one row per direction, `TABLE_TEXELS` RGBA32F texels): the view-projection's rows, the axis
+with the texel size (m), the irradiance normal to the axis (W/m^2 per colour).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
+from ..scene import Light
+from .declare import DIRECT, GBUF_NORMAL, GBUF_POSITION, TRIANGLES, PassDecl, Port
+from .light_views import views_for
+
+TABLE_TEXELS = 6
+
+SHADOW_SPEC = ShaderSpec(
+    name="sky_shadow",
+    vertex="sky/shadow.vert.glsl",
+    fragment="sky/shadow.frag.glsl",
+    uniforms=(Var("light_view_projection", "mat4"), Var("emit_axis", "vec3")),
+    attributes=(Var("pos_ws", "vec3"),),
+    varyings=(Var("v_depth", "float"),),
+    outputs=(Var("out_depth", "vec4"),),
+)
+
+# Texels per side of a block of the depth bounds, and the widest soft-shadow disc's radius in texels:
+# one bounds fetch (the 3 x 3 blocks around the receiver's) covers every tap of its disc.
+BLOCK_TEXELS = 8
+
+BOUNDS_SPEC = ShaderSpec(
+    name="sky_bounds",
+    compute="sky/bounds.comp.glsl",
+    local_size=(8, 8, 1),
+    samplers=(Sampler("sky_depth_atlas", "2D"),),
+    images=(Image("sky_bounds", "2D", "RGBA32F", "write"),),
+    uniforms=(Var("tile_texels", "int"),),
+    defines=(("BLOCK", str(BLOCK_TEXELS)),),
+)
+
+DIRECT_SPEC = ShaderSpec(
+    name="sky_direct",
+    compute="sky/direct.comp.glsl",
+    local_size=(8, 8, 1),
+    defines=(("BLOCK", str(BLOCK_TEXELS)),),
+    samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("sky_depth_atlas", "2D"),
+              Sampler("sky_bounds", "2D"), Sampler("sky_table", "2D")),
+    images=(Image("direct", "2D", "RGBA32F", "read_write"),),
+    uniforms=(Var("sky_count", "int"), Var("tiles_x", "int"), Var("tile_texels", "int"),
+              Var("scene_diagonal_m", "float")),
+)
+
+SKY_TABLE = Port("scene", "sky_table", "RGBA32F", "table",
+                 "per sky direction: view-projection rows, axis and texel size (m), irradiance (W/m^2)")
+SKY_DEPTH = Port("sky", "depth", "RGBA32F", "sky_atlas",
+                 "per sky direction's tile: depth along its axis (m), w = 1 where geometry")
+
+SKY_BOUNDS = Port("sky", "bounds", "RGBA32F", "sky_blocks",
+                  "per block of BLOCK_TEXELS^2 atlas texels: least, greatest depth (m) over its 3 x 3 blocks")
+
+SHADOW_DECL = PassDecl("sky_shadow", "solve", (TRIANGLES, SKY_TABLE), (SKY_DEPTH,),
+                       "every sky direction's small shadow map, into its tile of one atlas")
+BOUNDS_DECL = PassDecl("sky_bounds", "solve", (SKY_DEPTH,), (SKY_BOUNDS,),
+                       "the atlas's depth bounds per block: most directions settled in one fetch")
+DIRECT_DECL = PassDecl("sky_direct", "gather", (GBUF_POSITION, GBUF_NORMAL, SKY_DEPTH, SKY_BOUNDS, SKY_TABLE),
+                       (DIRECT,), "the sky's shadowed direct light of every direction, in one pass, added")
+
+
+@dataclass(frozen=True)
+class SkyLayout:
+    """The directions' tiles in the atlas: near square (tiles_x columns); tile_texels a multiple of
+    BLOCK_TEXELS."""
+
+    count: int
+    tile_texels: int
+
+    @classmethod
+    def of(cls, count: int, texels: int) -> SkyLayout:
+        """`count` tiles of at least `texels` per side, rounded up to whole blocks."""
+        return cls(count, -(-texels // BLOCK_TEXELS) * BLOCK_TEXELS)
+
+    @property
+    def tiles_x(self) -> int:
+        return math.ceil(math.sqrt(self.count))
+
+    @property
+    def size(self) -> tuple[int, int]:
+        return self.tiles_x * self.tile_texels, math.ceil(self.count / self.tiles_x) * self.tile_texels
+
+    @property
+    def blocks(self) -> tuple[int, int]:
+        return self.size[0] // BLOCK_TEXELS, self.size[1] // BLOCK_TEXELS
+
+    def viewport(self, k: int) -> tuple[int, int, int, int]:
+        n = self.tile_texels
+        return (k % self.tiles_x) * n, (k // self.tiles_x) * n, n, n
+
+
+def table(suns: list[Light], bounds: tuple[np.ndarray, np.ndarray], tile_texels: int) -> tuple[np.ndarray, list]:
+    """The sky table (rows, TABLE_TEXELS, 4) float32 and each direction's (view_projection, axis) for its
+    shadow draw; the views are those of a sun's RSM (light_views._sun_view) at the tile's size."""
+    rows = np.zeros((len(suns), TABLE_TEXELS, 4), np.float32)
+    draws = []
+    for k, sun in enumerate(suns):
+        (view,) = views_for(sun, k, bounds, tile_texels)
+        rows[k, :4] = view.view_projection
+        rows[k, 4] = (*view.face_axis, math.sqrt(view.texel_scale))
+        rows[k, 5] = (*(sun.color * sun.sun_strength), math.tan(sun.sun_angle_rad / 2.0))
+        draws.append((view.view_projection, view.face_axis))
+    return rows, draws
+
+
+def shadow(backend: Backend, target, mesh, layout: SkyLayout, draws: list) -> None:
+    """Every direction's shadow map into its tile; texels no geometry covers keep w = 0 (lit)."""
+    backend.clear(target, color=(0, 0, 0, 0), depth=1.0)
+    if mesh is None:
+        return
+    program = backend.program(SHADOW_SPEC)
+    for k, (view_projection, axis) in enumerate(draws):
+        backend.draw(program, target, mesh, uniforms={"light_view_projection": view_projection, "emit_axis": axis},
+                     depth_test=True, viewport=layout.viewport(k))
+
+
+def bounds(backend: Backend, atlas, out, layout: SkyLayout) -> None:
+    """The atlas's depth bounds (SKY_BOUNDS) into `out` (layout.blocks)."""
+    backend.dispatch(backend.program(BOUNDS_SPEC), group_count(layout.blocks, BOUNDS_SPEC.local_size),
+                     uniforms={"tile_texels": layout.tile_texels}, samplers={"sky_depth_atlas": atlas},
+                     images={"sky_bounds": out})
+
+
+def direct(backend: Backend, gbuf_position, gbuf_normal, atlas, sky_bounds, sky_table, out, layout: SkyLayout,
+           scene_diagonal_m: float) -> None:
+    """`scene_diagonal_m`: the bounds' diagonal, the farthest a blocker can be from its receiver (it
+    sizes the blocker search: the widest penumbra)."""
+    backend.dispatch(backend.program(DIRECT_SPEC), group_count(out.size, DIRECT_SPEC.local_size),
+                     uniforms={"sky_count": layout.count, "tiles_x": layout.tiles_x,
+                               "tile_texels": layout.tile_texels, "scene_diagonal_m": scene_diagonal_m},
+                     samplers={"gbuf_position": gbuf_position, "gbuf_normal": gbuf_normal,
+                               "sky_depth_atlas": atlas, "sky_bounds": sky_bounds, "sky_table": sky_table},
+                     images={"direct": out})

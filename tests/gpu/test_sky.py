@@ -1,0 +1,68 @@
+"""The sky's direct light (passes/sky_light.py): every region of the world map a direction with its
+own small shadow map, all summed in one pass."""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "hard"))
+from hard_scenes import box, camera, parts, rect  # noqa: E402
+from hard_scenes import scene as make_scene  # noqa: E402
+
+from addon.engine import methods  # noqa: E402
+from addon.engine.config import GIConfig, RsmConfig  # noqa: E402
+from addon.engine.world import constant_map  # noqa: E402
+
+pytestmark = pytest.mark.gpu
+
+RADIANCE = np.array([0.5, 1.0, 2.0], np.float32)  # W/m^2/sr per colour
+
+
+def direct(gl, sc, **rsm) -> np.ndarray:
+    method = methods.create(gl, {"gi": GIConfig(method="direct", resolution=32), "rsm": RsmConfig(**rsm)})
+    method.set_scene(sc)
+    return method.run().images["direct"]
+
+
+def open_floor():
+    geometry = parts((*rect([-2, -2, 0], [4, 0, 0], [0, 4, 0]), 0.5))
+    sc = make_scene(geometry, [], camera([0, -0.01, 3], [0, 0.01, -1], size=32, fov_deg=40))
+    return replace(sc, world_map=constant_map(RADIANCE))
+
+
+@pytest.mark.parametrize(("count", "rtol"), [(16, 0.015), (128, 1e-3)])
+def test_open_floor_under_a_uniform_sky_gets_its_radiance(gl, count, rtol):
+    # E = pi L on a floor under a uniform sky, so Diffuse Direct = E / pi = L exactly: the regions'
+    # vector irradiances sum to it (world.py, exact for a floor: the first split is the horizon) and
+    # nothing but the floor itself is there to block. 128 directions: 1e-3 (fp32 sums). 16: a wide
+    # region's soft-shadow disc, at a low direction, reaches floor that lies nearer the sky than the
+    # receiver's offset depth (the floor shadows itself a little; the receiver's plane is not
+    # extrapolated across the disc, which let thin walls leak): measured 1.09 % low, bounded at 1.5 %.
+    img = direct(gl, open_floor(), sky_directions=count)
+    centre = img[8:24, 8:24, :3].reshape(-1, 3)
+    np.testing.assert_allclose(centre, np.broadcast_to(RADIANCE, centre.shape), rtol=rtol)
+    assert centre.max() <= RADIANCE.max() * (1 + 1e-3)  # never more than the sky gives
+
+
+@pytest.mark.parametrize("wall_m", [0.1, 0.4])
+def test_closed_box_under_a_sky_stays_dark(gl, wall_m):
+    # A closed 2 m box under a bright sky: no direction reaches its inside. Walls 0.4 m thick (about 8
+    # texels of a 64-texel tile): exactly 0. Walls 0.1 m (2 texels): a soft-shadow disc at a grazing
+    # direction reaches past the roof's silhouette to surfaces deeper than the receiver (one depth
+    # layer cannot tell them from the floor seen through an opening); measured 54 of 1024 pixels at
+    # most 0.81 % of the open floor's light, 0.016 % on average: bounded at 1 % and 0.03 %.
+    outer = box([-1 - wall_m, -1 - wall_m, -wall_m], [1 + wall_m, 1 + wall_m, 2 + wall_m], inward=False)
+    inner = box([-1, -1, 0], [1, 1, 2], inward=True)
+    sc = make_scene(parts((*outer, 0.5), (*inner, 0.5)), [], camera([0.5, 0.5, 1.5], [-1, -1, -0.7], size=32))
+    img = direct(gl, replace(sc, world_map=constant_map(RADIANCE * 1e3)), sky_texels=64)
+    assert np.isfinite(img).all() and img.min() >= 0.0
+    share = img[..., :3] / (RADIANCE * 1e3)  # of what the open floor gets
+    if wall_m >= 0.4:
+        assert share.max() == 0.0
+    else:
+        assert share.max() < 0.01 and share.mean() < 3e-4
