@@ -108,6 +108,39 @@ def test_occluder_casts_a_shadow(gl, kind):
     assert img[row, col] > 0.1
 
 
+def test_hard_shadow_edge_is_filtered_and_exact_away_from_it(gl):
+    # The point light at (0, 0, 2) shadows the floor where x and y both lie in [0.6, 1.4] (the occluder
+    # 0.3..0.7 at z = 1, scaled x2 from the light). The shadow test is bilinearly filtered over the four
+    # nearest shadow-map texels, so pixels within a texel or two of that edge read a fraction of the
+    # light, and the rest read exactly 0 or the unshadowed E / pi (fp32: 1e-4). A 64-texel map makes a
+    # texel ~6 cm on the floor under the light: "away" is 3 texels (the 1.5-texel normal offset and the
+    # filter's one texel, plus margin).
+    light = Light("POINT", [0, 0, H], [0, 0, -1], [1, 1, 1], power_w=300.0)
+    method = DirectMethod(gl, GIConfig(), RsmConfig(resolution=64))
+    scene = make_scene(light)
+    method.set_scene(scene)
+    img = method.run().images["direct"][..., 0]
+    cam = scene.camera
+    ratios, edge_m = [], []
+    for row in range(SIZE):
+        for col in range(SIZE):
+            p = floor_point_at_pixel(cam, row, col)
+            seen_at_occluder = 0.8 * p[:2]  # the camera's ray (from z = 5) crosses z = 1 there
+            if max(abs(p[0]), abs(p[1])) > 0.98 or np.all((0.3 <= seen_at_occluder) & (seen_at_occluder <= 0.7)):
+                continue  # off the floor, or the camera sees the occluder there
+            ratios.append(img[row, col] / point_irradiance_over_pi(300.0 / (4 * np.pi), p))
+            # distance from the shadow's square [0.6, 1.4]^2 boundary (inside or out)
+            inside = 0.6 <= p[0] <= 1.4 and 0.6 <= p[1] <= 1.4
+            d_out = np.hypot(max(0.6 - p[0], 0.0, p[0] - 1.4), max(0.6 - p[1], 0.0, p[1] - 1.4))
+            edge_m.append(min(p[0] - 0.6, p[1] - 0.6) if inside else d_out)
+    ratios, edge_m = np.array(ratios), np.array(edge_m)
+    texel_m = 2 * H / 64
+    far = edge_m > 3 * texel_m
+    assert np.all((np.abs(ratios[far]) < 1e-4) | (np.abs(ratios[far] - 1) < 1e-4))
+    partial = (ratios > 0.05) & (ratios < 0.95)
+    assert partial.any() and np.all(edge_m[partial] <= 3 * texel_m)
+
+
 @pytest.mark.parametrize("shape, sx, sy", [("SQUARE", 1.0, 1.0), ("DISK", 1.2, 1.2), ("RECTANGLE", 1.6, 0.4)])
 def test_area_light_gives_its_polygons_irradiance(gl, shape, sx, sy):
     # Exact answer: the numpy twin (area_light.polygon_irradiance, itself checked against closed forms
