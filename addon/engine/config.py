@@ -79,6 +79,12 @@ class RsmConfig(_Validated):
     # (world.py) and its own RSM face (the VPLs every indirect method reads): 16 kept Sponza's update
     # near 0.7 s on llvmpipe (32: 1.4 s); 0 leaves the world out (no direct light from it either).
     world_suns: int = _num(16, 0, 256, "suns the world's bounce is split into (0: the world does not light)")
+    # A sun's RSM spans the whole scene, so at `resolution` its texels are coarse where the camera looks
+    # closely: a window's sunlit patch came out a camera pixel off along one edge (window-room, direct
+    # rel_rmse_8 0.298 at 256 texels). Its direct light reads a shadow map of its own at this size
+    # (docs/DIRECT.md); its VPLs still come from the RSM.
+    sun_shadow_texels: int = _num(1024, 0, 8192, "texels per side of a sun's own shadow map for its direct "
+                                  "light (0: its RSM's)")
     # The world's direct light: at most this many regions of the sky (the same importance-stratified
     # split, finer), each shadowed by a sky_texels^2 tile of one atlas and all evaluated in one pass over
     # the G-buffer (passes/sky_light.py). The count is this times the world's share of the scene's

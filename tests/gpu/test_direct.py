@@ -141,6 +141,39 @@ def test_hard_shadow_edge_is_filtered_and_exact_away_from_it(gl):
     assert partial.any() and np.all(edge_m[partial] <= 3 * texel_m)
 
 
+def sun_shadow_errors(gl, sun_shadow_texels):
+    """Floor pixels farther than 3 cm from the exact edge of a hard sun shadow whose visibility is not
+    exactly 0 or 1. The sun shines along (0.4, 0.4, -1): the occluder 0.3..0.7 at z = 1 shadows the floor
+    where x and y lie in [0.7, 1.1]."""
+    light = Light("SUN", [0, 0, H], [0.4, 0.4, -1.0], [1, 1, 1], sun_strength=3.0)
+    method = DirectMethod(gl, GIConfig(), RsmConfig(resolution=32, sun_shadow_texels=sun_shadow_texels))
+    scene = make_scene(light)
+    method.set_scene(scene)
+    img = method.run().images["direct"][..., 0]
+    lit_value = 3.0 * (1.0 / np.linalg.norm([0.4, 0.4, 1.0])) / np.pi  # E cos / pi
+    wrong = 0
+    for row in range(SIZE):
+        for col in range(SIZE):
+            p = floor_point_at_pixel(scene.camera, row, col)
+            seen_at_occluder = 0.8 * p[:2]
+            if max(abs(p[0]), abs(p[1])) > 0.98 or np.all((0.3 <= seen_at_occluder) & (seen_at_occluder <= 0.7)):
+                continue
+            inside = 0.7 <= p[0] <= 1.1 and 0.7 <= p[1] <= 1.1
+            edge_m = min(p[0] - 0.7, p[1] - 0.7) if inside else \
+                np.hypot(max(0.7 - p[0], 0.0, p[0] - 1.1), max(0.7 - p[1], 0.0, p[1] - 1.1))
+            want = 0.0 if inside else lit_value
+            wrong += edge_m > 0.03 and abs(img[row, col] - want) > 1e-4 * lit_value
+    return wrong
+
+
+def test_a_sun_shadows_from_its_own_finer_map(gl):
+    # RsmConfig.sun_shadow_texels: a sun's direct light reads a shadow map of its own. With the RSM at 32
+    # texels (~8 cm on this floor) and no map of its own, pixels 3 cm and more from the exact shadow edge
+    # come out wrong; with a 512-texel map of its own (~5 mm texels) none does.
+    assert sun_shadow_errors(gl, 0) > 0
+    assert sun_shadow_errors(gl, 512) == 0
+
+
 @pytest.mark.parametrize("shape, sx, sy", [("SQUARE", 1.0, 1.0), ("DISK", 1.2, 1.2), ("RECTANGLE", 1.6, 0.4)])
 def test_area_light_gives_its_polygons_irradiance(gl, shape, sx, sy):
     # Exact answer: the numpy twin (area_light.polygon_irradiance, itself checked against closed forms

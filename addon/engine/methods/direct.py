@@ -28,7 +28,7 @@ from ..backends.base import Backend
 from ..config import GIConfig, RsmConfig
 from ..errors import ConfigError
 from ..passes import accumulate, declare, denoise, direct_light, gbuffer, rsm, sky_light, zero
-from ..passes.light_views import LightView, emissive_lights, reaches, views_for
+from ..passes.light_views import KIND_CODE, LightView, emissive_lights, reaches, views_for
 from ..scene import Camera, Scene
 
 # Each light face's RSM is kept between updates while all of them fit in this budget, so a gather after
@@ -140,6 +140,8 @@ class DirectMethod:
         self._rsm_slots: list[tuple[dict, object]] = []  # (textures, target) per kept face, made on use
         self._kept_faces = max(1, RSM_KEEP_BYTES // (RSM_BYTES_PER_TEXEL * n * n))
         self.rsm, self.rsm_target = self._rsm_slot(0)  # the face being drawn or read (hooks use it)
+        self._slot = 0  # that face's slot: its sun shadow map's too
+        self._sun_shadows: dict[int, tuple[dict, object]] = {}  # slot -> a sun's own shadow map (made on use)
         self._emitter_rows = None  # the emitter table on the GPU (light_views)
         self._world_key, self._world_suns = None, []
         self._world_map, self._sky_suns_key, self._sky_suns = None, None, []  # sky_suns()
@@ -158,6 +160,30 @@ class DirectMethod:
             target = be.target([textures["position"], textures["normal"], textures["flux"]], be.depth_texture((n, n)))
             self._rsm_slots.append((textures, target))
         return self._rsm_slots[index]
+
+    def _own_sun_shadow(self, view: LightView) -> bool:
+        """Whether `view` (a sun lamp's face; world suns' direct light is the sky pass's) gets a shadow
+        map of its own for its direct light (RsmConfig.sun_shadow_texels)."""
+        return (self.rsm_config.sun_shadow_texels > 0 and view.uniforms["light_kind"] == KIND_CODE["SUN"]
+                and view.light_index not in self.vpl_shares)
+
+    def _sun_shadow_slot(self, slot: int) -> tuple[dict, object]:
+        if slot not in self._sun_shadows:
+            be, n = self.backend, self.rsm_config.sun_shadow_texels
+            textures = {k: be.texture((n, n)) for k in ("position", "normal", "flux")}
+            target = be.target([textures["position"], textures["normal"], textures["flux"]], be.depth_texture((n, n)))
+            self._sun_shadows[slot] = (textures, target)
+        return self._sun_shadows[slot]
+
+    def shadow_map(self, view: LightView) -> tuple[object, LightView]:
+        """What the direct pass tests `view`'s shadows against, and the view as that map's texels see it:
+        the RSM's position texture, or a sun's own finer map with its texel area scaled to match."""
+        if not self._own_sun_shadow(view):
+            return self.rsm["position"], view
+        scale = (self.rsm_config.resolution / self.rsm_config.sun_shadow_texels) ** 2
+        fine = replace(view, texel_scale=view.texel_scale * scale,
+                       uniforms={**view.uniforms, "texel_scale": view.texel_scale * scale})
+        return self._sun_shadow_slot(self._slot)[0]["position"], fine
 
     def set_camera(self, camera: Camera) -> None:
         self.source = replace(self.source, camera=camera)
@@ -365,8 +391,11 @@ class DirectMethod:
 
     def _draw_rsm(self, view: LightView, slot: int, timings: dict[str, float]) -> None:
         self.rsm, self.rsm_target = self._rsm_slot(slot)
+        self._slot = slot
         with self.step(timings, rsm.DECL):
             rsm.run(self.backend, self.rsm_target, self._meshes[rsm.SPEC.name], view)
+            if self._own_sun_shadow(view):  # the same orthographic view, finer
+                rsm.run(self.backend, self._sun_shadow_slot(slot)[1], self._meshes[rsm.SPEC.name], view)
 
     def _solve(self, views: list[LightView], timings: dict[str, float], slots) -> None:
         self._draw_sky(timings)
@@ -401,6 +430,7 @@ class DirectMethod:
         self._sky_direct(timings)
         for view, slot in zip(views, slots, strict=True):
             self.rsm, self.rsm_target = self._rsm_slot(slot)
+            self._slot = slot
             self._gather_view(view, timings)
         self.gather_pixels(timings)
         self._average_and_show(timings, first)
@@ -455,8 +485,9 @@ class DirectMethod:
             self.gather_view(view, timings)
             return
         with self.step(timings, direct_light.DECL):
-            direct_light.run(self.backend, self.gbuf["position"], self.gbuf["normal"], self.rsm["position"],
-                             self.direct, view, self.rsm_config.shadow_bias_texels, self.emitters)
+            shadow, shadow_view = self.shadow_map(view)
+            direct_light.run(self.backend, self.gbuf["position"], self.gbuf["normal"], shadow, self.direct,
+                             shadow_view, self.rsm_config.shadow_bias_texels, self.emitters)
         self.gather_view(view, timings)
 
     def read(self) -> dict[str, np.ndarray]:

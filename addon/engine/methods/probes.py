@@ -80,7 +80,8 @@ class ProbesMethod(OneBounceMethod):
 
     def solve_view(self, view: LightView, timings: dict[str, float]) -> None:
         with self.step(timings, probe_project.SHADE_DECL):
-            probe_project.shade(self.backend, self.atlas, self.atlas_direct, self.rsm["position"], view,
+            shadow, shadow_view = self.shadow_map(view)
+            probe_project.shade(self.backend, self.atlas, self.atlas_direct, shadow, shadow_view,
                                 self.rsm_config.shadow_bias_texels, self.emitters)
 
     def finish_solve(self, timings: dict[str, float]) -> None:
