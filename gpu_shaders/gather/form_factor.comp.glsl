@@ -2,7 +2,8 @@
 // pixels or lightmap texels) with normal n: for each probe around x (probes/weights.glsl, the weights
 // of the probes' lookup) each of its quad lights (gather/quads.comp.glsl) is rebuilt in world space,
 // corner c at probe + d_c w_c (w_c the corner's unit direction, d_c its measured distance: the
-// distance correction), and adds L F, F its form factor at x:
+// distance correction), or where a quad is not whole each of its texels as the piece of its own plane
+// its corner directions cut (plane_corner), and adds L F, F its form factor at x:
 //   polygon (the default): Lambert's formula for the quad clipped to x's horizon (n . v >= 0),
 //     F = 1 / (2 pi) sum over edges (v_i, v_i+1) of angle_i n . (v_i x v_i+1) / |v_i x v_i+1|,
 //     angle_i = atan2(|v_i x v_i+1|, v_i . v_i+1), edges whose cross product vanishes skipped;
@@ -70,13 +71,14 @@ float form_factor(vec3 v0, vec3 v1, vec3 v2, vec3 v3, vec3 n) {
 }
 #endif
 
-vec3 quad_light(vec3 probe_rel, int face, ivec2 first, int size, vec4 d, vec3 light, vec3 n) {
-    int nt = face_texels;
-    vec3 v0 = probe_rel + d.x * normalize(corner_point(face, first, nt));
-    vec3 v1 = probe_rel + d.y * normalize(corner_point(face, first + ivec2(size, 0), nt));
-    vec3 v2 = probe_rel + d.z * normalize(corner_point(face, first + ivec2(size, size), nt));
-    vec3 v3 = probe_rel + d.w * normalize(corner_point(face, first + ivec2(0, size), nt));
+// A quad with corners v (relative to x, in corner_offset order) of radiance `light`, at x.
+vec3 quad_light(vec3 v0, vec3 v1, vec3 v2, vec3 v3, vec3 light, vec3 n) {
     return light * form_factor(v0, v1, v2, v3, n);
+}
+
+// The direction of corner k of a face of face_texels texels a side (unit).
+vec3 corner_dir(int face, ivec2 k) {
+    return normalize(corner_point(face, k, face_texels));
 }
 
 // The light of one face of probe p (its quads, or the texels of a quad that is not whole) at x.
@@ -94,8 +96,10 @@ vec3 face_light(int p, int face, vec3 probe_rel, vec3 n) {
             }
             ivec2 first = ivec2(qx, qy) * k;
             if (quad.w == 1.0) {
-                e += quad_light(probe_rel, face, first, k, texelFetch(quad_corners, quad_origin + ivec2(qx, qy), 0),
-                                quad.rgb, n);
+                vec4 d = texelFetch(quad_corners, quad_origin + ivec2(qx, qy), 0);
+                e += quad_light(probe_rel + d.x * corner_dir(face, first), probe_rel + d.y * corner_dir(face, first + ivec2(k, 0)),
+                                probe_rel + d.z * corner_dir(face, first + ivec2(k, k)),
+                                probe_rel + d.w * corner_dir(face, first + ivec2(0, k)), quad.rgb, n);
                 continue;
             }
             for (int j = 0; j < k; ++j) {
@@ -105,7 +109,14 @@ vec3 face_light(int p, int face, vec3 probe_rel, vec3 n) {
                     if (texel.w == 0.0 || all(equal(texel.rgb, vec3(0.0)))) {
                         continue;
                     }
-                    e += quad_light(probe_rel, face, ij, 1, texelFetch(fine_corners, texel_origin + ij, 0), texel.rgb, n);
+                    vec4 plane = texelFetch(fine_plane, texel_origin + ij, 0);
+                    vec3 centre = face_direction(face, texel_st(ij));
+                    bool clipped;
+                    e += quad_light(probe_rel + plane_corner(plane, centre, corner_dir(face, ij), clipped),
+                                    probe_rel + plane_corner(plane, centre, corner_dir(face, ij + ivec2(1, 0)), clipped),
+                                    probe_rel + plane_corner(plane, centre, corner_dir(face, ij + ivec2(1, 1)), clipped),
+                                    probe_rel + plane_corner(plane, centre, corner_dir(face, ij + ivec2(0, 1)), clipped),
+                                    texel.rgb, n);
                 }
             }
         }

@@ -2,7 +2,7 @@
 // 001's down-sampling), one invocation per quad. A quad is whole where the surface it covers is
 // continuous: at every texel corner inside it or on its border, every texel touching that corner (on
 // any cube face: corner_candidates) sees geometry, and their planes (texels.comp.glsl) meet that
-// corner's direction within DEPTH_EDGE of each other. A whole quad (kind 1) is one light: radiance
+// corner's direction, not too near edge-on (plane_corner), within DEPTH_EDGE of each other. A whole quad (kind 1) is one light: radiance
 // the solid-angle-weighted mean of its texels', corners at the mean of their candidates' distances,
 // which is a function of the corner's direction alone, so quads on either side of a cube edge share
 // their corners (no seams). Otherwise (kind 2) it straddles a depth edge or a hole: averaged, it would
@@ -23,6 +23,7 @@ const float DEPTH_EDGE = 0.1;
 bool corner_candidates(int p, int face, ivec2 k, out float lo, out float hi, out float mean) {
     int n = face_texels;
     vec3 c = corner_point(face, k, n);
+    vec3 dir = normalize(c);
     lo = 1e30;
     hi = 0.0;
     float sum = 0.0;
@@ -48,7 +49,10 @@ bool corner_candidates(int p, int face, ivec2 k, out float lo, out float hi, out
                     whole = false;
                     continue;
                 }
-                float d = texelFetch(fine_corners, t, 0)[corner_of_offset(kg - ij)];
+                bool clipped;
+                float d = length(plane_corner(texelFetch(fine_plane, t, 0), face_direction(g, texel_st(ij)), dir,
+                                              clipped));
+                whole = whole && !clipped;
                 lo = min(lo, d);
                 hi = max(hi, d);
                 sum += d;

@@ -16,13 +16,13 @@ from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_coun
 from ..config import GatherConfig, ProbesConfig
 from ..probe_grid import ProbeGrid
 from .declare import GBUF_NORMAL, GBUF_POSITION, INDIRECT, PassDecl
-from .gather_quads import FINE_CORNERS, FINE_RADIANCE, QUAD_CORNERS, QUAD_RADIANCE
+from .gather_quads import FINE_PLANE, FINE_RADIANCE, QUAD_CORNERS, QUAD_RADIANCE
 from .probe_capture import GRID_UNIFORMS, MOMENTS, STATE
 from .probe_lookup import MIN_VARIANCE_RATIO
 from .rsm_gather import MAX_LOOP_ITERATIONS
 
 DECL = PassDecl("gather_form_factor", "gather",
-                (GBUF_POSITION, GBUF_NORMAL, QUAD_RADIANCE, QUAD_CORNERS, FINE_RADIANCE, FINE_CORNERS, MOMENTS, STATE),
+                (GBUF_POSITION, GBUF_NORMAL, QUAD_RADIANCE, QUAD_CORNERS, FINE_RADIANCE, FINE_PLANE, MOMENTS, STATE),
                 (INDIRECT,), "every probe's quad lights around each pixel, by their form factors")
 
 ITEMS = 48  # (probe, face) pairs a receiver visits: 8 probes x 6 faces
@@ -34,7 +34,7 @@ def _spec(form_factor: str) -> ShaderSpec:
         compute="gather/form_factor.comp.glsl",
         local_size=(8, 8, 1),
         samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("quad_radiance", "2D"),
-                  Sampler("quad_corners", "2D"), Sampler("fine_radiance", "2D"), Sampler("fine_corners", "2D"),
+                  Sampler("quad_corners", "2D"), Sampler("fine_radiance", "2D"), Sampler("fine_plane", "2D"),
                   Sampler("moments", "2D"), Sampler("state", "2D")),
         images=(Image("indirect", "2D", "RGBA32F", "read_write"),),
         uniforms=(*GRID_UNIFORMS, Var("normal_bias_m", "float"), Var("min_variance_m2", "float"),
@@ -64,7 +64,7 @@ def run(backend: Backend, position, normal, quads: dict, moments, state, indirec
                 "min_variance_m2": MIN_VARIANCE_RATIO * grid.spacing_m ** 2,
                 "visibility": int(probes.chebyshev_visibility), "face_quads": config.face_quads}
     samplers = {"gbuf_position": position, "gbuf_normal": normal, "moments": moments, "state": state,
-                **{k: quads[k] for k in ("quad_radiance", "quad_corners", "fine_radiance", "fine_corners")}}
+                **{k: quads[k] for k in ("quad_radiance", "quad_corners", "fine_radiance", "fine_plane")}}
     step = items_per_dispatch(grid.face_texels, config.face_quads)
     for begin in range(0, ITEMS, step):
         backend.dispatch(backend.program(spec), group_count(indirect.size, spec.local_size),

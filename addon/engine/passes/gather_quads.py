@@ -3,17 +3,19 @@ Szirmay-Kalos, "Robust diffuse final gathering on the GPU"; docs/GATHER.md).
 
 gather_texels: per texel of the probes' atlas (probe_capture: every probe's six n x n faces), the
 radiance it brings, L = albedo x (direct [+ the previous bounces' indirect]) (W/m^2/sr; the same
-radiance the probes project, probes/radiance.glsl), and the distances (m) from the probe, along the
-texel's four corner directions, to the plane through the surface point it sees with that surface's
-normal: where the surface is flat these are the corners of the piece of it the texel sees.
+radiance the probes project, probes/radiance.glsl), and the plane of the surface it sees (its normal
+and offset from the probe): where the surface is flat, that plane cut by the texel's four corner
+directions is exactly the piece of it the texel sees (gather/quad.glsl, plane_corner; a plane seen
+near edge-on is cut at 4 x the texel's distance, in the plane).
 gather_quads: each face's texels merged into M x M quads (GatherConfig.face_quads = M, dividing n),
 each a quad light whose radiance is the solid-angle-weighted mean of its texels' and whose corners lie
-at the mean of the distances the texels touching each corner give its direction (on every cube face
-that holds the corner: a quad shares its corners with its neighbours across cube edges, no seams).
-A quad over a depth edge (two planes meeting a corner's direction more than 10 % apart) or over
-directions that see nothing is marked for the gather to use its texels one by one instead: averaged, it
-would float between the near and the far surface (the digest's pitfall).
-Outputs: fine_radiance, fine_corners (atlas, n x n faces); quad_radiance (rgb; a = 0 none, 1 one quad,
+at the mean of the distances at which the planes of the texels touching each corner meet its direction
+(on every cube face that holds the corner: a quad shares its corners with its neighbours across cube
+edges, no seams). A quad over a depth edge (two planes meeting a corner's direction more than 10 %
+apart), over directions that see nothing or over a plane seen near edge-on is marked for the gather to
+use its texels one by one instead: averaged, it would float between the near and the far surface (the
+digest's pitfall).
+Outputs: fine_radiance, fine_plane (atlas, n x n faces); quad_radiance (rgb; a = 0 none, 1 one quad,
 2 its texels), quad_corners (the capture's tile layout with M x M faces, grid.tiled_size(M)).
 """
 
@@ -27,8 +29,8 @@ from .probe_project import ATLAS_DIRECT, ATLAS_INDIRECT
 
 FINE_RADIANCE = Port("gather", "fine_radiance", "RGBA32F", "probe_atlas",
                      "radiance (W/m^2/sr) a probe texel brings; w = 1 where it sees geometry")
-FINE_CORNERS = Port("gather", "fine_corners", "RGBA32F", "probe_atlas",
-                    "distance (m) from the probe to the texel's surface plane along its 4 corner directions")
+FINE_PLANE = Port("gather", "fine_plane", "RGBA32F", "probe_atlas",
+                  "plane of the surface a probe texel sees: unit normal towards the probe, offset n . (x - probe) (m)")
 QUAD_RADIANCE = Port("gather", "quad_radiance", "RGBA32F", "probe_quads",
                      "mean radiance (W/m^2/sr) of a quad's texels; a = 0 none, 1 whole quad, 2 its texels")
 QUAD_CORNERS = Port("gather", "quad_corners", "RGBA32F", "probe_quads",
@@ -36,8 +38,8 @@ QUAD_CORNERS = Port("gather", "quad_corners", "RGBA32F", "probe_quads",
 
 TEXELS_DECL = PassDecl("gather_texels", "solve", (ATLAS_POSITION, ATLAS_NORMAL, ATLAS_ALBEDO, ATLAS_DIRECT,
                                                    ATLAS_INDIRECT),
-                       (FINE_RADIANCE, FINE_CORNERS), "each probe texel's radiance and its surface's corners")
-QUADS_DECL = PassDecl("gather_quads", "solve", (FINE_RADIANCE, FINE_CORNERS), (QUAD_RADIANCE, QUAD_CORNERS),
+                       (FINE_RADIANCE, FINE_PLANE), "each probe texel's radiance and its surface's plane")
+QUADS_DECL = PassDecl("gather_quads", "solve", (FINE_RADIANCE, FINE_PLANE), (QUAD_RADIANCE, QUAD_CORNERS),
                       "each probe face's texels merged into M x M quad lights (split over depth edges)")
 
 
@@ -48,7 +50,7 @@ def _texels_spec(bounce: bool) -> ShaderSpec:
         local_size=(8, 8, 1),
         samplers=(Sampler("atlas_position", "2D"), Sampler("atlas_normal", "2D"), Sampler("atlas_albedo", "2D"),
                   Sampler("atlas_direct", "2D")) + ((Sampler("atlas_indirect", "2D"),) if bounce else ()),
-        images=(Image("fine_radiance", "2D", "RGBA32F", "write"), Image("fine_corners", "2D", "RGBA32F", "write")),
+        images=(Image("fine_radiance", "2D", "RGBA32F", "write"), Image("fine_plane", "2D", "RGBA32F", "write")),
         uniforms=GRID_UNIFORMS,
         defines=(("BOUNCE", "1"),) if bounce else (),
     )
@@ -60,7 +62,7 @@ QUADS_SPEC = ShaderSpec(
     name="gather_quads",
     compute="gather/quads.comp.glsl",
     local_size=(8, 8, 1),
-    samplers=(Sampler("fine_radiance", "2D"), Sampler("fine_corners", "2D")),
+    samplers=(Sampler("fine_radiance", "2D"), Sampler("fine_plane", "2D")),
     images=(Image("quad_radiance", "2D", "RGBA32F", "write"), Image("quad_corners", "2D", "RGBA32F", "write")),
     uniforms=(*ATLAS_UNIFORMS, Var("face_quads", "int")),
 )
@@ -69,13 +71,13 @@ QUADS_SPEC = ShaderSpec(
 def allocate(backend: Backend, grid: ProbeGrid, face_quads: int) -> dict:
     """The textures both passes write: {port name: texture}."""
     fine, quads = grid.atlas_size, grid.tiled_size(face_quads)
-    return {FINE_RADIANCE.name: backend.texture(fine), FINE_CORNERS.name: backend.texture(fine),
+    return {FINE_RADIANCE.name: backend.texture(fine), FINE_PLANE.name: backend.texture(fine),
             QUAD_RADIANCE.name: backend.texture(quads), QUAD_CORNERS.name: backend.texture(quads)}
 
 
 def texels(backend: Backend, atlas: dict, atlas_direct, out: dict, grid: ProbeGrid, atlas_indirect=None) -> None:
-    """out["fine_radiance"], out["fine_corners"] := every atlas texel's radiance (albedo x (direct
-    [+ atlas_indirect])) and its surface plane's distances along its corner directions."""
+    """out["fine_radiance"], out["fine_plane"] := every atlas texel's radiance (albedo x (direct
+    [+ atlas_indirect])) and the plane of the surface it sees."""
     spec = TEXELS_SPECS[atlas_indirect is not None]
     samplers = {"atlas_position": atlas["position"], "atlas_normal": atlas["normal"], "atlas_albedo": atlas["albedo"],
                 "atlas_direct": atlas_direct}
@@ -83,12 +85,12 @@ def texels(backend: Backend, atlas: dict, atlas_direct, out: dict, grid: ProbeGr
         samplers["atlas_indirect"] = atlas_indirect
     backend.dispatch(backend.program(spec), group_count(grid.atlas_size, spec.local_size),
                      uniforms=grid_uniforms(spec, grid), samplers=samplers,
-                     images={k: out[k] for k in ("fine_radiance", "fine_corners")})
+                     images={k: out[k] for k in ("fine_radiance", "fine_plane")})
 
 
 def quads(backend: Backend, out: dict, grid: ProbeGrid, face_quads: int) -> None:
     """out["quad_radiance"], out["quad_corners"] := every probe face's M x M quads (M = face_quads)."""
     backend.dispatch(backend.program(QUADS_SPEC), group_count(grid.tiled_size(face_quads), QUADS_SPEC.local_size),
                      uniforms={**grid_uniforms(QUADS_SPEC, grid), "face_quads": face_quads},
-                     samplers={k: out[k] for k in ("fine_radiance", "fine_corners")},
+                     samplers={k: out[k] for k in ("fine_radiance", "fine_plane")},
                      images={k: out[k] for k in ("quad_radiance", "quad_corners")})
