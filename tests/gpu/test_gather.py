@@ -73,8 +73,9 @@ def _receivers(gl, points, normals):
     return gl.texture((k, 1), data=pos), gl.texture((k, 1), data=nrm)
 
 
-def _gather(gl, grid, field, points, normals, probes=ProbesConfig(), config=GatherConfig()):
+def _gather(gl, grid, field, points, normals, probes=None, config=None):
     quads, moments, state, _, _ = field
+    probes, config = probes or ProbesConfig(), config or GatherConfig()
     pos, nrm = _receivers(gl, points, normals)
     out = gl.texture((len(points), 1))
     gather_form_factor.run(gl, pos, nrm, quads, moments, state, out, grid, probes, config)
@@ -139,16 +140,18 @@ def test_the_horizon_clips_quads_a_tilted_receiver_sees_in_part(gl):
     normals = [(1.0, 0.0, 0.4), (0.0, -1.0, 0.2)]
     field = _field(gl, GRID, _square(1.0, 1.0), 4)
     got = _gather(gl, GRID, field, points, normals)
-    expected = np.array([numeric_form_factor(p, n, 1.0, 1.0) for p, n in zip(points, normals)])[:, None] * RADIANCE
+    f = [numeric_form_factor(p, n, 1.0, 1.0) for p, n in zip(points, normals, strict=True)]
+    expected = np.array(f)[:, None] * RADIANCE
     np.testing.assert_allclose(got, expected, rtol=1e-3)
 
 
 def test_a_point_1_mm_from_a_lit_wall_stays_bounded(gl):
     # A receiver 1 mm below the square, facing it, under the centre of a whole quad (M = 4: the quad
     # [-0.5, 0]^2 at z = 1). Polygon form factors: F = 1 - 1.0e-6 (the closed form; at most 1 however
-    # close), so Diffuse Indirect = L to fp32 rounding (measured 1 + 1.5e-6: bounded by L (1 + 1e-5)). The point-to-point baseline puts that quad's 0.25 m^2 at 1 mm:
-    # A / (pi r^2) = 8e4, a spike. Visibility is off: the normal bias would test the probe's view from
-    # behind the wall, which the probes' own tests cover; here the form factor alone is measured.
+    # close), so Diffuse Indirect = L to fp32 rounding (measured 1 + 1.5e-6: bounded by L (1 + 1e-5)).
+    # The point-to-point baseline puts that quad's 0.25 m^2 at 1 mm: A / (pi r^2) = 8e4, a spike.
+    # Visibility is off: the normal bias would test the probe's view from behind the wall, which the
+    # probes' own tests cover; here the form factor alone is measured.
     probes = ProbesConfig(chebyshev_visibility=False)
     point = (-0.25, -0.25, 0.999)
     field = _field(gl, GRID, _square(1.0, 1.0), 4)
