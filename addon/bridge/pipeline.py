@@ -125,9 +125,9 @@ def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
         notes.append("the scene has no light sources: all light is zero")
     stats = {
         "method": gi.method,
-        # The groups the method reads (registry): a shared group and its own.
+        # The groups the method reads (registry): the shared groups and its own.
         "config": {group: settings[group].to_dict() for group in settings
-                   if group in registry.SHARED_GROUPS or group == registry.get(gi.method).own_group},
+                   if group in registry.SHARED_GROUPS or group in registry.get(gi.method).own_groups},
         "image_size": [width, height],
         "triangles": captured.triangle_count,
         "lights": len(captured.lights),

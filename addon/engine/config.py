@@ -211,6 +211,23 @@ class ProbesConfig(_Validated):
 
 
 @dataclass(frozen=True)
+class GatherConfig(_Validated):
+    """Distance-corrected final gathering from the probes' cube maps (method `gather`, paper 001):
+    docs/GATHER.md. The probes' own settings (ProbesConfig) place and capture the cube maps."""
+
+    # M: each probe face's face_texels^2 captured texels are merged into M x M quad lights, each rebuilt
+    # at its measured corner distances (fine texels where a quad would straddle a depth edge). The
+    # paper's M is 4 or 2. Must divide ProbesConfig.face_texels (the quads' corners are texel corners).
+    face_quads: int = _num(4, 2, 8, "quad lights per side of each probe face (M x M per face; must divide "
+                           "face_texels)")
+    # polygon: the exact form factor of each quad at the receiver (Lambert's formula, clipped to the
+    # receiver's horizon), bounded near walls; point: the paper's baseline, each quad a point light
+    # A cos cos / (pi r^2), which spikes where a receiver is near a quad (docs/GATHER.md).
+    form_factor: str = _choice("polygon", ("polygon", "point"), "each quad's form factor at the receiver: "
+                               "polygon-to-point (exact, bounded) or point-to-point (the paper's baseline)")
+
+
+@dataclass(frozen=True)
 class DiffusionConfig(_Validated):
     """Volume diffusion (method `diffusion`, paper 000): docs/DIFFUSION.md derives the transport."""
 
@@ -256,7 +273,7 @@ class GIConfig(_Validated):
 # Settings group -> its config class: the Blender property groups (scene.bounce.<group>), the command
 # line's flags and the registry's `reads` use these names.
 GROUPS: dict[str, type] = {"gi": GIConfig, "rsm": RsmConfig, "lpv": LpvConfig, "vct": VctConfig,
-                           "probes": ProbesConfig, "diffusion": DiffusionConfig}
+                           "probes": ProbesConfig, "diffusion": DiffusionConfig, "gather": GatherConfig}
 
 
 def settings(**configs) -> dict[str, Any]:

@@ -35,9 +35,15 @@ class MethodSpec:
 
     @property
     def own_group(self) -> str | None:
-        """The settings group of its own (its config class), or None."""
-        own = [r.split(".")[0] for r in self.reads if r.split(".")[0] not in SHARED_GROUPS]
-        return own[0] if own else None
+        """The settings group of its own (its config class), or None: the first of `own_groups`."""
+        return self.own_groups[0] if self.own_groups else None
+
+    @property
+    def own_groups(self) -> tuple[str, ...]:
+        """Every settings group it reads besides the shared ones, in `reads` order: what its class takes
+        after the gi and rsm configs (`gather` reads its own group and the probes' it gathers from)."""
+        groups = [r.split(".")[0] for r in self.reads if r.split(".")[0] not in SHARED_GROUPS]
+        return tuple(dict.fromkeys(groups))
 
     def reads_setting(self, group: str, field: str) -> bool:
         return f"{group}.{field}" in self.reads or f"{group}.*" in self.reads
@@ -108,6 +114,14 @@ METHODS: tuple[MethodSpec, ...] = (
         # transfer at 32 cells with the default steps and with its own rule of one span (docs/DIFFUSION.md).
         bench=({"diffusion.grid_cells": 16}, {}, {"diffusion.grid_cells": 64}, {"diffusion.transfer": "cone"},
                {"diffusion.transfer": "cone", "diffusion.span_multiple": 1.0})),
+    MethodSpec(
+        name="gather", summary="distance-corrected final gather of the probes' cube maps as quad lights (paper 001)",
+        module="gather", class_name="GatherMethod", products=("direct", "indirect", "albedo"), max_bounces=8,
+        reads=(*_IMAGE, "gi.bounces", *_LIGHT_VIEWS, "gather.*", "probes.*"),
+        # M = 2, 4, 8 quads a face side with the polygon form factor, and the paper's point-to-point
+        # baseline at the default M (docs/GATHER.md).
+        bench=({"gather.face_quads": 2}, {"gather.face_quads": 4}, {"gather.face_quads": 8},
+               {"gather.form_factor": "point"})),
 )
 
 NAMES: tuple[str, ...] = tuple(m.name for m in METHODS)

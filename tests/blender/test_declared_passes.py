@@ -51,9 +51,17 @@ def point_scene():
     return SceneCache().update(bpy.context.evaluated_depsgraph_get(), 32, 32)
 
 
-@pytest.mark.parametrize("case", method_outputs.CASES)
+# Methods whose images tools/method_outputs.py does not record yet, run here at small settings.
+UNRECORDED = {
+    "gather": {"gi": {"method": "gather"}, "probes": {"probes_per_side": 4}},
+    "gather-b2": {"gi": {"method": "gather", "bounces": 2}, "probes": {"probes_per_side": 4}},
+}
+CASES = {**method_outputs.CASES, **UNRECORDED}
+
+
+@pytest.mark.parametrize("case", CASES)
 def test_the_declared_lists_are_what_runs(gl, point_scene, case):
-    method = methods.create(gl, method_outputs.settings_of(method_outputs.CASES[case]))
+    method = methods.create(gl, method_outputs.settings_of(CASES[case]))
     method.set_scene(point_scene)
     timings = method.run().timings_ms
     declared = {decl.name for decl in _ordered(type(method))}

@@ -31,6 +31,9 @@ CASES = {
     # probes (6 a side, _method): the SH field does not depend on the camera, bounces included.
     "probes": ("probes", {}, {}, {}, True),
     "probes-2-bounces": ("probes", {"bounces": 2}, {}, {}, True),
+    # gather (the probes' 6 a side): its quads do not depend on the camera, bounces included.
+    "gather": ("gather", {}, {}, {}, True),
+    "gather-2-bounces": ("gather", {"bounces": 2}, {}, {}, True),
 }
 
 

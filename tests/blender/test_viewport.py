@@ -199,18 +199,27 @@ def test_navigating_gives_preview_then_full_quality(cornell):
 
 @pytest.mark.parametrize("name", ["direct", "direct-world", "rsm", "lpv", "lpv-far-field", "lpv-emitter-classes",
                                   "lpv-octree", "lpv-octree-index", "vct", "vct-filtered", "diffusion", "probes",
-                                  "probes-irradiance"])
+                                  "probes-irradiance", "gather", "gather-point"])
 def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, name):
     # lpv at 16 cells runs one grid; "lpv-far-field" at 32 cells adds the far field's passes;
     # "lpv-emitter-classes" (16 cells) the classes' injection, unpacks and own-light lookups;
     # "lpv-octree" (16 cells) every level's injection and the time merge, "lpv-octree-index" the
     # downsampling and the index merge's shader;
     # "vct-filtered" the filtered injection (gl_VertexID, the projected-area fetches);
-    # "direct-world" the sky's shadow atlas (a draw per tile's viewport) and its fused direct pass.
+    # "direct-world" the sky's shadow atlas (a draw per tile's viewport) and its fused direct pass;
+    # "gather-point" the gather's point-to-point form factor.
     from addon.bridge import scenes
     from addon.bridge.capture import SceneCache
     from addon.engine import methods
-    from addon.engine.config import DiffusionConfig, GIConfig, LpvConfig, ProbesConfig, RsmConfig, VctConfig
+    from addon.engine.config import (
+        DiffusionConfig,
+        GatherConfig,
+        GIConfig,
+        LpvConfig,
+        ProbesConfig,
+        RsmConfig,
+        VctConfig,
+    )
 
     # vct: its glossy product too; direct-world: Blender's default grey world besides the spot.
     scenes.build("cornell-glossy" if name.startswith("vct") else "cornell-grey-world" if name == "direct-world"
@@ -228,7 +237,9 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
         method = methods.create(be, {"gi": gi, "rsm": rsm, "lpv": lpv, "vct": vct,
                                      "diffusion": DiffusionConfig(grid_cells=16),
                                      "probes": ProbesConfig(probes_per_side=6, encoding="irradiance"
-                                                            if name == "probes-irradiance" else "sh")})
+                                                            if name == "probes-irradiance" else "sh"),
+                                     "gather": GatherConfig(form_factor="point" if name == "gather-point"
+                                                            else "polygon")})
         method.set_scene(scene)
         result = method.run()
         assert ("sky_direct" in result.timings_ms) == (name == "direct-world")  # the world lights, via the sky pass

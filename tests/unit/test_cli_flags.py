@@ -6,7 +6,15 @@ import pytest
 from addon.cli import build_parser
 from addon.commands import _settings
 from addon.engine import config
-from addon.engine.config import DiffusionConfig, GIConfig, LpvConfig, ProbesConfig, RsmConfig, VctConfig
+from addon.engine.config import (
+    DiffusionConfig,
+    GatherConfig,
+    GIConfig,
+    LpvConfig,
+    ProbesConfig,
+    RsmConfig,
+    VctConfig,
+)
 
 CONFIG_COMMANDS = ("render", "bake")  # the commands that build all four configs
 
@@ -32,7 +40,8 @@ def other_value(setting):
 
 
 def test_the_schema_covers_the_four_configs():
-    assert set(_settings.CONFIGS) == {GIConfig, RsmConfig, LpvConfig, VctConfig, ProbesConfig, DiffusionConfig}
+    assert set(_settings.CONFIGS) == {GIConfig, RsmConfig, LpvConfig, VctConfig, ProbesConfig, DiffusionConfig,
+                                      GatherConfig}
 
 
 @pytest.mark.parametrize("field", every_field(), ids=lambda f: f"{f[0].__name__}.{f[1]}")

@@ -48,4 +48,4 @@ def test_frozen():
 def test_limits_expose_what_properties_mirror():
     lim = limits(RsmConfig)["resolution"]
     assert (lim["default"], lim["min"], lim["max"]) == (256, 16, 4096)
-    assert limits(GIConfig)["method"]["choices"] == ("direct", "rsm", "lpv", "vct", "probes", "diffusion")
+    assert limits(GIConfig)["method"]["choices"] == ("direct", "rsm", "lpv", "vct", "probes", "diffusion", "gather")

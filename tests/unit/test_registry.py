@@ -11,7 +11,7 @@ from addon.engine import config, methods, registry
 
 def test_config_method_choices_are_the_registry():
     assert config.limits(config.GIConfig)["method"]["choices"] == registry.NAMES
-    assert registry.NAMES == ("direct", "rsm", "lpv", "vct", "probes", "diffusion")  # shipped, in menu order
+    assert registry.NAMES == ("direct", "rsm", "lpv", "vct", "probes", "diffusion", "gather")  # shipped, in menu order
 
 
 @pytest.mark.parametrize("spec", registry.METHODS, ids=lambda s: s.name)

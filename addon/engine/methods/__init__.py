@@ -14,8 +14,8 @@ def get(name: str):
 def create(backend, settings: dict):
     """The method settings["gi"].method built from {group: config} (config.settings; missing groups
     take their defaults): every method takes the gi and rsm configs, a method with a settings group of
-    its own (registry) also that group's config."""
+    its own (registry) also those groups' configs, in the order it reads them."""
     settings = complete(**settings)
     spec = registry.get(settings["gi"].method)
-    own = (settings[spec.own_group],) if spec.own_group else ()
+    own = tuple(settings[group] for group in spec.own_groups)
     return get(spec.name)(backend, settings["gi"], settings["rsm"], *own)

@@ -85,24 +85,35 @@ class ProbesMethod(OneBounceMethod):
                                 self.rsm_config.shadow_bias_texels, self.emitters)
 
     def finish_solve(self, timings: dict[str, float]) -> None:
-        be, grid = self.backend, self.grid
-        # (first bounce's pass, later bounces' pass, the bounce lookup, the encoding's function)
+        self.encode_bounces(timings, self.gi.bounces)
+
+    def _encoding(self) -> tuple:
+        """(first bounce's pass, later bounces' pass, the bounce lookup, the encoding's function)."""
         if self.irradiance_encoding:
-            first, later, bounce_decl, encode = (probe_project.CONVOLVE_DECL, probe_project.RECONVOLVE_DECL,
-                                                 probe_lookup.IRRADIANCE_BOUNCE_DECL, probe_project.convolve)
-        else:
-            first, later, bounce_decl, encode = (probe_project.PROJECT_DECL, probe_project.REPROJECT_DECL,
-                                                 probe_lookup.BOUNCE_DECL, probe_project.run)
+            return (probe_project.CONVOLVE_DECL, probe_project.RECONVOLVE_DECL,
+                    probe_lookup.IRRADIANCE_BOUNCE_DECL, probe_project.convolve)
+        return (probe_project.PROJECT_DECL, probe_project.REPROJECT_DECL, probe_lookup.BOUNCE_DECL,
+                probe_project.run)
+
+    def encode_bounces(self, timings: dict[str, float], count: int) -> None:
+        """`self.light` := bounces 1..count of the probe field: `count` encodings, each after the first
+        preceded by the field read back at the atlas (`read_back`)."""
+        first, later, _, encode = self._encoding()
         self.light = self._light[0]
         with self.step(timings, first):
-            encode(be, self.atlas, self.atlas_direct, self.light, grid)
-        for bounce in range(2, self.gi.bounces + 1):
-            with self.step(timings, bounce_decl):
-                probe_lookup.run(be, self.atlas["position"], self.atlas["normal"], self.field(), self.atlas_indirect,
-                                 grid, self.probes_config)
+            encode(self.backend, self.atlas, self.atlas_direct, self.light, self.grid)
+        for bounce in range(2, count + 1):
+            self.read_back(timings)
             self.light = self._light[(bounce - 1) % 2]
             with self.step(timings, later):
-                encode(be, self.atlas, self.atlas_direct, self.light, grid, self.atlas_indirect)
+                encode(self.backend, self.atlas, self.atlas_direct, self.light, self.grid, self.atlas_indirect)
+
+    def read_back(self, timings: dict[str, float]) -> None:
+        """`atlas_indirect` := the probe field (`self.light`) read at every atlas texel: the indirect light
+        at the surfaces the probes see, which the next bounce re-emits."""
+        with self.step(timings, self._encoding()[2]):
+            probe_lookup.run(self.backend, self.atlas["position"], self.atlas["normal"], self.field(),
+                             self.atlas_indirect, self.grid, self.probes_config)
 
     def gather_pixels(self, timings: dict[str, float]) -> None:
         with self.step(timings, probe_lookup.DECL):
