@@ -10,9 +10,12 @@
 // stands for its whole block (`weight` texels), so its disk is taken as DISK_SHARE of the block's area,
 // A = DISK_SHARE x weight x surfel area: a VPL within a few centimetres of the receiver no longer spikes
 // by the block's weight (at 256 VPLs 88 % of the squared difference between two seeds sat in 1 % of
-// the pixels, next to the walls). Cornell 128 px, 256 VPLs (tools/noise_table.py): share 1 / 256 (the
-// surfel alone) noise 0.059, rel_rmse_8 0.193, bias 1.14; 1 / 16: 0.041, 0.195; 1 / 4: 0.034, 0.201,
-// 1.13; 1 (the block): 0.023, 0.221 (the corners' real near-field light lost).
+// the pixels, next to the walls). Cornell 128 px, 256 VPLs, the two geometric denoise iterations
+// (tools/noise_table.py; noise / rel_rmse_8 / bias): share 1 / 256 (the surfel alone) 0.059 / 0.193 /
+// 1.14; 1 / 16 0.041 / 0.195; 1 / 4 0.034 / 0.201 / 1.13; 1 (the block) 0.023 / 0.221 (the corners' real
+// near-field light lost). The bake of the Cornell floor (tests/e2e/test_bake_vs_cycles.py: 1024 VPLs,
+// 64 x 64 texels, the first row 4 cm from the walls) bounds it: rel_rmse_8 / bias 0.126 / 0.948 at
+// 1 / 256, 0.149 / 0.931 at 1 / 16, 0.208 / 0.900 at 1 / 4 (bound 0.18, bias within 0.08).
 // With VOXEL_VISIBILITY, each VPL counts only if the segment between the receiver and the VPL, both
 // moved `offset_cells` off their surfaces along their normals, crosses no occupied voxel (a march in
 // half-cell steps through the voxelizer's occupancy).
@@ -20,7 +23,7 @@
 #include "common/hash.glsl"
 
 const float PI = 3.14159265;
-const float DISK_SHARE = 0.25;
+const float DISK_SHARE = 0.0625;  // 1 / 16
 
 #ifdef VOXEL_VISIBILITY
 // 1 if no occupied voxel lies on the segment, skipping its first and last cell: a VPL low on a wall
