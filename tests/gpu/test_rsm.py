@@ -99,12 +99,12 @@ def test_gather_matches_the_exact_integral(gl):
 
 
 def test_default_vpls_near_field_disk(gl):
-    # At the default 256 VPLs each drawn VPL is a disk of a quarter of its block (gather.comp.glsl),
-    # which removes the spikes of VPLs a few centimetres from a receiver at the price of some near-field
+    # At the default 256 VPLs each drawn VPL is a disk of 1/16 of its block (gather.comp.glsl), which
+    # removes the spikes of VPLs a few centimetres from a receiver at the price of some near-field
     # light. Same wall as above, raw gather, mean of 4 seeds per pixel: measured 0.3-1.9 m up within
-    # 1.0 % of the exact integral (the disk is negligible beside r^2 there); at the crease row (0.12 m)
-    # 0.943 (0.963 with the texel's own disk). Bounds: 2 % above 0.25 m (4 seeds leave ~0.8 % noise),
-    # [0.90, 1.0] at the crease.
+    # 1.3 % of the exact integral (the disk is negligible beside r^2 there); at the crease row (0.12 m)
+    # 0.958 (0.963 with the texel's own disk, 0.943 with a quarter of the block). Bounds: 2 % above
+    # 0.25 m (4 seeds leave ~0.8 % noise), [0.90, 1.0] at the crease.
     light = Light("SUN", [0, 0, 10], [0, 0, -1], [1, 1, 1], sun_strength=3.0)
     cam = Camera(look_along([4, 0, 1], [-1, 0, 0], [0, 0, 1]), perspective(np.radians(40), 0.1, 100), 48, 48)
     scene = scene_of([rect([0, -1, 0], [2, 0, 0], [0, 2, 0]), rect([0, -1, 0], [0, 2, 0], [0, 0, 2])],
