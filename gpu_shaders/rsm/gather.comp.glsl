@@ -3,8 +3,9 @@
 //
 // Sampling: the RSM is split into strata_per_side^2 equal blocks; each pixel draws one texel per block
 // (its own hash, so the estimate is unbiased and the noise is per-pixel, not structured) weighted by
-// the block's texel count. One dispatch handles block rows [row_begin, row_end): llvmpipe silently
-// stops a shader after 65,535 loop iterations, so the caller splits long visibility marches. A VPL of flux phi is a Lambertian disk of its surfel area A:
+// the block's texel count (refinement gathers step along a sequence, below). One dispatch handles
+// block rows [row_begin, row_end): llvmpipe silently stops a shader after 65,535 loop iterations, so
+// the caller splits long visibility marches. A VPL of flux phi is a Lambertian disk of area A:
 //     E += phi / pi * cos_vpl * cos_x / (r^2 + A / pi)
 // The A / pi term is the on-axis form factor of a disk: it keeps nearby VPLs from spiking. A drawn VPL
 // stands for its whole block (`weight` texels), so its disk is taken as DISK_SHARE of the block's area,
@@ -60,12 +61,17 @@ void main() {
     float weight = block.x * block.y;
     float disk_share = DISK_SHARE * weight;
     uint pixel_id = uint(px.y * 65536 + px.x);
+    // Progressive refinement: the n-th gather (sample_index) keeps the update's draws and moves each
+    // by n x the R2 sequence's steps (Roberts 2018), so a pixel's draws in a block over the samples form
+    // one low-discrepancy set (each still uniform in the block: unbiased). Cornell 128 px, 16 samples:
+    // noise 0.012 with a fresh seed per sample, 0.0058 so.
+    vec2 sample_step = float(sample_index) * vec2(0.75487767, 0.56984029);
     vec3 irradiance = vec3(0.0);
     for (int j = row_begin; j < row_end; ++j) {
         for (int i = 0; i < strata_per_side; ++i) {
             uint stratum = uint(j * strata_per_side + i);
-            vec2 u = vec2(random01(pixel_id, stratum, uint(seed) * 2u),
-                          random01(pixel_id, stratum, uint(seed) * 2u + 1u));
+            vec2 u = fract(vec2(random01(pixel_id, stratum, uint(seed) * 2u),
+                                random01(pixel_id, stratum, uint(seed) * 2u + 1u)) + sample_step);
             ivec2 t = min(ivec2((vec2(i, j) + u) * block), rsm_size - 1);
             vec4 vpl_pos = texelFetch(rsm_position, t, 0);
             if (vpl_pos.w == 0.0) {
