@@ -1,7 +1,7 @@
 // One iteration of the edge-aware a-trous wavelet filter (passes/denoise.py, whose numpy `reference`
 // is this shader's twin): every covered pixel becomes the normalised, G-buffer-weighted mean of the
-// 5 x 5 taps `step_px` pixels apart around it. The weights never look at the values, so the filter is
-// linear: a flat field stays flat and nothing but geometry stops it.
+// 5 x 5 taps `step_px` pixels apart around it. Except in the GUIDED iteration the weights never look
+// at the values, so those iterations are linear: a flat field stays flat and only geometry stops them.
 //
 // A tap's weight is the B3-spline kernel times
 // - normal agreement max(0, n . n_q)^normal_power (creases),
@@ -11,6 +11,13 @@
 //   charts of a lightmap).
 // The footprint (m) is the distance to the nearest covered neighbour along x and along y, the larger of
 // the two: the nearest neighbour lies on the pixel's own surface, even next to an edge.
+//
+// GUIDED (the last iteration, passes/denoise.py): a tap also weighs exp(-|l_q - l| / (luminance_sigma *
+// sd)), l the luminance of `source` (the geometric iterations' output), sd the noise that output keeps:
+// the standard deviation of the unfiltered `raw` luminance over the 5 x 5 taps 1 px apart (the same
+// G-buffer weights) times raw_noise_factor (denoise.noise_factor of the iterations before). Where the
+// values differ by more than the noise explains (a real gradient) the taps stop; within the noise the
+// iteration widens the kernel (SVGF's edge-stopping function, Schied et al. 2017, from one frame).
 
 // The B3 spline (1, 4, 6, 4, 1) / 16 at tap k in -2..2; denoise.KERNEL is the same. A function, not a
 // const array: Blender translates bodies for Metal and Vulkan, and no other body here uses const arrays.
@@ -35,6 +42,43 @@ float axis_footprint(ivec2 px, vec3 p, ivec2 axis, ivec2 size) {
     return nearest;
 }
 
+// The G-buffer weight of the tap at `offset` from the pixel (position p, normal n, footprint f).
+float geometry_weight(ivec2 q, ivec2 offset, vec3 p, vec3 n, float footprint) {
+    vec3 d = texelFetch(gbuf_position, q, 0).xyz - p;
+    float facing = pow(max(dot(n, texelFetch(gbuf_normal, q, 0).xyz), 0.0), normal_power);
+    float plane = abs(dot(n, d)) / (plane_sigma * footprint);
+    float expected = length(vec2(offset)) * footprint;
+    float excess = max(length(d) - expected, 0.0) / (position_sigma * expected);
+    return facing * exp(-(plane * plane + excess * excess));
+}
+
+#ifdef GUIDED
+const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);
+
+// Standard deviation of the raw luminance over the 5 x 5 taps 1 px apart, with the filter's weights.
+float raw_deviation(ivec2 px, vec3 p, vec3 n, float footprint, ivec2 size) {
+    float m1 = 0.0, m2 = 0.0, total = 0.0;
+    for (int j = -2; j <= 2; j++) {
+        for (int i = -2; i <= 2; i++) {
+            ivec2 q = px + ivec2(i, j);
+            if (!covered(q, size)) {
+                continue;
+            }
+            float w = b3(i) * b3(j);
+            if (i != 0 || j != 0) {
+                w *= geometry_weight(q, ivec2(i, j), p, n, footprint);
+            }
+            float l = dot(texelFetch(raw, q, 0).rgb, LUMA);
+            m1 += w * l;
+            m2 += w * l * l;
+            total += w;
+        }
+    }
+    m1 /= total;
+    return sqrt(max(m2 / total - m1 * m1, 0.0));
+}
+#endif
+
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = textureSize(gbuf_position, 0);
@@ -53,6 +97,11 @@ void main() {
         return;
     }
     vec3 n = texelFetch(gbuf_normal, px, 0).xyz;
+#ifdef GUIDED
+    float luminance = dot(texelFetch(source, px, 0).rgb, LUMA);
+    // 1e-30: a noiseless neighbourhood stops every tap that differs at all (a flat field still averages).
+    float scale = luminance_sigma * raw_deviation(px, p, n, footprint, size) * raw_noise_factor + 1e-30;
+#endif
     vec4 sum = vec4(0.0);
     float total = 0.0;
     for (int j = -2; j <= 2; j++) {
@@ -63,15 +112,14 @@ void main() {
                 continue;
             }
             float w = b3(i) * b3(j);
+            vec4 value = texelFetch(source, q, 0);
             if (i != 0 || j != 0) {
-                vec3 d = texelFetch(gbuf_position, q, 0).xyz - p;
-                float facing = pow(max(dot(n, texelFetch(gbuf_normal, q, 0).xyz), 0.0), normal_power);
-                float plane = abs(dot(n, d)) / (plane_sigma * footprint);
-                float expected = length(vec2(offset)) * footprint;
-                float excess = max(length(d) - expected, 0.0) / (position_sigma * expected);
-                w *= facing * exp(-(plane * plane + excess * excess));
+                w *= geometry_weight(q, offset, p, n, footprint);
+#ifdef GUIDED
+                w *= exp(-abs(dot(value.rgb, LUMA) - luminance) / scale);
+#endif
             }
-            sum += w * texelFetch(source, q, 0);
+            sum += w * value;
             total += w;
         }
     }

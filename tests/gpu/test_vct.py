@@ -86,6 +86,27 @@ def gather(gl, pyr, grid, points_cells, normals, config=None, scale=RADIANCE_SCA
     return gl.read(indirect)[0, :, :3], gl.read(ao)[0, :, 0]
 
 
+
+def patch_image(gl, patch=1, side=64, distance=8, seed=0, sample=0):
+    """E / pi (side x side, red channel) of a side x side image whose receivers all sit at one point
+    `distance` cells in front of a square of patch x patch cells of radiance 1 (its corner cell straight
+    ahead), facing it: with patch = 1 the inverse-square test's scene, exact 1 / (pi distance^2)."""
+    n = 64
+    vols = Volumes((n, n, n))
+    c = n // 2
+    vols.wall(0, c, -1, 1.0, span=slice(c, c + patch))  # facing -x
+    pyr = vols.pyramid(gl)
+    pos = np.zeros((side, side, 4), np.float32)
+    pos[..., :3] = vols.grid.origin_m + np.array([c + 0.5 - distance, c + 0.5, c + 0.5]) * vols.grid.cell_size_m
+    pos[..., 3] = 1.0
+    nrm = np.zeros((side, side, 4), np.float32)
+    nrm[..., 0] = 1.0
+    gbuf = {"position": gl.texture((side, side), data=pos), "normal": gl.texture((side, side), data=nrm)}
+    indirect, ao = gl.texture((side, side)), gl.texture((side, side))
+    vct_gather.pixels(gl, pyr, RADIANCE_SCALE, gbuf, indirect, ao, vols.grid, VctConfig(offset_cells=0.0), seed,
+                      sample=sample)
+    return gl.read(indirect)[..., 0]
+
 def closed_box(n=32, lo=2, radiance=1.0):
     vols = Volumes((n, n, n))
     hi = n - 1 - lo
@@ -461,3 +482,28 @@ def test_mirror_reflects_what_it_faces_and_nothing_else(gl):
     assert 0.95 <= g[0, 0] <= 1.0 + 1e-5
     assert abs(g[1, 0]) < 1e-6
     assert np.all(g[2] == 0.0)
+
+
+def test_a_tile_of_receivers_stratifies_its_cones(gl):
+    """The 64 pixels of an 8 x 8 tile take 64 phases of one lattice over (jitter, rotation)
+    (gather.comp.glsl), so a tile's mean deviates less than the mean of 64 independent receivers, whose
+    deviation is the pixels' spread / 8. 4096 receivers at one point facing an 8 x 8-cell patch: measured
+    0.26 of the independent deviation (seed 0); bound 0.5 (the spread of 64 tile means is itself known to
+    ~9 %). The mean is what the receivers estimate on their own: within 1 % of seed 1's."""
+    img = patch_image(gl, 8, seed=0)
+    tiles = img.reshape(8, 8, 8, 8).mean(axis=(1, 3))
+    print("tile-mean deviation / independent:", tiles.std() / (img.std() / 8))
+    assert tiles.std() < 0.5 * img.std() / 8
+    assert img.mean() == pytest.approx(patch_image(gl, 8, seed=1).mean(), rel=0.01)
+
+
+def test_refinement_samples_stratify_each_pixel(gl):
+    """The n-th refinement gather steps each pixel's (jitter, rotation) along the R2 sequence, so 16
+    samples of a pixel deviate less than 16 independent ones (the single sample's spread / 4); the mean
+    stays. Same scene as above: measured 0.53 of the independent deviation, means within 0.01 %; bounds
+    0.75 and 1 %."""
+    one = patch_image(gl, 8)
+    sixteen = sum(patch_image(gl, 8, sample=i) for i in range(16)) / 16
+    print("16-sample deviation / independent:", sixteen.std() / (one.std() / 4))
+    assert sixteen.std() < 0.75 * one.std() / 4
+    assert sixteen.mean() == pytest.approx(one.mean(), rel=0.01)

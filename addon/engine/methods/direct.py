@@ -279,6 +279,9 @@ class DirectMethod:
                            **({"shown": be.texture(size), "scratch": be.texture(size)} if self.gi.denoise else {})}
                        for n in self.NOISY}
         self.samples = 0  # gathers averaged into the noisy products since the last update
+        # The running gather's index among them: 0 for an update's, n for the n-th refine (gather_seed;
+        # vct's cones continue a low-discrepancy sequence over it).
+        self.sample_index = 0
 
     def camera(self) -> Camera:
         """The current camera in the uploaded geometry's (re-centred) frame."""
@@ -469,16 +472,20 @@ class DirectMethod:
         if not self._noisy or self._solved_for is None or self._solved_for != self.light_key():
             return {}
         views = self.light_views()
-        base = self.gi
-        # Far apart, so no sample's seeds (seed + 6 x light + face in the rsm gather) meet another's.
-        self.gi = replace(base, seed=(base.seed + SEED_STRIDE * self.samples) % 2**31)
+        self.sample_index = self.samples
         timings: dict[str, float] = {}
         try:
             with self.timed(timings, "total"), self.timed(timings, "gather"):
                 self._gather(views, timings, range(len(views)), first=False)
         finally:
-            self.gi = base
+            self.sample_index = 0
         return timings
+
+    def gather_seed(self) -> int:
+        """The seed of the running gather's random numbers: GIConfig.seed for an update's gather, then
+        SEED_STRIDE further per refine, far apart so that no sample's seeds (seed + 6 x light + face in
+        the rsm gather) meet another's."""
+        return (self.gi.seed + SEED_STRIDE * self.sample_index) % 2**31
 
     def _gather_view(self, view: LightView, timings: dict[str, float]) -> None:
         if view.light_index in self.vpl_shares:  # a world sun: its direct light is the sky pass's

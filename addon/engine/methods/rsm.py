@@ -56,4 +56,5 @@ class RsmMethod(OneBounceMethod):
             rsm_gather.run(self.backend, self.gbuf, self.rsm, self.indirect, vpls,
                            self.gi.seed + view.light_index * 6 + max(view.face_index, 0),
                            occupancy=self.voxels["vox_albedo"] if self.voxels else None,
-                           grid=self.voxels and self.grid, offset_cells=self.rsm_config.voxel_offset_cells)
+                           grid=self.voxels and self.grid, offset_cells=self.rsm_config.voxel_offset_cells,
+                           sample=self.sample_index)

@@ -136,7 +136,8 @@ class VctMethod(OneBounceMethod):
     def gather_pixels(self, timings: dict[str, float]) -> None:
         with self.step(timings, vct_gather.PIXELS_DECL):
             vct_gather.pixels(self.backend, self.pyramid, self.radiance_scale, self.gbuf, self.indirect,
-                              self.ao, self.grid, self.vct_config, self.gi.seed, self._low)
+                              self.ao, self.grid, self.vct_config, self.gi.seed, self._low, self.sample_index)
         with self.step(timings, vct_gather.GLOSSY_DECL):
             vct_gather.glossy(self.backend, self.pyramid, self.radiance_scale, self.gbuf, self._lobe_albedo,
-                              self.glossy, self.grid, self.vct_config, self.camera().position_m, self.gi.seed)
+                              self.glossy, self.grid, self.vct_config, self.camera().position_m,
+                              self.gather_seed())

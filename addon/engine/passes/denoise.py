@@ -25,6 +25,15 @@ the two):
 Pixels with coverage 0 are written 0 and weigh nothing; a covered pixel without a covered neighbour
 keeps its value. After k iterations the kernel reaches 2 (2^k - 1) pixels (`iterations_for` picks k
 for an image size); `noise_factor` is the standard deviation it leaves of i.i.d. noise on a plane.
+
+With `Params.guided` one more iteration follows, 2^k pixels apart, whose taps also weigh
+exp(-|l_q - l| / (luminance_sigma sd)): l the luminance of the k iterations' output, sd the noise left
+in it, estimated per pixel as the standard deviation of `noisy`'s luminance over its 5 x 5 taps 1 px
+apart times noise_factor(k) (SVGF's edge-stopping function, Schied et al. 2017, from one image). Real
+gradients, which differ by more than the noise, stop it; the residual blotches of the geometric
+iterations, which differ by about the noise, are averaged once more. That iteration looks at the
+values, so it is not linear; a flat field still stays flat, and the energy of a noisy plane stays
+within 1 % (tests/gpu/test_denoise.py).
 """
 
 from __future__ import annotations
@@ -70,20 +79,43 @@ class Params:
     # Distance from the pixel's tangent plane (in pixel footprints) at which a tap's weight falls to
     # 1/e: a depth step of two footprints weighs 0.02.
     plane_sigma_footprints: float = 1.0
+    # One more iteration after `iterations`, stopped by luminance differences beyond the noise (module
+    # docstring). Cornell 128 px (noise between seeds / rel_rmse_8 / bias, tools/noise_table.py): vct
+    # 0.083 / 0.116 / 0.951 -> 0.066 / 0.117 / 0.946, rsm 0.034 / 0.201 / 1.126 -> 0.027 / 0.202 / 1.125;
+    # a third geometric iteration instead: vct 0.041 / 0.147, rsm 0.032 / 0.230 (real gradients flatten).
+    guided: bool = True
+    # Luminance difference, in units of the estimated noise, at which a guided tap's weight falls to
+    # 1/e: SVGF's 4. 2: vct 0.074, rsm 0.030; 8: vct 0.058 / 0.123, rsm 0.024 / 0.204 (gradients start
+    # to flatten).
+    luminance_sigma: float = 4.0
     # Excess distance beyond the tap's offset on the pixel's own surface, in footprints per pixel of
     # offset, at which a tap's weight falls to 1/e: the slack lets perspective stretch a surface by
     # ~2x across the kernel; a chart 1 m away across a lightmap seam, or a silhouette, weighs ~0.
     position_sigma_footprints: float = 1.0
 
 
+_SAMPLERS = (Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("source", "2D"))
+_UNIFORMS = (Var("step_px", "int"), Var("normal_power", "float"), Var("plane_sigma", "float"),
+             Var("position_sigma", "float"))
+
 SPEC = ShaderSpec(
     name="denoise",
     compute="common/denoise.comp.glsl",
     local_size=(8, 8, 1),
-    samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("source", "2D")),
+    samplers=_SAMPLERS,
     images=(Image("filtered", "2D"),),
-    uniforms=(Var("step_px", "int"), Var("normal_power", "float"), Var("plane_sigma", "float"),
-              Var("position_sigma", "float")),
+    uniforms=_UNIFORMS,
+)
+
+# The guided iteration: `raw` is the unfiltered input, whose local spread estimates the noise.
+SPEC_GUIDED = ShaderSpec(
+    name="denoise_guided",
+    compute="common/denoise.comp.glsl",
+    local_size=(8, 8, 1),
+    samplers=(*_SAMPLERS, Sampler("raw", "2D")),
+    images=(Image("filtered", "2D"),),
+    uniforms=(*_UNIFORMS, Var("luminance_sigma", "float"), Var("raw_noise_factor", "float")),
+    defines=(("GUIDED", "1"),),
 )
 
 
@@ -92,30 +124,33 @@ DECL = PassDecl("denoise", "gather", (GBUF_POSITION, GBUF_NORMAL, INDIRECT), (IN
                 "surfaces (GIConfig.denoise)")
 
 
-def _destinations(iterations: int, noisy, out, scratch) -> list:
-    """The texture each iteration writes, alternating so that the last one writes `out`."""
-    if iterations < 1:
-        raise ValueError(f"denoise: iterations must be >= 1, not {iterations}")
-    if iterations > 1 and scratch is None:
-        raise ValueError("denoise: two or more iterations need a scratch texture")
+def _destinations(passes: int, noisy, out, scratch) -> list:
+    """The texture each pass writes, alternating so that the last one writes `out`."""
+    if passes < 1:
+        raise ValueError(f"denoise: iterations must be >= 1, not {passes}")
+    if passes > 1 and scratch is None:
+        raise ValueError("denoise: two or more passes (iterations, and the guided one) need a scratch texture")
     if noisy is out or noisy is scratch or out is scratch:
         raise ValueError("denoise: noisy, out and scratch must be different textures")
-    return [out if (iterations - 1 - k) % 2 == 0 else scratch for k in range(iterations)]
+    return [out if (passes - 1 - k) % 2 == 0 else scratch for k in range(passes)]
 
 
 def run(backend: Backend, gbuf: dict, noisy, out, scratch=None, params: Params = Params()) -> None:
-    """out := `noisy` filtered (module docstring); `scratch` is needed for two or more iterations."""
-    program = backend.program(SPEC)
+    """out := `noisy` filtered (module docstring); `scratch` is needed for two or more passes (the
+    iterations, and the guided one)."""
     groups = group_count(out.size, SPEC.local_size)
+    passes = params.iterations + int(params.guided)
     source = noisy
-    for k, dest in enumerate(_destinations(params.iterations, noisy, out, scratch)):
-        backend.dispatch(program, groups,
-                         uniforms={"step_px": 1 << k, "normal_power": params.normal_power,
-                                   "plane_sigma": params.plane_sigma_footprints,
-                                   "position_sigma": params.position_sigma_footprints},
-                         samplers={"gbuf_position": gbuf["position"], "gbuf_normal": gbuf["normal"],
-                                   "source": source},
-                         images={"filtered": dest})
+    for k, dest in enumerate(_destinations(passes, noisy, out, scratch)):
+        guided = k == params.iterations
+        uniforms = {"step_px": 1 << k, "normal_power": params.normal_power,
+                    "plane_sigma": params.plane_sigma_footprints, "position_sigma": params.position_sigma_footprints}
+        samplers = {"gbuf_position": gbuf["position"], "gbuf_normal": gbuf["normal"], "source": source}
+        if guided:
+            uniforms.update(luminance_sigma=params.luminance_sigma, raw_noise_factor=noise_factor(params.iterations))
+            samplers["raw"] = noisy
+        backend.dispatch(backend.program(SPEC_GUIDED if guided else SPEC), groups, uniforms=uniforms,
+                         samplers=samplers, images={"filtered": dest})
         source = dest
 
 
@@ -146,10 +181,13 @@ def footprint_m(position: np.ndarray) -> np.ndarray:
     return np.maximum(*axes)
 
 
-def _iteration(pos, cov, nrm, footprint, src, step_px: int, params: Params) -> np.ndarray:
-    total = np.zeros(cov.shape)
-    acc = np.zeros(src.shape)
-    scale = np.where(footprint > 0, footprint, 1.0)  # pixels without a footprint keep their value below
+# Rec. 709 luminance: the guided iteration compares these (the shader's LUMA).
+LUMA = np.array([0.2126, 0.7152, 0.0722])
+
+
+def _taps(pos, cov, nrm, footprint, step_px: int, params: Params):
+    """(dy, dx, G-buffer weight) of the 25 taps `step_px` apart, the kernel included."""
+    scale = np.where(footprint > 0, footprint, 1.0)  # pixels without a footprint keep their value
     for j in range(-2, 3):
         for i in range(-2, 3):
             dy, dx = j * step_px, i * step_px
@@ -162,19 +200,46 @@ def _iteration(pos, cov, nrm, footprint, src, step_px: int, params: Params) -> n
                 excess = np.maximum(np.linalg.norm(d, axis=-1) - expected, 0.0) / (
                     params.position_sigma_footprints * expected)
                 w = w * facing * np.exp(-(plane**2 + excess**2))
-            acc += w[..., None] * _shifted(src, dy, dx)
-            total += w
+            yield dy, dx, w
+
+
+def _iteration(pos, cov, nrm, footprint, src, step_px: int, params: Params, noise_sd=None) -> np.ndarray:
+    """One iteration; with `noise_sd` (per pixel) the guided one."""
+    total = np.zeros(cov.shape)
+    acc = np.zeros(src.shape)
+    luminance = src[..., :3] @ LUMA
+    for dy, dx, w in _taps(pos, cov, nrm, footprint, step_px, params):
+        if noise_sd is not None and (dy or dx):
+            scale = params.luminance_sigma * noise_sd + 1e-30
+            w = w * np.exp(-np.abs(_shifted(luminance, dy, dx) - luminance) / scale)
+        acc += w[..., None] * _shifted(src, dy, dx)
+        total += w
     filtered = np.where((footprint > 0)[..., None], acc / np.maximum(total, 1e-300)[..., None], src)
     return np.where(cov[..., None], filtered, 0.0)
 
 
+def _raw_deviation(pos, cov, nrm, footprint, raw, params: Params) -> np.ndarray:
+    """Standard deviation of `raw`'s luminance over the 5 x 5 taps 1 px apart, with the filter's weights."""
+    luminance = raw[..., :3] @ LUMA
+    m1, m2, total = np.zeros(cov.shape), np.zeros(cov.shape), np.zeros(cov.shape)
+    for dy, dx, w in _taps(pos, cov, nrm, footprint, 1, params):
+        q = _shifted(luminance, dy, dx)
+        m1, m2, total = m1 + w * q, m2 + w * q * q, total + w
+    total = np.maximum(total, 1e-300)
+    return np.sqrt(np.maximum(m2 / total - (m1 / total) ** 2, 0.0))
+
+
 def reference(position: np.ndarray, normal: np.ndarray, noisy: np.ndarray, params: Params = Params()) -> np.ndarray:
     """What `run` computes, on (h, w, 4) arrays (G-buffer position and normal, the noisy product), in float64."""
-    position, normal, src = (np.asarray(a, np.float32).astype(np.float64) for a in (position, normal, noisy))
+    position, normal, raw = (np.asarray(a, np.float32).astype(np.float64) for a in (position, normal, noisy))
     pos, cov, nrm = position[..., :3], position[..., 3] != 0, normal[..., :3]
     footprint = footprint_m(position)
+    src = raw
     for k in range(params.iterations):
         src = _iteration(pos, cov, nrm, footprint, src, 1 << k, params)
+    if params.guided:
+        noise_sd = _raw_deviation(pos, cov, nrm, footprint, raw, params) * noise_factor(params.iterations)
+        src = _iteration(pos, cov, nrm, footprint, src, 1 << params.iterations, params, noise_sd)
     return src
 
 

@@ -1,7 +1,7 @@
 """RSM indirect gather pass (Dachsbacher & Stamminger 2005, eq. 1 with a disk term), no visibility.
 
 Inputs: G-buffer position and normal; one RSM face's position, normal (w = surfel area, m^2) and flux
-(W). Uniforms: strata_per_side (VPLs per pixel = strata_per_side^2), seed; with voxel visibility also the
+(W). Uniforms: strata_per_side (VPLs per pixel = strata_per_side^2), seed, sample_index; with voxel visibility also the
 voxelizer's occupancy (`vox_albedo`, a = occupancy) and its grid. Output: `indirect`
 (RGBA32F, camera resolution), accumulated over faces and lights, in Cycles' Diffuse Indirect unit
 (indirect irradiance / pi). One bounce. See gpu_shaders/rsm/gather.comp.glsl for the estimator.
@@ -19,7 +19,8 @@ from .declare import GBUF_NORMAL, GBUF_POSITION, INDIRECT, RSM, VOX_ALBEDO, Pass
 
 _SAMPLERS = (Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("rsm_position", "2D"),
              Sampler("rsm_normal", "2D"), Sampler("rsm_flux", "2D"))
-_UNIFORMS = (Var("strata_per_side", "int"), Var("seed", "int"), Var("row_begin", "int"), Var("row_end", "int"))
+_UNIFORMS = (Var("strata_per_side", "int"), Var("seed", "int"), Var("sample_index", "int"), Var("row_begin", "int"),
+             Var("row_end", "int"))
 # llvmpipe ends a shader invocation's loops after 65,535 iterations in total (FACTS.md); keep each
 # dispatch's worst case below that. A GPU has no such cap; the split costs it a few dispatches.
 MAX_LOOP_ITERATIONS = 60_000
@@ -55,11 +56,13 @@ def strata_per_side(vpl_samples: int) -> int:
 
 
 def run(backend: Backend, gbuf: dict, rsm: dict, indirect, vpl_samples: int, seed: int,
-        occupancy=None, grid: Grid | None = None, offset_cells: float = 1.5) -> None:
-    """Gather one RSM face into `indirect`; pass the voxelizer's `vox_albedo` and grid for visibility."""
+        occupancy=None, grid: Grid | None = None, offset_cells: float = 1.5, sample: int = 0) -> None:
+    """Gather one RSM face into `indirect`; pass the voxelizer's `vox_albedo` and grid for visibility.
+    `seed` is the update's; `sample` the gather's index among those averaged since
+    (DirectMethod.sample_index): the draws step along a low-discrepancy sequence with it."""
     spec = SPEC if occupancy is None else SPEC_VOXEL_VISIBILITY
     k = strata_per_side(vpl_samples)
-    uniforms = {"strata_per_side": k, "seed": seed}
+    uniforms = {"strata_per_side": k, "seed": seed, "sample_index": sample}
     samplers = {"gbuf_position": gbuf["position"], "gbuf_normal": gbuf["normal"],
                 "rsm_position": rsm["position"], "rsm_normal": rsm["normal"], "rsm_flux": rsm["flux"]}
     if occupancy is not None:

@@ -54,7 +54,7 @@ PIXELS = ShaderSpec(
     local_size=GATHER_GROUP,
     samplers=(*_PYRAMID, Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D")),
     images=(Image("indirect", "2D"), Image("ao", "2D")),
-    uniforms=(*_DIFFUSE_UNIFORMS, Var("scale", "int")),
+    uniforms=(*_DIFFUSE_UNIFORMS, Var("scale", "int"), Var("sample_index", "int")),
 )
 
 UPSAMPLE = ShaderSpec(
@@ -113,14 +113,16 @@ def low_size(size: tuple[int, int], scale: int) -> tuple[int, int]:
 
 
 def pixels(backend: Backend, pyramid: dict, radiance_scale: float, gbuf: dict, indirect, ao, grid: Grid,
-           config: VctConfig, seed: int = 0, low: tuple | None = None) -> None:
+           config: VctConfig, seed: int = 0, low: tuple | None = None, sample: int = 0) -> None:
     """Gather into `indirect` and `ao`; with config.gather_scale > 1, into `low` (two textures of
-    low_size) first, then upsample."""
+    low_size) first, then upsample. `seed` is the update's; `sample` the gather's index among those
+    averaged since (DirectMethod.sample_index): each pixel's cone pattern continues one low-discrepancy
+    sequence over the samples (gather.comp.glsl)."""
     scale = config.gather_scale
     out = (indirect, ao) if scale == 1 else low
     backend.dispatch(backend.program(PIXELS), group_count(out[0].size, PIXELS.local_size),
                      uniforms={**cone_uniforms(grid, config, seed, radiance_scale),
-                               "diffuse_cones": config.diffuse_cones, "scale": scale},
+                               "diffuse_cones": config.diffuse_cones, "scale": scale, "sample_index": sample},
                      samplers={**named(pyramid, "pyr"), "gbuf_position": gbuf["position"],
                                "gbuf_normal": gbuf["normal"]},
                      images={"indirect": out[0], "ao": out[1]})
