@@ -464,8 +464,8 @@ class DirectMethod:
             setattr(self, name, shown)
 
     def refine(self) -> dict[str, float]:
-        """One more gather of the noisy products, with the next seed, averaged into them: progressive
-        refinement while nothing changes (the light field, the G-buffer and the camera are kept). Returns
+        """One more gather of the noisy products, the next sample (`sample_index`), averaged into them:
+        progressive refinement while nothing changes (the light field, the G-buffer and the camera are kept). Returns
         timings (empty when not profiling); `samples` grows only when a gather ran: not for a method
         without noisy products, nor when the last update could not keep its light field (a gather then
         needs a solve first)."""

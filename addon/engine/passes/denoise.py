@@ -11,7 +11,7 @@ an iteration reads one and writes another.
 
 Each iteration k (`Params.iterations` in all) replaces every covered pixel with the normalised,
 weighted mean of 5 x 5 taps 2^k pixels apart (the B3-spline kernel, `KERNEL`); the weights come only
-from the G-buffer, so the filter is linear in `noisy`, a flat field stays flat and the energy of a
+from the G-buffer, so these iterations are linear in `noisy`, a flat field stays flat and the energy of a
 noisy field over a surface stays put. A tap's weight is the kernel times normal agreement
 max(0, n . n_q)^normal_power times exp(-(plane^2 + excess^2)), where, in units of the pixel's
 footprint f (the world distance to its nearest covered neighbour along x and along y, the larger of
@@ -81,12 +81,12 @@ class Params:
     plane_sigma_footprints: float = 1.0
     # One more iteration after `iterations`, stopped by luminance differences beyond the noise (module
     # docstring). Cornell 128 px (noise between seeds / rel_rmse_8 / bias, tools/noise_table.py): vct
-    # 0.083 / 0.116 / 0.951 -> 0.066 / 0.117 / 0.946, rsm 0.034 / 0.201 / 1.126 -> 0.027 / 0.202 / 1.125;
+    # 0.083 / 0.116 / 0.951 -> 0.066 / 0.117 / 0.946, rsm 0.041 / 0.195 / 1.135 -> 0.031 / 0.197 / 1.134;
     # a third geometric iteration instead: vct 0.041 / 0.147, rsm 0.032 / 0.230 (real gradients flatten).
     guided: bool = True
     # Luminance difference, in units of the estimated noise, at which a guided tap's weight falls to
-    # 1/e: SVGF's 4. 2: vct 0.074, rsm 0.030; 8: vct 0.058 / 0.123, rsm 0.024 / 0.204 (gradients start
-    # to flatten).
+    # 1/e: SVGF's 4. 2: vct 0.074; 8: vct 0.058 / 0.123, per-pixel rel_rmse against Cycles 0.174 against
+    # 0.167 (gradients start to flatten).
     luminance_sigma: float = 4.0
     # Excess distance beyond the tap's offset on the pixel's own surface, in footprints per pixel of
     # offset, at which a tap's weight falls to 1/e: the slack lets perspective stretch a surface by
