@@ -22,6 +22,7 @@ ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
 UPDATES_JSON = ROOT / "benchmarks" / "updates" / "results.json"
 DEFAULTS_JSON = ROOT / "benchmarks" / "defaults" / "results.json"
+EEVEE_JSON = ROOT / "benchmarks" / "eevee" / "results.json"
 LPV_DOC = ROOT / "docs" / "LPV.md"
 OCTREE_JSON = ROOT / "benchmarks" / "octree" / "results.json"
 LPV_CAMERA_TARGET_PCT = 15  # the issue's target: lpv's camera update <= 15 % of its full update
@@ -31,6 +32,10 @@ _BLOCK = re.compile(r"(<!-- figures:(?P<name>[a-z0-9-]+):begin -->\n)(?P<body>.*
 
 def load(path: Path) -> dict:
     return json.loads(path.read_text())
+
+
+def _seconds(s: float) -> str:
+    return f"{1e3 * s:.0f} ms" if s < 1 else f"{s:.1f} s"
 
 
 def _produced_by(results: dict) -> str:
@@ -154,6 +159,47 @@ def methods_block(results: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _cycles_time(s: dict | None) -> str:
+    """Cycles' time to our rel_rmse_8 along its curve, with the bound of metrics.cycles_equivalent_speedup
+    ('<=': our error is above its fastest point; '>=': below its slowest)."""
+    if s is None or s.get("cycles_time_s") is None:
+        return "–"
+    return {"=": "", "<": "<= ", ">": ">= "}[s["bound"]] + _seconds(s["cycles_time_s"])
+
+
+def headline_block(results: dict, eevee_results: dict) -> str:
+    """Table: per scene, our most accurate method at its defaults (indirect light) with its time, and what
+    the anchors need for the same rel_rmse_8: raw Cycles and Cycles + OIDN along their curves of the same
+    run, and EEVEE's render at its best GI setting (a separate run on the same machine: its time and
+    error, since an EEVEE render is not a curve)."""
+    eevee = {sc["name"]: sc.get("eevee") for sc in eevee_results["scenes"]}
+    records = [r for r in _default_records(results) if r["product"] == "indirect" and r["rel_rmse_8"] is not None]
+    lines = ["**Our time at equal error**: per scene, the most accurate method at its defaults and what the "
+             "anchors need to match it.", "",
+             "Ours and Cycles (raw, and with Open Image Denoise: the time Cycles needs for the same rel_rmse_8 along "
+             "its curve of the same run; <= where our error is above its fastest point). " + _produced_by(results)
+             + f" {results['res']} px long side, indirect light against Cycles at {results['ref_spp']} spp.", "",
+             "EEVEE (one render at its best GI setting: its time and rel_rmse_8; EEVEE / ours = its time over ours "
+             "where our error is at most its own). " + _produced_by(eevee_results), "",
+             "| scene | method | rel_rmse_8 | ours | Cycles | Cycles + OIDN | EEVEE | EEVEE / ours |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for scene in dict.fromkeys(r["scene"] for r in records):
+        best = min((r for r in records if r["scene"] == scene), key=lambda r: r["rel_rmse_8"])
+        ev = eevee.get(scene)
+        ev_err = ev["metrics"]["rel_rmse_8"] if ev else None
+        ev_cell = f"{_seconds(ev['time_s'])} at {ev_err:.3f}" if ev and ev_err is not None else "–"
+        if ev_err is None:
+            ratio = "–"
+        elif best["rel_rmse_8"] <= ev_err:
+            ratio = f"{ev['time_s'] / (best['total_ms'] / 1e3):.3g}x"
+        else:
+            ratio = "error above EEVEE's"
+        lines.append(f"| {scene} | {best['method']} | {best['rel_rmse_8']:.3f} | {_seconds(best['total_ms'] / 1e3)} "
+                     f"| {_cycles_time(best['speedup'])} | {_cycles_time(best.get('speedup_oidn'))} | {ev_cell} | "
+                     f"{ratio} |")
+    return "\n".join(lines) + "\n"
+
+
 # The octree table's columns: each a registry benchmark row of lpv (registry.METHODS), matched exactly.
 OCTREE_COLUMNS = (
     ("far field (default)", None),
@@ -216,12 +262,13 @@ def octree_block(results: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-# block name -> (the file it is in, its results.json, the function that formats it)
-BLOCKS: dict[str, tuple[Path, Path, Callable[[dict], str]]] = {
-    "update-costs": (README, UPDATES_JSON, update_costs_block),
-    "accuracy": (README, DEFAULTS_JSON, accuracy_block),
-    "methods": (README, DEFAULTS_JSON, methods_block),
-    "lpv-octree": (LPV_DOC, OCTREE_JSON, octree_block),
+# block name -> (the file it is in, its results.json file(s), the function that formats them)
+BLOCKS: dict[str, tuple[Path, tuple[Path, ...], Callable[..., str]]] = {
+    "headline": (README, (DEFAULTS_JSON, EEVEE_JSON), headline_block),
+    "update-costs": (README, (UPDATES_JSON,), update_costs_block),
+    "accuracy": (README, (DEFAULTS_JSON,), accuracy_block),
+    "methods": (README, (DEFAULTS_JSON,), methods_block),
+    "lpv-octree": (LPV_DOC, (OCTREE_JSON,), octree_block),
 }
 
 
@@ -232,7 +279,7 @@ def documents() -> list[Path]:
 
 def render_blocks(doc: Path = README) -> dict[str, str]:
     """The bodies of `doc`'s blocks, from their results.json files."""
-    return {name: fmt(load(path)) for name, (where, path, fmt) in BLOCKS.items() if where == doc}
+    return {name: fmt(*map(load, paths)) for name, (where, paths, fmt) in BLOCKS.items() if where == doc}
 
 
 def rewrite(text: str, blocks: dict[str, str]) -> str:

@@ -126,3 +126,24 @@ def test_octree_block():
                        + " | ".join(["0.400 / 0.90, 10 ms, 150k"] * 3) + " |")
     assert lines[-1] == ("- octree, ours (time, its defaults): error at most one grid's on 1 of 2 scenes and at "
                          "most the far field's on 0; propagation time a median 5 % of one grid's.")
+
+
+def test_headline_block():
+    """Per scene the most accurate default indirect record; Cycles' times with their bounds; EEVEE's time
+    over ours only where our error is at most EEVEE's."""
+    def rec(scene, method, err, ms, cycles_s, bound="="):
+        return {**_record(scene, method, rel_rmse_8=err), "product": "indirect", "total_ms": ms,
+                "speedup": {"cycles_time_s": cycles_s, "bound": bound, "speedup": 1.0},
+                "speedup_oidn": {"cycles_time_s": cycles_s / 2, "bound": bound, "speedup": 1.0}}
+
+    records = [rec("cornell", "lpv", 0.4, 200.0, 0.05), rec("cornell", "vct", 0.13, 750.0, 0.21),
+               rec("window-sky", "rsm", 0.9, 100.0, 0.04, "<"),
+               {**_record("cornell", "direct"), "product": "direct", "rel_rmse_8": 0.01}]
+    eevee = {**_results([]), "scenes": [
+        {"name": "cornell", "eevee": {"time_s": 75.0, "metrics": {"rel_rmse_8": 0.68}}},
+        {"name": "window-sky", "eevee": {"time_s": 60.0, "metrics": {"rel_rmse_8": 0.5}}}]}
+    lines = readme_figures.headline_block(_results(records), eevee).splitlines()
+    rows = [line for line in lines if line.startswith("| cornell") or line.startswith("| window-sky")]
+    assert rows == ["| cornell | vct | 0.130 | 750 ms | 210 ms | 105 ms | 75.0 s at 0.680 | 100x |",
+                    "| window-sky | rsm | 0.900 | 100 ms | <= 40 ms | <= 20 ms | 60.0 s at 0.500 | "
+                    "error above EEVEE's |"]
