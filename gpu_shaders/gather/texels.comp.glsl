@@ -23,7 +23,9 @@ void main() {
     vec4 pos = texelFetch(atlas_position, px, 0);
     vec3 rel = pos.xyz - (p < probe_count() ? probe_position(probe_cell(p)) : vec3(0.0));
     vec3 normal = texelFetch(atlas_normal, px, 0).xyz;
-    if (p >= probe_count() || pos.w == 0.0 || dot(normal, normalize(rel)) > -EDGE_ON) {
+    // Written so that a surface at the probe itself (rel = 0, which the face's near plane should not
+    // let through) fails the test too, instead of a NaN passing it.
+    if (p >= probe_count() || pos.w == 0.0 || !(dot(normal, rel) < -EDGE_ON * length(rel))) {
         imageStore(fine_radiance, px, vec4(0.0));
         imageStore(fine_plane, px, vec4(0.0));
         return;

@@ -139,6 +139,21 @@ PROBES_KNOWN_DEFECTS = {
 }
 
 
+# Known defects of `gather` (the probes' defaults, 4 x 4 quads a face), measured on llvmpipe, 48 px
+# (docs/GATHER.md, "Limits"). It reads the probes' captures, so it inherits their defects; near the
+# offending texels its form factors make them count more than the probes' SH does.
+GATHER = "gather: "
+GATHER_KNOWN_DEFECTS = {
+    "test_camera_inside_closed_block[gather]": "indirect 0.072 inside a closed block (exact 0): the probes' "
+                                               "visibility lets an outside probe through (as for `probes`, "
+                                               "0.13), and its quads then light the inner corner",
+    "test_light_inside_closed_box_stays_inside[gather]": "indirect 0.049 x P/(6 pi) outside a closed box (exact "
+                                                         "0): the probes' texels at the box's outer edges that "
+                                                         "see its lit inside (`probes`: 0.002) become quad "
+                                                         "lights beside the ground",
+}
+
+
 def pytest_collection_modifyitems(items):
     for item in items:
         reason = KNOWN_DEFECTS.get(item.name)
@@ -159,6 +174,9 @@ def pytest_collection_modifyitems(items):
         reason = PROBES_KNOWN_DEFECTS.get(item.name)
         if reason is not None:
             item.add_marker(pytest.mark.xfail(strict=True, reason=PROBES + reason))
+        reason = GATHER_KNOWN_DEFECTS.get(item.name)
+        if reason is not None:
+            item.add_marker(pytest.mark.xfail(strict=True, reason=GATHER + reason))
 
 
 # Module-level rather than in a session fixture: the outcomes come from the report hook and are only
