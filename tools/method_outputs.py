@@ -32,6 +32,8 @@ CASES = {
     "lpv-classic": {"gi": {"method": "lpv"}, "lpv": {"grid_cells": 16, "variant": "classic"}},
     "vct": {"gi": {"method": "vct"}, "vct": {"voxel_cells": 16, "diffuse_cones": 6}},
     "vct-b2": {"gi": {"method": "vct", "bounces": 2}, "vct": {"voxel_cells": 16, "diffuse_cones": 6}},
+    "gather": {"gi": {"method": "gather"}, "probes": {"probes_per_side": 4}},
+    "gather-b2": {"gi": {"method": "gather", "bounces": 2}, "probes": {"probes_per_side": 4}},
 }
 
 

@@ -51,12 +51,7 @@ def point_scene():
     return SceneCache().update(bpy.context.evaluated_depsgraph_get(), 32, 32)
 
 
-# Methods whose images tools/method_outputs.py does not record yet, run here at small settings.
-UNRECORDED = {
-    "gather": {"gi": {"method": "gather"}, "probes": {"probes_per_side": 4}},
-    "gather-b2": {"gi": {"method": "gather", "bounces": 2}, "probes": {"probes_per_side": 4}},
-}
-CASES = {**method_outputs.CASES, **UNRECORDED}
+CASES = method_outputs.CASES
 
 
 @pytest.mark.parametrize("case", CASES)
