@@ -83,26 +83,6 @@ float soft_sun_visibility(vec2 uv, ivec2 size, float receiver, float bias_m, flo
     return lit / float(SOFT_SAMPLES);
 }
 
-// Bilinear percentage-closer filtering of the hard test (a point, spot or area patch's shadow): the four
-// texels around the receiver's shadow-map position each decide lit or not, weighted by their bilinear
-// weights, so the edge moves continuously with the receiver instead of in texel steps.
-float pcf_visibility(vec2 st, ivec2 size, vec3 p_test, float bias_m) {
-    vec2 g = st - 0.5;
-    ivec2 t0 = ivec2(floor(g));
-    vec2 f = g - vec2(t0);
-    float receiver = light_kind == LIGHT_SUN ? dot(p_test, emit_axis) : length(p_test - light_pos_ws);
-    float lit = 0.0;
-    for (int k = 0; k < 4; ++k) {
-        ivec2 o = ivec2(k & 1, k >> 1);
-        vec4 occ = texelFetch(rsm_position, clamp(t0 + o, ivec2(0), size - 1), 0);
-        float occluder = light_kind == LIGHT_SUN ? dot(occ.xyz, emit_axis) : length(occ.xyz - light_pos_ws);
-        float tap = occ.w <= 0.0 || receiver <= occluder + bias_m ? 1.0 : 0.0;
-        vec2 w = mix(1.0 - f, f, vec2(o));
-        lit += w.x * w.y * tap;
-    }
-    return lit;
-}
-
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(px, textureSize(gbuf_position, 0)))) {
@@ -159,8 +139,10 @@ void main() {
         if (light_kind == LIGHT_SUN && sun_tan_half > 0.0) {
             lit = soft_sun_visibility((ndc.xy * 0.5 + 0.5) * vec2(size), size, dot(p_test, emit_axis), bias_m,
                                       texel_m, n);
-        } else {
-            lit = pcf_visibility((ndc.xy * 0.5 + 0.5) * vec2(size), size, p_test, bias_m);
+        } else if (occ.w > 0.0) {
+            float receiver = light_kind == LIGHT_SUN ? dot(p_test, emit_axis) : length(p_test - light_pos_ws);
+            float occluder = light_kind == LIGHT_SUN ? dot(occ.xyz, emit_axis) : length(occ.xyz - light_pos_ws);
+            lit = receiver <= occluder + bias_m ? 1.0 : 0.0;
         }
     }
     vec4 acc = imageLoad(direct, px);
