@@ -230,7 +230,7 @@ def test_results_json_has_one_record_per_run():
         "scene": "cornell", "method": "direct", "setting": {"rsm.resolution": 256}, "label": "resolution 256",
         "default": True, "product": "direct", "config": run["config"], "image_size": [48, 48], "triangles": 34,
         "timings_ms": {"gbuffer": 0.4, "rsm": 2.7, "solve": 2.7, "total": 3.1}, "total_ms": 3.1, "runs": 2,
-        "update_ms": {"full": 3.0, "lights": 2.0, "camera": 1.5},
+        "update_ms": {"full": 3.0, "lights": 2.0, "camera": 1.5}, "work": {},
         "rel_rmse": 0.3, "rel_rmse_8": 0.06, "bias": 0.997, "noise": 0.0,
         "speedup": {"cycles_time_s": 0.006, "speedup": 1.9, "bound": "<"},
         "speedup_oidn": None, "vs_eevee": None, "full": None,
