@@ -208,6 +208,12 @@ class ProbesConfig(_Validated):
     # engines (`bake --target probes`) wants every probe: dynamic objects move through empty space.
     only_read_probes: bool = field(default=True, metadata={
         "doc": "capture and light only the probes a surface's lookup reads (off: every probe)"})
+    # DDGI's relocation, this rule (probe_grid.relocation_step, docs/PROBES.md "Relocation"): a probe
+    # inside a solid moves out through its nearest back face, one near surfaces moves to a quarter
+    # spacing from them, at most 0.45 spacing per axis; the moved probes are captured again.
+    relocate: bool = field(default=False, metadata={
+        "doc": "move probes out of solids and off surfaces near them (at most 0.45 spacing per axis), from "
+               "their own captures"})
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from addon.engine.config import ProbesConfig
-from addon.engine.passes import probe_capture, probe_lookup, probe_project
+from addon.engine.passes import probe_capture, probe_lookup, probe_project, probe_relocate
 from addon.engine.probe_grid import ProbeGrid
 
 pytestmark = pytest.mark.gpu
@@ -27,8 +27,8 @@ def textures(gl, grid: ProbeGrid):
 
 
 def capture(gl, grid, triangles=None):
-    """The atlas G-buffer, moments and state of `grid` around `triangles` ((t, 3, 3) positions, or None:
-    an empty world)."""
+    """The atlas G-buffer, moments, state and (zero) offsets of `grid` around `triangles` ((t, 3, 3)
+    positions, or None: an empty world)."""
     atlas, target = textures(gl, grid)
     mesh = None
     if triangles is not None:
@@ -38,9 +38,9 @@ def capture(gl, grid, triangles=None):
         attrs = {"pos_ws": tris.reshape(-1, 3), "normal_ws": normals, "albedo": np.full((len(normals), 3), 0.5)}
         mesh = gl.mesh(gl.program(probe_capture.SPEC), attrs, "triangles")
     probe_capture.run(gl, target, atlas, mesh, grid, probe_capture.face_matrices(grid, 100.0))
-    moments, state = gl.texture(grid.atlas_size), gl.texture(grid.state_size)
-    probe_capture.moments(gl, atlas, moments, state, grid, backface_share=1.0)
-    return atlas, moments, state
+    moments, state, offset = gl.texture(grid.atlas_size), gl.texture(grid.state_size), probe_relocate.allocate(gl, grid)
+    probe_capture.moments(gl, atlas, moments, state, grid, 1.0, offset)
+    return atlas, moments, state, offset
 
 
 def constant_sh(gl, grid, radiance_per_probe):
@@ -79,7 +79,7 @@ def test_one_probe_in_a_uniform_environment_gives_e_pi_l(gl, encoding):
     # Irradiance maps: each normal's sum of max(0, n.w) dw over the 8^2-texel faces' centres is pi to
     # within 0.52 % (numpy: 1.0052 at a face centre, 0.9973 at a corner), so rtol 1e-2.
     grid = ProbeGrid(np.zeros(3), 1.0, (1, 1, 1), N)
-    _, moments, state = capture(gl, grid)  # an empty world: no occluder, every probe on
+    _, moments, state, offset = capture(gl, grid)  # an empty world: no occluder, every probe on
     size = grid.atlas_size
     albedo = gl.texture(size, data=np.broadcast_to(np.float32([1.0, 1.0, 1.0, 1.0]), (size[1], size[0], 4)))
     direct = gl.texture(size, data=np.broadcast_to(np.float32([0.3, 0.6, 1.2, 0.0]), (size[1], size[0], 4)))
@@ -95,7 +95,8 @@ def test_one_probe_in_a_uniform_environment_gives_e_pi_l(gl, encoding):
     nrm = np.c_[nrm / np.linalg.norm(nrm, axis=1, keepdims=True), np.zeros(16)].astype(np.float32).reshape(4, 4, 4)
     out = gl.texture((4, 4))
     probe_lookup.run(gl, gl.texture((4, 4), data=pos), gl.texture((4, 4), data=nrm),
-                     {encoding: light, "moments": moments, "state": state}, out, grid, ProbesConfig())
+                     {encoding: light, "moments": moments, "state": state, "probe_offset": offset}, out, grid,
+                     ProbesConfig())
     got = gl.read(out)[..., :3].reshape(-1, 3)
     rtol = RTOL if encoding == "sh" else 1e-2
     np.testing.assert_allclose(got, np.broadcast_to([0.3, 0.6, 1.2], got.shape), rtol=rtol)
@@ -113,12 +114,13 @@ def test_a_wall_between_a_probe_and_a_receiver_gives_it_zero_weight(gl, wall):
     # at x = 0, A sees it 0.53 m away towards the lookup point at 0.79 m: its visibility is exactly 0, and
     # the receiver reads B alone: 0.
     grid = ProbeGrid(np.array([-0.5, 0.0, 0.0]), 1.0, (2, 1, 1), N)
-    _, moments, state = capture(gl, grid, WALL if wall else None)
+    _, moments, state, offset = capture(gl, grid, WALL if wall else None)
     sh = constant_sh(gl, grid, [(1.0, 1.0, 1.0), (0.0, 0.0, 0.0)])
     pos = gl.texture((1, 1), data=np.float32([[[0.25, 0.0, 0.0, 1.0]]]))
     nrm = gl.texture((1, 1), data=np.float32([[[0.0, 0.0, 1.0, 0.0]]]))
     out = gl.texture((1, 1))
-    probe_lookup.run(gl, pos, nrm, {"sh": sh, "moments": moments, "state": state}, out, grid, ProbesConfig())
+    probe_lookup.run(gl, pos, nrm, {"sh": sh, "moments": moments, "state": state, "probe_offset": offset}, out,
+                     grid, ProbesConfig())
     got = gl.read(out)[0, 0, :3]
     if wall:
         assert np.all(got == 0.0), got
@@ -130,7 +132,7 @@ def test_capture_sees_the_wall_at_its_distance(gl):
     # Probe A at x = -0.5 looks along +x (face 0) at the wall x = 0: its centre texels hold positions on the
     # wall at distance 0.5 / cos; the moments' mean over a 3 x 3 window is within the window's spread.
     grid = ProbeGrid(np.array([-0.5, 0.0, 0.0]), 1.0, (2, 1, 1), N)
-    atlas, moments, _ = capture(gl, grid, WALL)
+    atlas, moments, _, _ = capture(gl, grid, WALL)
     x, y = grid.face_origin(0, 0)
     pos = gl.read(atlas["position"])[y:y + N, x:x + N]
     assert np.all(pos[..., 3] == 1.0) and np.allclose(pos[..., 0], 0.0, atol=1e-6)
@@ -216,4 +218,4 @@ def test_only_the_probes_a_lookup_reads_are_lit_and_the_image_is_the_same(gl):
         images.append(method.run().images["indirect"])
         work.append(method.work())
     assert images[0].mean() > 0 and np.array_equal(images[0], images[1])
-    assert work[1] == {"probes": 4096, "probes_lit": 4096} and work[0]["probes_lit"] < 0.75 * 4096
+    assert work[1] == {"probes": 4096, "probes_lit": 4096, "probes_moved": 0} and work[0]["probes_lit"] < 0.75 * 4096
