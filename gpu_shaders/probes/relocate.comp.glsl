@@ -1,9 +1,11 @@
 // One relocation step per probe (docs/PROBES.md, "Relocation"; the numpy twin is
 // probe_grid.relocation_step): from the probe's own capture at its current position (grid position +
 // probe_offset.xyz), a new offset.
-// Inside a solid (no texel misses, back faces over inside_share of the sphere): along the nearest back
-// face's plane normal to clearance_m beyond it, or, when that needs more than max_offset_m on some axis,
-// no move (part-way leaves it inside). Otherwise: for each texel whose point lies within clearance_m, in
+// Inside a solid (no texel misses, back faces over inside_share of the sphere): out through a back face,
+// along its plane's normal to clearance_m beyond it, the offset clamped to +-max_offset_m; an exit counts
+// if it ends at least min_exit_m beyond the face and within the occupied bounds [bounds_lo_m,
+// bounds_hi_m] (a floor slab's probe leaves into the room even where the slab's bottom is nearer); of
+// those, the nearest face's; none: no move (part-way leaves it inside). Otherwise: for each texel whose point lies within clearance_m, in
 // capture order, a step along its plane's normal to clearance_m in front of it where the probe is
 // nearer (projections onto each near half-space in turn). The offset is clamped to +-max_offset_m per
 // axis, so the probe stays in the half cells around its grid position. A change below min_step_m is
@@ -19,12 +21,14 @@ void main() {
     int p = probe_index(q);
     int n = face_texels;
     vec3 offset = imageLoad(probe_offset, px).xyz;
-    vec3 pos = probe_first + vec3(q) * probe_spacing + offset;
-    // The back-face share, whether any texel misses, and the nearest back face's plane.
+    vec3 grid_pos = probe_first + vec3(q) * probe_spacing;
+    vec3 pos = grid_pos + offset;
+    // The back-face share, whether any texel misses, and the exit through the nearest back face that
+    // ends outside it and within the bounds.
     float back = 0.0;
     bool open = false;
     float exit_height = 3.0e38;
-    vec3 exit_normal = vec3(0.0);
+    vec3 exit_offset = offset;
     for (int face = 0; face < 6; ++face) {
         ivec2 origin = face_origin(p, face);
         for (int j = 0; j < n; ++j) {
@@ -38,9 +42,12 @@ void main() {
                 if (nrm.w < 0.0) {
                     back += texel_solid_angle(ivec2(i, j));
                     float height = dot(pos - seen.xyz, nrm.xyz);
-                    if (height < exit_height) {
+                    vec3 out_offset = clamp(offset - nrm.xyz * (height + clearance_m), -max_offset_m, max_offset_m);
+                    vec3 end = grid_pos + out_offset;
+                    if (height < exit_height && dot(end - seen.xyz, -nrm.xyz) >= min_exit_m
+                            && all(greaterThanEqual(end, bounds_lo_m)) && all(lessThanEqual(end, bounds_hi_m))) {
                         exit_height = height;
-                        exit_normal = nrm.xyz;
+                        exit_offset = out_offset;
                     }
                 }
             }
@@ -48,11 +55,7 @@ void main() {
     }
     vec3 step = vec3(0.0);
     if (!open && back > inside_share * 4.0 * 3.14159265) {
-        step = -exit_normal * (exit_height + clearance_m);
-        if (any(greaterThan(abs(offset + step), vec3(max_offset_m)))) {
-            imageStore(probe_offset, px, vec4(offset, 0.0));
-            return;
-        }
+        step = exit_offset - offset;  // 0 where no exit counts
     } else {
         for (int face = 0; face < 6; ++face) {
             ivec2 origin = face_origin(p, face);

@@ -81,7 +81,7 @@ class ProbesMethod(OneBounceMethod):
         the probes a step leaves alone keep theirs."""
         be, grid = self.backend, self.grid
         for _ in range(RELOCATE_ROUNDS):
-            offsets_m, moved = probe_relocate.step(be, self.atlas, self.offset, grid)
+            offsets_m, moved = probe_relocate.step(be, self.atlas, self.offset, grid, self.bounds_m)
             if not moved.any():
                 break
             probe_relocate.clear_moved(be, self.atlas, self.offset, grid)

@@ -22,6 +22,7 @@ from ..probe_grid import (
     RELOCATE_CLEARANCE_RATIO,
     RELOCATE_INSIDE_SHARE,
     RELOCATE_MAX_OFFSET_RATIO,
+    RELOCATE_MIN_EXIT_RATIO,
     RELOCATE_MIN_STEP_RATIO,
     ProbeGrid,
 )
@@ -38,7 +39,8 @@ SPEC = ShaderSpec(
     samplers=(Sampler("atlas_position", "2D"), Sampler("atlas_normal", "2D")),
     images=(Image("probe_offset", "2D", "RGBA32F", "read_write"),),
     uniforms=(*GRID_UNIFORMS, Var("clearance_m", "float"), Var("max_offset_m", "float"),
-              Var("inside_share", "float"), Var("min_step_m", "float")),
+              Var("inside_share", "float"), Var("min_exit_m", "float"), Var("min_step_m", "float"),
+              Var("bounds_lo_m", "vec3"), Var("bounds_hi_m", "vec3")),
 )
 
 CLEAR_SPEC = ShaderSpec(
@@ -57,14 +59,16 @@ def allocate(backend: Backend, grid: ProbeGrid):
     return backend.texture((w, h), data=np.zeros((h, w, 4), np.float32))
 
 
-def step(backend: Backend, atlas: dict, offset, grid: ProbeGrid) -> np.ndarray:
-    """One relocation step of every probe from its capture in `atlas`; returns the offsets (count, 3) (m)
-    and which probes moved ((count,) bool), in probe order."""
+def step(backend: Backend, atlas: dict, offset, grid: ProbeGrid, bounds_m) -> tuple[np.ndarray, np.ndarray]:
+    """One relocation step of every probe from its capture in `atlas` (bounds_m: the occupied bounds (lo,
+    hi) the grid was fitted to); returns the offsets (count, 3) (m) and which probes moved ((count,)
+    bool), in probe order."""
     s = grid.spacing_m
     backend.dispatch(backend.program(SPEC), group_count(offset.size, SPEC.local_size),
                      uniforms={**grid_uniforms(SPEC, grid), "clearance_m": RELOCATE_CLEARANCE_RATIO * s,
                                "max_offset_m": RELOCATE_MAX_OFFSET_RATIO * s, "inside_share": RELOCATE_INSIDE_SHARE,
-                               "min_step_m": RELOCATE_MIN_STEP_RATIO * s},
+                               "min_exit_m": RELOCATE_MIN_EXIT_RATIO * s, "min_step_m": RELOCATE_MIN_STEP_RATIO * s,
+                               "bounds_lo_m": bounds_m[0], "bounds_hi_m": bounds_m[1]},
                      samplers={"atlas_position": atlas["position"], "atlas_normal": atlas["normal"]},
                      images={"probe_offset": offset})
     table = backend.read(offset).reshape(-1, 4)  # (ny nz, nx) rows ravel in probe order
