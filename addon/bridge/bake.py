@@ -497,8 +497,9 @@ def bake_volume(blend: Path, out_dir: Path, settings: dict, overwrite: bool = Fa
 def bake_probes(blend: Path, out_dir: Path, settings: dict, overwrite: bool = False,
                 backend=None, progress: bool = True) -> dict:
     """Method `probes`' solved probe volume for engines (engine/probe_export.py; docs/BAKE.md):
-    DIR/<stem>_probes.json (the layout: grid, faces, tiles, units, files) and three EXR atlases,
-    <stem>_probes_sh.exr, <stem>_probes_irradiance.exr and <stem>_probes_moments.exr. Every bounce the
+    DIR/<stem>_probes.json (the layout: grid, faces, tiles, units, files) and four EXR textures,
+    <stem>_probes_sh.exr, <stem>_probes_irradiance.exr, <stem>_probes_moments.exr and
+    <stem>_probes_offsets.exr (the probes' relocation, m). Every bounce the
     settings ask for is in them; no camera is involved. Returns the summary (also in bake.json's form)."""
     from ..engine import probe_export
     from ..engine.passes.probe_project import IRRADIANCE_TEXELS
@@ -511,7 +512,7 @@ def bake_probes(blend: Path, out_dir: Path, settings: dict, overwrite: bool = Fa
     settings["probes"] = replace(settings["probes"], only_read_probes=False)
     out_dir = check_output_dir(Path(out_dir))
     stem = safe_name(Path(blend).stem)
-    paths = {k: out_dir / f"{stem}_probes_{k}.exr" for k in ("sh", "irradiance", "moments")}
+    paths = {k: out_dir / f"{stem}_probes_{k}.exr" for k in ("sh", "irradiance", "moments", "offsets")}
     layout_path = out_dir / f"{stem}_probes.json"
     existing = [str(p) for p in (*paths.values(), layout_path) if p.exists()]
     if existing and not overwrite:
@@ -530,12 +531,14 @@ def bake_probes(blend: Path, out_dir: Path, settings: dict, overwrite: bool = Fa
         irradiance = probe_export.irradiance_from_sh(grid, coeffs, IRRADIANCE_TEXELS)
     moments = be.read(method.moments)[..., :3].copy()
     moments[..., 2] = 0.0
-    atlases = {"sh": probe_export.sh_table(grid, coeffs), "irradiance": irradiance, "moments": moments}
+    atlases = {"sh": probe_export.sh_table(grid, coeffs), "irradiance": irradiance, "moments": moments,
+               "offsets": be.read(method.offset)[..., :3]}
     for key, atlas in atlases.items():
         images.write_exr(paths[key], np.asarray(atlas, np.float32)[::-1])  # EXR row 0 = the atlas's top
     probes_off = np.flatnonzero(be.read(method.state)[..., 0].ravel() < 0.5)
     doc = probe_export.layout(grid, method.origin_m, method.probes_config.encoding, IRRADIANCE_TEXELS,
-                              probes_off.tolist(), {k: p.name for k, p in paths.items()})
+                              probes_off.tolist(), {k: p.name for k, p in paths.items()},
+                              method.probes_config.relocate)
     layout_path.write_text(json.dumps(doc, indent=2))
     summary = {"blend": str(blend), "file": str(layout_path), "files": [str(p) for p in paths.values()],
                "dims": list(grid.dims), "spacing_m": grid.spacing_m, "probes_off": len(probes_off),

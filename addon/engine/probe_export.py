@@ -1,7 +1,7 @@
 """The probe volume for engines (`bake --target probes`; docs/BAKE.md, docs/PROBES.md): what method
 `probes` solved, as arrays in a documented layout. numpy only; the bridge writes the files.
 
-An engine gets three atlases and a layout:
+An engine gets four textures and a layout:
 - `sh`: the L2 SH of the radiance arriving at each probe (W/m^2/sr, by direction of arrival), the
   paper's nine coefficients per colour (sh.py's basis and order). With the SH encoding these are the
   solve's own; with the irradiance encoding they are the irradiance cube maps projected to SH and
@@ -12,6 +12,9 @@ An engine gets three atlases and a layout:
   renderer's lookup evaluates; with the irradiance encoding, the solve's own maps.
 - `moments`: the mean and mean square of the distance (m, m^2) from each probe to what its capture
   texels see (the lookup's Chebyshev visibility), at the capture's face_texels^2 a face.
+- `offsets`: each probe's move off its grid position (m; ProbesConfig.relocate, else 0), one texel per
+  probe in the state's layout: the probe sits at its grid position + offset, and the moments are
+  distances from there.
 Atlases are (h, w, 3) float32 with row 0 the texture's first (bottom) row, as the GPU holds them.
 """
 
@@ -23,7 +26,7 @@ from . import sh
 from .probe_grid import FACE_FRAMES, SH_COEFFS, ProbeGrid, texel_directions, texel_solid_angles
 
 FORMAT = "bounce-probes"
-VERSION = 1
+VERSION = 2  # 2: the offsets (relocated probes)
 
 
 def sh_grid(grid: ProbeGrid, sh_table: np.ndarray) -> np.ndarray:
@@ -79,7 +82,7 @@ def sh_from_irradiance(grid: ProbeGrid, atlas: np.ndarray, n: int) -> np.ndarray
 
 
 def layout(grid: ProbeGrid, origin_m, encoding: str, irradiance_texels: int, probes_off: list[int],
-           files: dict[str, str]) -> dict:
+           files: dict[str, str], relocated: bool = False) -> dict:
     """The JSON description an engine needs to read the atlases (origin_m: the solve's frame in world
     space, the method's re-centring)."""
     nx, ny, nz = grid.dims
@@ -88,7 +91,9 @@ def layout(grid: ProbeGrid, origin_m, encoding: str, irradiance_texels: int, pro
         "dims": [nx, ny, nz],
         "first_probe_m": [float(v) for v in np.asarray(grid.first_m) + np.asarray(origin_m)],
         "spacing_m": float(grid.spacing_m),
-        "probe_index": "p = ix + nx * (iy + ny * iz); probe (ix, iy, iz) at first_probe_m + (ix, iy, iz) * spacing_m",
+        "probe_index": ("p = ix + nx * (iy + ny * iz); probe (ix, iy, iz) at first_probe_m + (ix, iy, iz) * spacing_m "
+                        "+ its offset (offsets)"),
+        "relocated": bool(relocated),
         "faces": [{"face": f, "forward": FACE_FRAMES[f, 0].tolist(), "right": FACE_FRAMES[f, 1].tolist(),
                    "up": FACE_FRAMES[f, 2].tolist()} for f in range(6)],
         "texel_direction": ("face texel (i, j) of n x n looks along normalize(forward + s right + t up), "
@@ -108,7 +113,13 @@ def layout(grid: ProbeGrid, origin_m, encoding: str, irradiance_texels: int, pro
                                 "Cycles' Diffuse Indirect = E / pi"},
         "moments": {"file": files["moments"], "face_texels": grid.face_texels, "size": list(grid.atlas_size),
                     "units": "R: mean distance (m), G: mean square distance (m^2) to the surfaces seen; B: 0"},
+        "offsets": {"file": files["offsets"], "size": list(grid.state_size),
+                    "texel": "probe (ix, iy, iz) at (ix, iy + ny iz)",
+                    "units": "RGB: the probe's move off its grid position (m, world axes); within 0.45 spacing "
+                             "per axis"},
         "probes_off": [int(p) for p in probes_off],
-        "lookup": ("docs/PROBES.md: weight the 8 probes around p + normal_bias * spacing * n by trilinear x "
-                   "back-face x Chebyshev visibility (moments), skip probes_off, renormalise, clamp at 0"),
+        "lookup": ("docs/PROBES.md: weight the 8 probes of the grid cell around p + normal_bias * spacing * n "
+                   "(cells and trilinear weights from the grid positions) by trilinear x back-face x Chebyshev "
+                   "visibility (moments; both from the offset positions), skip probes_off, renormalise, "
+                   "clamp at 0"),
     }

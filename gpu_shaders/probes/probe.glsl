@@ -1,6 +1,6 @@
 // The probe grid and its atlas (addon/engine/probe_grid.py is the numpy twin; docs/PROBES.md).
 // Uniforms: probe_first (m, probe (0,0,0)), probe_spacing (m), probe_dims, face_texels (n),
-// tiles_per_row. Probe p = ix + nx (iy + ny iz) owns a 3n x 2n tile, face f at column f % 3, row f / 3.
+// tiles_per_row; sampler probe_offset (xyz: each probe's relocation, m) where probes are placed. Probe p = ix + nx (iy + ny iz) owns a 3n x 2n tile, face f at column f % 3, row f / 3.
 // Face f = 2 axis + (negative ? 1 : 0) looks along `forward`; its texel (i, j) along
 // forward + s right + t up, s = 2 (i + 0.5) / n - 1, t likewise from j.
 
@@ -16,14 +16,16 @@ ivec3 probe_cell(int p) {
     return ivec3(p % probe_dims.x, (p / probe_dims.x) % probe_dims.y, p / (probe_dims.x * probe_dims.y));
 }
 
-// A macro, not a function: shaders that never place a probe (the projection, the classification) do
-// not declare probe_first and probe_spacing.
-#define probe_position(q) (probe_first + vec3(q) * probe_spacing)
-
 // The SH table's / state texture's row of a probe: iy + ny iz.
 int probe_row(ivec3 q) {
     return q.y + probe_dims.y * q.z;
 }
+
+// Where probe q sits: its grid position moved by its relocation offset (sampler probe_offset, the
+// state's layout; all 0 without relocation, and x + 0 is x exactly). A macro, not a function: shaders
+// that never place a probe (the projection, the classification) do not declare probe_first,
+// probe_spacing and probe_offset.
+#define probe_position(q) (probe_first + vec3(q) * probe_spacing + texelFetch(probe_offset, ivec2((q).x, probe_row(q)), 0).xyz)
 
 // Texel (0, 0) of face `face` of probe p in an atlas of n x n faces (the capture's: n = face_texels).
 ivec2 tile_origin(int p, int face, int n) {

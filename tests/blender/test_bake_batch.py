@@ -134,10 +134,12 @@ def test_probes_follow_their_documented_layout(blends, tmp_path, encoding):
             "--encoding", encoding, "--quiet")
     assert r.returncode == 0, r.stderr
     doc = json.loads((out / "cornell_probes.json").read_text())
-    atlas = {k: read_exr(out / doc[k]["file"])[::-1] for k in ("sh", "irradiance", "moments")}  # row 0 = bottom
+    keys = ("sh", "irradiance", "moments", "offsets")
+    atlas = {k: read_exr(out / doc[k]["file"])[::-1] for k in keys}  # row 0 = bottom
     for k in atlas:
         assert list(atlas[k].shape[1::-1]) == doc[k]["size"] and np.isfinite(atlas[k]).all()
     assert atlas["irradiance"].min() >= 0 and atlas["moments"].min() >= 0
+    assert not doc["relocated"] and np.all(atlas["offsets"][..., :3] == 0)  # relocation is off
 
     open_blend(blends / "cornell.blend")
     scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 8, 8)

@@ -199,7 +199,7 @@ def test_navigating_gives_preview_then_full_quality(cornell):
 
 @pytest.mark.parametrize("name", ["direct", "direct-world", "rsm", "lpv", "lpv-far-field", "lpv-emitter-classes",
                                   "lpv-octree", "lpv-octree-index", "vct", "vct-filtered", "diffusion", "probes",
-                                  "probes-irradiance", "gather", "gather-point"])
+                                  "probes-irradiance", "probes-relocate", "gather", "gather-point"])
 def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, name):
     # lpv at 16 cells runs one grid; "lpv-far-field" at 32 cells adds the far field's passes;
     # "lpv-emitter-classes" (16 cells) the classes' injection, unpacks and own-light lookups;
@@ -207,7 +207,8 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
     # downsampling and the index merge's shader;
     # "vct-filtered" the filtered injection (gl_VertexID, the projected-area fetches);
     # "direct-world" the sky's shadow atlas (a draw per tile's viewport) and its fused direct pass;
-    # "gather-point" the gather's point-to-point form factor.
+    # "gather-point" the gather's point-to-point form factor; "probes-relocate" the relocation step,
+    # the moved probes' tiles cleared and drawn again, and every probe shader at the moved positions.
     from addon.bridge import scenes
     from addon.bridge.capture import SceneCache
     from addon.engine import methods
@@ -237,7 +238,8 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
         method = methods.create(be, {"gi": gi, "rsm": rsm, "lpv": lpv, "vct": vct,
                                      "diffusion": DiffusionConfig(grid_cells=16),
                                      "probes": ProbesConfig(probes_per_side=6, encoding="irradiance"
-                                                            if name == "probes-irradiance" else "sh"),
+                                                            if name == "probes-irradiance" else "sh",
+                                                            relocate=name == "probes-relocate"),
                                      "gather": GatherConfig(form_factor="point" if name == "gather-point"
                                                             else "polygon")})
         method.set_scene(scene)

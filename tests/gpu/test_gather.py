@@ -9,7 +9,14 @@ import numpy as np
 import pytest
 
 from addon.engine.config import GatherConfig, ProbesConfig
-from addon.engine.passes import gather_form_factor, gather_quads, probe_capture, probe_lookup, probe_project
+from addon.engine.passes import (
+    gather_form_factor,
+    gather_quads,
+    probe_capture,
+    probe_lookup,
+    probe_project,
+    probe_relocate,
+)
 from addon.engine.probe_grid import ProbeGrid
 
 pytestmark = pytest.mark.gpu
@@ -50,19 +57,19 @@ def _box(half):
 
 def _field(gl, grid, triangles, face_quads):
     """Capture `triangles` around the probes of `grid`, light every texel with DIRECT, build the quads;
-    returns (quads, moments, state, atlas, atlas_direct)."""
+    returns (quads, moments, state, offset, atlas, atlas_direct) (offset: every probe at its grid position)."""
     size = grid.atlas_size
     atlas = {p.name: gl.texture(size) for p in probe_capture.ATLAS}
     target = gl.target(list(atlas.values()), gl.depth_texture(size))
     mesh = gl.mesh(gl.program(probe_capture.SPEC), _triangles(triangles), "triangles")
     probe_capture.run(gl, target, atlas, mesh, grid, probe_capture.face_matrices(grid, 100.0))
-    moments, state = gl.texture(size), gl.texture(grid.state_size)
-    probe_capture.moments(gl, atlas, moments, state, grid, backface_share=1.0)
+    moments, state, offset = gl.texture(size), gl.texture(grid.state_size), probe_relocate.allocate(gl, grid)
+    probe_capture.moments(gl, atlas, moments, state, grid, 1.0, offset)
     direct = gl.texture(size, data=np.broadcast_to(np.float32([*DIRECT, 0.0]), (size[1], size[0], 4)))
     quads = gather_quads.allocate(gl, grid, face_quads)
-    gather_quads.texels(gl, atlas, direct, quads, grid)
+    gather_quads.texels(gl, atlas, direct, quads, grid, offset)
     gather_quads.quads(gl, quads, grid, face_quads)
-    return quads, moments, state, atlas, direct
+    return quads, moments, state, offset, atlas, direct
 
 
 def _receivers(gl, points, normals):
@@ -74,11 +81,11 @@ def _receivers(gl, points, normals):
 
 
 def _gather(gl, grid, field, points, normals, probes=None, config=None):
-    quads, moments, state, _, _ = field
+    quads, moments, state, offset, _, _ = field
     probes, config = probes or ProbesConfig(), config or GatherConfig()
     pos, nrm = _receivers(gl, points, normals)
     out = gl.texture((len(points), 1))
-    gather_form_factor.run(gl, pos, nrm, quads, moments, state, out, grid, probes, config)
+    gather_form_factor.run(gl, pos, nrm, quads, moments, state, offset, out, grid, probes, config)
     return gl.read(out)[0, :, :3].astype(np.float64)
 
 
@@ -177,12 +184,13 @@ def test_far_from_walls_in_a_uniform_field_gather_equals_probes(gl):
     points = rng.uniform(-0.4, 0.4, (16, 3))
     normals = rng.normal(size=(16, 3))
     got = _gather(gl, grid, field, points, normals)
-    _, moments, state, atlas, direct = field
+    _, moments, state, offset, atlas, direct = field
     sh = gl.texture(grid.sh_size)
     probe_project.run(gl, atlas, direct, sh, grid)
     pos, nrm = _receivers(gl, points, normals)
     out = gl.texture((len(points), 1))
-    probe_lookup.run(gl, pos, nrm, {"sh": sh, "moments": moments, "state": state}, out, grid, ProbesConfig())
+    probe_lookup.run(gl, pos, nrm, {"sh": sh, "moments": moments, "state": state, "probe_offset": offset}, out,
+                     grid, ProbesConfig())
     probes = gl.read(out)[0, :, :3].astype(np.float64)
     np.testing.assert_allclose(probes, np.broadcast_to(RADIANCE, probes.shape), rtol=1e-4)
     np.testing.assert_allclose(got, probes, rtol=5e-3)

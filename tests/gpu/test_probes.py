@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from addon.engine.config import ProbesConfig
-from addon.engine.passes import probe_capture, probe_lookup, probe_project
-from addon.engine.probe_grid import ProbeGrid
+from addon.engine.passes import probe_capture, probe_lookup, probe_project, probe_relocate
+from addon.engine.probe_grid import RELOCATE_CLEARANCE_RATIO, ProbeGrid, relocation_step
 
 pytestmark = pytest.mark.gpu
 
@@ -26,21 +26,26 @@ def textures(gl, grid: ProbeGrid):
     return atlas, target
 
 
+def mesh_of(gl, triangles):
+    """The capture's mesh of `triangles` ((t, 3, 3) positions; normals from the winding), or None."""
+    if triangles is None:
+        return None
+    tris = np.asarray(triangles, np.float32)
+    normals = np.repeat(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), 3, axis=0)
+    normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+    attrs = {"pos_ws": tris.reshape(-1, 3), "normal_ws": normals, "albedo": np.full((len(normals), 3), 0.5)}
+    return gl.mesh(gl.program(probe_capture.SPEC), attrs, "triangles")
+
+
 def capture(gl, grid, triangles=None):
-    """The atlas G-buffer, moments and state of `grid` around `triangles` ((t, 3, 3) positions, or None:
-    an empty world)."""
+    """The atlas G-buffer, moments, state and (zero) offsets of `grid` around `triangles` ((t, 3, 3)
+    positions, or None: an empty world)."""
     atlas, target = textures(gl, grid)
-    mesh = None
-    if triangles is not None:
-        tris = np.asarray(triangles, np.float32)
-        normals = np.repeat(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), 3, axis=0)
-        normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
-        attrs = {"pos_ws": tris.reshape(-1, 3), "normal_ws": normals, "albedo": np.full((len(normals), 3), 0.5)}
-        mesh = gl.mesh(gl.program(probe_capture.SPEC), attrs, "triangles")
+    mesh = mesh_of(gl, triangles)
     probe_capture.run(gl, target, atlas, mesh, grid, probe_capture.face_matrices(grid, 100.0))
-    moments, state = gl.texture(grid.atlas_size), gl.texture(grid.state_size)
-    probe_capture.moments(gl, atlas, moments, state, grid, backface_share=1.0)
-    return atlas, moments, state
+    moments, state, offset = gl.texture(grid.atlas_size), gl.texture(grid.state_size), probe_relocate.allocate(gl, grid)
+    probe_capture.moments(gl, atlas, moments, state, grid, 1.0, offset)
+    return atlas, moments, state, offset
 
 
 def constant_sh(gl, grid, radiance_per_probe):
@@ -79,7 +84,7 @@ def test_one_probe_in_a_uniform_environment_gives_e_pi_l(gl, encoding):
     # Irradiance maps: each normal's sum of max(0, n.w) dw over the 8^2-texel faces' centres is pi to
     # within 0.52 % (numpy: 1.0052 at a face centre, 0.9973 at a corner), so rtol 1e-2.
     grid = ProbeGrid(np.zeros(3), 1.0, (1, 1, 1), N)
-    _, moments, state = capture(gl, grid)  # an empty world: no occluder, every probe on
+    _, moments, state, offset = capture(gl, grid)  # an empty world: no occluder, every probe on
     size = grid.atlas_size
     albedo = gl.texture(size, data=np.broadcast_to(np.float32([1.0, 1.0, 1.0, 1.0]), (size[1], size[0], 4)))
     direct = gl.texture(size, data=np.broadcast_to(np.float32([0.3, 0.6, 1.2, 0.0]), (size[1], size[0], 4)))
@@ -95,7 +100,8 @@ def test_one_probe_in_a_uniform_environment_gives_e_pi_l(gl, encoding):
     nrm = np.c_[nrm / np.linalg.norm(nrm, axis=1, keepdims=True), np.zeros(16)].astype(np.float32).reshape(4, 4, 4)
     out = gl.texture((4, 4))
     probe_lookup.run(gl, gl.texture((4, 4), data=pos), gl.texture((4, 4), data=nrm),
-                     {encoding: light, "moments": moments, "state": state}, out, grid, ProbesConfig())
+                     {encoding: light, "moments": moments, "state": state, "probe_offset": offset}, out, grid,
+                     ProbesConfig())
     got = gl.read(out)[..., :3].reshape(-1, 3)
     rtol = RTOL if encoding == "sh" else 1e-2
     np.testing.assert_allclose(got, np.broadcast_to([0.3, 0.6, 1.2], got.shape), rtol=rtol)
@@ -113,12 +119,13 @@ def test_a_wall_between_a_probe_and_a_receiver_gives_it_zero_weight(gl, wall):
     # at x = 0, A sees it 0.53 m away towards the lookup point at 0.79 m: its visibility is exactly 0, and
     # the receiver reads B alone: 0.
     grid = ProbeGrid(np.array([-0.5, 0.0, 0.0]), 1.0, (2, 1, 1), N)
-    _, moments, state = capture(gl, grid, WALL if wall else None)
+    _, moments, state, offset = capture(gl, grid, WALL if wall else None)
     sh = constant_sh(gl, grid, [(1.0, 1.0, 1.0), (0.0, 0.0, 0.0)])
     pos = gl.texture((1, 1), data=np.float32([[[0.25, 0.0, 0.0, 1.0]]]))
     nrm = gl.texture((1, 1), data=np.float32([[[0.0, 0.0, 1.0, 0.0]]]))
     out = gl.texture((1, 1))
-    probe_lookup.run(gl, pos, nrm, {"sh": sh, "moments": moments, "state": state}, out, grid, ProbesConfig())
+    probe_lookup.run(gl, pos, nrm, {"sh": sh, "moments": moments, "state": state, "probe_offset": offset}, out,
+                     grid, ProbesConfig())
     got = gl.read(out)[0, 0, :3]
     if wall:
         assert np.all(got == 0.0), got
@@ -130,7 +137,7 @@ def test_capture_sees_the_wall_at_its_distance(gl):
     # Probe A at x = -0.5 looks along +x (face 0) at the wall x = 0: its centre texels hold positions on the
     # wall at distance 0.5 / cos; the moments' mean over a 3 x 3 window is within the window's spread.
     grid = ProbeGrid(np.array([-0.5, 0.0, 0.0]), 1.0, (2, 1, 1), N)
-    atlas, moments, _ = capture(gl, grid, WALL)
+    atlas, moments, _, _ = capture(gl, grid, WALL)
     x, y = grid.face_origin(0, 0)
     pos = gl.read(atlas["position"])[y:y + N, x:x + N]
     assert np.all(pos[..., 3] == 1.0) and np.allclose(pos[..., 0], 0.0, atol=1e-6)
@@ -216,4 +223,71 @@ def test_only_the_probes_a_lookup_reads_are_lit_and_the_image_is_the_same(gl):
         images.append(method.run().images["indirect"])
         work.append(method.work())
     assert images[0].mean() > 0 and np.array_equal(images[0], images[1])
-    assert work[1] == {"probes": 4096, "probes_lit": 4096} and work[0]["probes_lit"] < 0.75 * 4096
+    assert work[1] == {"probes": 4096, "probes_lit": 4096, "probes_moved": 0} and work[0]["probes_lit"] < 0.75 * 4096
+
+
+# Relocation (probe_relocate; the numpy twin probe_grid.relocation_step, tested in tests/unit).
+FLOOR_AT = -0.01  # a floor 1 cm under the probes of the grids below (spacing 1 m)
+
+
+def _floor(z):
+    return [[[-5.0, -5.0, z], [5.0, -5.0, z], [5.0, 5.0, z]], [[-5.0, -5.0, z], [5.0, 5.0, z], [-5.0, 5.0, z]]]
+
+
+def _per_probe(image, grid, p):
+    """(6, n, n, 4) the atlas texels of probe p, [face, row j, column i] (the capture order)."""
+    n = grid.face_texels
+    return np.stack([image[y:y + n, x:x + n] for x, y in (grid.face_origin(p, f) for f in range(6))])
+
+
+def test_relocation_step_equals_the_numpy_twin(gl):
+    # Probes on a 3 x 2 x 1 grid 1 cm above a floor, the floor the bounds' bottom; probe 4 (x = 0, y = 1)
+    # sits inside a solid box [-0.2, 0.2] x [0.8, 1.2] x [-0.005, 0.05] (outward normals) on it. The GPU
+    # step gives what probe_grid.relocation_step gives on the same capture read back: the 1 cm probes rise
+    # to the clearance; probe 4 leaves through the box's top (its bottom, nearer, would end below the
+    # bounds). fp32 positions of order 1 m against float64:
+    # 1e-5 m (the decisions are far from their thresholds here, so they agree).
+    grid = ProbeGrid(np.array([-1.0, 0.0, 0.0]), 1.0, (3, 2, 1), N)
+    box = _box_faces((-0.2, 0.8, -0.005), (0.2, 1.2, 0.05))[:, ::-1]  # reversed winding: outward normals
+    atlas, target = textures(gl, grid)
+    probe_capture.run(gl, target, atlas, mesh_of(gl, np.concatenate([_floor(FLOOR_AT), box])), grid,
+                      probe_capture.face_matrices(grid, 100.0))
+    offset = probe_relocate.allocate(gl, grid)
+    bounds = (np.array([-1.5, -0.5, FLOOR_AT]), np.array([1.5, 1.5, 0.5]))
+    got, moved = probe_relocate.step(gl, atlas, offset, grid, bounds)
+    position, normal = gl.read(atlas["position"]), gl.read(atlas["normal"])
+    for p, grid_pos in enumerate(grid.positions_m()):
+        pos, nrm = _per_probe(position, grid, p), _per_probe(normal, grid, p)
+        want = relocation_step(grid_pos, np.zeros(3), pos[..., :3], nrm[..., :3], nrm[..., 3], pos[..., 3] > 0,
+                               1.0, *bounds)
+        np.testing.assert_allclose(got[p], want, rtol=0, atol=1e-5, err_msg=f"probe {p}")
+        assert moved[p]
+    np.testing.assert_allclose(got[4], [0.0, 0.0, 0.05 + RELOCATE_CLEARANCE_RATIO], atol=1e-5)
+    np.testing.assert_allclose(got[0], [0.0, 0.0, RELOCATE_CLEARANCE_RATIO + FLOOR_AT], atol=1e-5)
+
+
+def test_a_relocated_probe_is_captured_again_where_it_moved(gl):
+    # One probe 1 cm above a floor: the step moves it to the clearance above it (0.15 m: offset 0.14,
+    # fp32 to 1e-6), its tile is cleared and drawn again from there, and a second step finds it in place
+    # (no move). From its new position its -z face sees the floor at z = -0.01 in every texel, the
+    # centre texels at between 0.15 m and 0.15 / cos(their angle off the axis) m (fp32: 1e-6 m either side).
+    grid = ProbeGrid(np.zeros(3), 1.0, (1, 1, 1), N)
+    atlas, target = textures(gl, grid)
+    mesh = mesh_of(gl, _floor(FLOOR_AT))
+    probe_capture.run(gl, target, atlas, mesh, grid, probe_capture.face_matrices(grid, 100.0))
+    offset = probe_relocate.allocate(gl, grid)
+    bounds = (np.full(3, -1.0), np.full(3, 1.0))
+    offsets_m, moved = probe_relocate.step(gl, atlas, offset, grid, bounds)
+    assert moved[0]
+    np.testing.assert_allclose(offsets_m[0], [0.0, 0.0, RELOCATE_CLEARANCE_RATIO + FLOOR_AT], rtol=0, atol=1e-6)
+    probe_relocate.clear_moved(gl, atlas, offset, grid)
+    positions = grid.positions_m() + offsets_m
+    probe_capture.draw(gl, target, mesh, grid, probe_capture.face_matrices(grid, 100.0, positions), moved, positions)
+    again, moved_again = probe_relocate.step(gl, atlas, offset, grid, bounds)
+    assert not moved_again[0] and np.array_equal(again, offsets_m)
+    down = _per_probe(gl.read(atlas["position"]), grid, 0)[5]  # face 5 looks along -z
+    assert np.all(down[..., 3] == 1.0) and np.allclose(down[..., 2], FLOOR_AT, atol=1e-6)
+    centre = np.linalg.norm(down[N // 2 - 1:N // 2 + 1, N // 2 - 1:N // 2 + 1, :3] - positions[0], axis=-1)
+    clearance = RELOCATE_CLEARANCE_RATIO
+    assert np.all(centre >= clearance - 1e-6)
+    assert np.all(centre <= clearance / math.cos(math.atan(math.sqrt(2) / N)) + 1e-6)

@@ -83,8 +83,9 @@ def test_irradiance_round_trips_to_sh():
 def test_layout_is_json_and_in_world_space():
     g = grid()
     doc = probe_export.layout(g, np.array([10.0, 0.0, -1.0]), "sh", 4, [3],
-                              {"sh": "a.exr", "irradiance": "b.exr", "moments": "c.exr"})
+                              {"sh": "a.exr", "irradiance": "b.exr", "moments": "c.exr", "offsets": "d.exr"})
     again = json.loads(json.dumps(doc))
     assert again["first_probe_m"] == [10.5, -1.0, 1.0]
     assert again["dims"] == [3, 2, 4] and again["probes_off"] == [3]
     assert again["irradiance"]["size"] == list(g.tiled_size(4)) and again["moments"]["size"] == list(g.atlas_size)
+    assert again["offsets"] == {**doc["offsets"], "file": "d.exr", "size": [3, 8]} and again["relocated"] is False

@@ -7,7 +7,16 @@ import numpy as np
 import pytest
 
 from addon.engine import sh
-from addon.engine.probe_grid import FACE_FRAMES, ProbeGrid, face_view_projection, texel_directions, texel_solid_angles
+from addon.engine.probe_grid import (
+    FACE_FRAMES,
+    RELOCATE_CLEARANCE_RATIO,
+    RELOCATE_MAX_OFFSET_RATIO,
+    ProbeGrid,
+    face_view_projection,
+    relocation_step,
+    texel_directions,
+    texel_solid_angles,
+)
 
 
 @pytest.mark.parametrize("n", [1, 2, 7, 16, 64])
@@ -134,3 +143,132 @@ def test_read_by_marks_the_corners_of_every_cell_a_lookup_can_fall_in():
     flat = ProbeGrid(np.zeros(3), 1.0, (3, 3, 1), 8)
     assert _probes(flat, flat.read_by(np.array([[0.2, 0.2, 7.0]]), np.array([[0.2, 0.2, 7.0]]), 0.0)) == \
         [(0, 0, 0), (0, 1, 0), (1, 0, 0), (1, 1, 0)]
+
+
+# Relocation (probe_grid.relocation_step). The capture is ray cast here in float64 against axis-aligned
+# rectangles, as the rasterizer would fill the texels: the nearest rectangle along each texel's centre
+# direction. Spacing 1 m, so clearances and bounds read in spacings.
+N_RELOCATE = 8
+CLEAR = RELOCATE_CLEARANCE_RATIO
+BOUND = RELOCATE_MAX_OFFSET_RATIO
+WIDE = (np.full(3, -10.0), np.full(3, 10.0))  # bounds far from every probe
+
+
+def rect(axis, at, lo, hi, facing):
+    """The rectangle {x[axis] = at, lo <= the other two coordinates <= hi} whose front faces `facing`
+    (+1: the +axis side)."""
+    return axis, at, np.asarray(lo, np.float64), np.asarray(hi, np.float64), facing
+
+
+def solid_box(lo, hi):
+    """The six faces of a closed box, fronts outwards."""
+    lo, hi = np.asarray(lo, np.float64), np.asarray(hi, np.float64)
+    faces = []
+    for axis in range(3):
+        others = [a for a in range(3) if a != axis]
+        faces += [rect(axis, lo[axis], lo[others], hi[others], -1), rect(axis, hi[axis], lo[others], hi[others], +1)]
+    return faces
+
+
+def cast(pos, rects, n=N_RELOCATE):
+    """The capture of a probe at `pos`: (seen, normal towards the probe, side, hit) per texel."""
+    d = texel_directions(n)
+    best = np.full(d.shape[:3], np.inf)
+    seen, normal = np.zeros(d.shape), np.zeros(d.shape)
+    side = np.zeros(d.shape[:3])
+    for axis, at, lo, hi, facing in rects:
+        others = [a for a in range(3) if a != axis]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = (at - pos[axis]) / d[..., axis]
+        x = pos + t[..., None] * d
+        inside = np.all((x[..., others] >= lo) & (x[..., others] <= hi), axis=-1)
+        take = (t > 1e-9) & inside & (t < best)
+        best[take] = t[take]
+        seen[take] = x[take]
+        towards = np.sign(pos[axis] - at)
+        normal[take] = np.eye(3)[axis] * towards
+        side[take] = 1.0 if towards == facing else -1.0
+    return seen, normal, side, np.isfinite(best)
+
+
+def relocate(grid_pos, rects, offset=(0.0, 0.0, 0.0), bounds=WIDE):
+    grid_pos, offset = np.asarray(grid_pos, np.float64), np.asarray(offset, np.float64)
+    return relocation_step(grid_pos, offset, *cast(grid_pos + offset, rects), 1.0, *bounds)
+
+
+FLOOR = rect(2, 0.0, (-5, -5), (5, 5), +1)
+
+
+def test_a_probe_1_cm_above_a_floor_moves_to_the_clearance():
+    # The floor z = 0 is 0.01 below the probe: the step is along its normal to CLEAR above it, so the
+    # offset is exactly (0, 0, CLEAR - 0.01); float64 arithmetic on values of order 1, so 1e-12.
+    offset = relocate((0.3, 0.2, 0.01), [FLOOR])
+    np.testing.assert_allclose(offset, [0.0, 0.0, CLEAR - 0.01], rtol=0, atol=1e-12)
+
+
+def test_a_second_step_leaves_a_relocated_probe_in_place():
+    # From CLEAR above the floor the probe is no nearer than the clearance: no move (a step of float
+    # rounding would be below RELOCATE_MIN_STEP_RATIO and is none): exactly the same offset back.
+    first = relocate((0.3, 0.2, 0.01), [FLOOR])
+    assert np.array_equal(relocate((0.3, 0.2, 0.01), [FLOOR], first), first)
+
+
+def test_a_probe_in_a_corner_moves_off_both_surfaces_in_one_step():
+    # Floor 0.02 below, wall x = 0 0.05 to the -x side: both near half-spaces are projected onto in
+    # turn, and they are orthogonal, so the offset is exactly (CLEAR - 0.05, 0, CLEAR - 0.02).
+    wall = rect(0, 0.0, (-5, -5), (5, 5), +1)
+    offset = relocate((0.05, 0.0, 0.02), [FLOOR, wall])
+    np.testing.assert_allclose(offset, [CLEAR - 0.05, 0.0, CLEAR - 0.02], rtol=0, atol=1e-12)
+
+
+def test_no_probe_moves_without_geometry_near():
+    # An empty world, and a floor 0.5 spacings away (beyond the clearance): the offset stays exactly 0.
+    assert np.array_equal(relocate((0.0, 0.0, 0.0), []), np.zeros(3))
+    assert np.array_equal(relocate((0.0, 0.0, 0.5), [FLOOR]), np.zeros(3))
+
+
+def test_flipped_normals_move_an_open_probe_the_same_way():
+    # Surfaces are two-sided: a probe that sees the sky somewhere is never "inside", so a floor seen
+    # from its back moves it exactly as one seen from its front.
+    back_floor = rect(2, 0.0, (-5, -5), (5, 5), -1)
+    assert np.array_equal(relocate((0.3, 0.2, 0.01), [back_floor]), relocate((0.3, 0.2, 0.01), [FLOOR]))
+
+
+def test_a_probe_inside_a_closed_box_moves_out_through_the_nearest_face():
+    # The probe at z = 0.03 inside the box [-0.2, 0.2]^2 x [-0.2, 0.05] sees only back faces; the top
+    # face is the nearest (0.02 away), so it leaves upwards to CLEAR above it: offset (0, 0, 0.02 + CLEAR).
+    offset = relocate((0.0, 0.0, 0.03), solid_box((-0.2, -0.2, -0.2), (0.2, 0.2, 0.05)))
+    np.testing.assert_allclose(offset, [0.0, 0.0, 0.02 + CLEAR], rtol=0, atol=1e-12)
+
+
+def test_a_probe_deep_inside_a_solid_stays():
+    # Half a spacing from every face of the box: leaving needs 0.5 + CLEAR > BOUND on some axis, and a
+    # part-way move leaves it inside, so it stays (exactly 0).
+    assert np.array_equal(relocate((0.0, 0.0, 0.0), solid_box((-0.5, -0.5, -0.5), (0.5, 0.5, 0.5))), np.zeros(3))
+
+
+def test_a_probe_in_a_floor_slab_leaves_into_the_bounds():
+    # A slab z in [-0.4, 0] spanning the scene, bounds from its bottom up: the probe at z = -0.3 is
+    # nearer the bottom face (0.1) than the top (0.3), but leaving downwards ends below the bounds. Up:
+    # 0.3 + CLEAR is clamped to BOUND, BOUND - 0.3 past the top (>= RELOCATE_MIN_EXIT_RATIO): offset
+    # (0, 0, BOUND).
+    slab = solid_box((-5, -5, -0.4), (5, 5, 0.0))
+    bounds = (np.array([-5.0, -5.0, -0.4]), np.array([5.0, 5.0, 3.0]))
+    np.testing.assert_allclose(relocate((0.0, 0.0, -0.3), slab, bounds=bounds), [0.0, 0.0, BOUND], atol=1e-12)
+    # From z = -0.38 the clamped exit ends 0.07 past the top (< 0.1): it stays.
+    assert np.array_equal(relocate((0.0, 0.0, -0.38), slab, bounds=bounds), np.zeros(3))
+
+
+def test_offsets_never_exceed_the_bound():
+    # Random closed boxes and floors around random probes, stepped three times: every offset component
+    # within BOUND (the clamp is exact in float64).
+    rng = np.random.default_rng(7)
+    for _ in range(60):
+        rects = [FLOOR] if rng.random() < 0.5 else []
+        for _ in range(rng.integers(1, 4)):
+            c, h = rng.uniform(-0.6, 0.6, 3), rng.uniform(0.05, 0.5, 3)
+            rects += solid_box(c - h, c + h)
+        grid_pos, offset = rng.uniform(-0.5, 0.5, 3), np.zeros(3)
+        for _ in range(3):
+            offset = relocate(grid_pos, rects, offset)
+            assert np.abs(offset).max() <= BOUND

@@ -51,12 +51,12 @@ class GatherMethod(ProbesMethod):
             self.read_back(timings)
             indirect = self.atlas_indirect
         with self.step(timings, gather_quads.TEXELS_DECL):
-            gather_quads.texels(be, self.atlas, self.atlas_direct, self.quads, grid, indirect)
+            gather_quads.texels(be, self.atlas, self.atlas_direct, self.quads, grid, self.offset, indirect)
         with self.step(timings, gather_quads.QUADS_DECL):
             gather_quads.quads(be, self.quads, grid, self.gather_config.face_quads)
 
     def gather_pixels(self, timings: dict[str, float]) -> None:
         with self.step(timings, gather_form_factor.DECL):
             gather_form_factor.run(self.backend, self.gbuf["position"], self.gbuf["normal"], self.quads,
-                                   self.moments, self.state, self.indirect, self.grid, self.probes_config,
+                                   self.moments, self.state, self.offset, self.indirect, self.grid, self.probes_config,
                                    self.gather_config)

@@ -3,29 +3,33 @@
 
 Setup (once per geometry change, set_scene): the grid is fitted to the bounds (probe_grid.ProbeGrid.fit,
 ProbesConfig.probes_per_side); probe_capture rasterizes every probe's six faces into one atlas G-buffer
-(position, normal, albedo), then the distance moments of each atlas texel and which probes sit inside
-geometry. Solve (per light change): per light face probe_direct (the direct pass on the atlas), then
-probe_project (albedo x direct -> L2 SH per probe); each further bounce reads the field back at the
-atlas (probe_lookup.bounce) and re-projects with it (GIConfig.bounces = N: N projections). Gather (per
-camera move, per lightmap): the direct pass on the G-buffer, then probe_lookup -> `indirect` (Cycles'
-Diffuse Indirect units). The light field (sh, moments, state) does not depend on the camera, so a
-camera move costs the G-buffer, the direct light and the lookup. Products: direct, indirect, albedo.
+(position, normal, albedo); with ProbesConfig.relocate, probe_relocate moves probes out of solids and
+off near surfaces and the moved ones are captured again (probe_grid.RELOCATE_ROUNDS times); then the
+distance moments of each atlas texel and which probes sit inside geometry. Solve (per light change):
+per light face probe_direct (the direct pass on the atlas), then probe_project (albedo x direct -> L2
+SH per probe); each further bounce reads the field back at the atlas (probe_lookup.bounce) and
+re-projects with it (GIConfig.bounces = N: N projections). Gather (per camera move, per lightmap): the
+direct pass on the G-buffer, then probe_lookup -> `indirect` (Cycles' Diffuse Indirect units). The light
+field (sh, moments, state, offsets) does not depend on the camera, so a camera move costs the G-buffer,
+the direct light and the lookup. Products: direct, indirect, albedo.
 """
 
 from __future__ import annotations
 
+import numpy as np
+
 from .. import registry
 from ..config import ProbesConfig
-from ..passes import declare, probe_capture, probe_lookup, probe_project, zero
+from ..passes import declare, probe_capture, probe_lookup, probe_project, probe_relocate, zero
 from ..passes.light_views import LightView
-from ..probe_grid import ProbeGrid
+from ..probe_grid import RELOCATE_ROUNDS, ProbeGrid
 from .direct import OneBounceMethod, triangle_attributes
 
 
 class ProbesMethod(OneBounceMethod):
     spec = registry.get("probes")
     PASSES = declare.extend(
-        OneBounceMethod.PASSES, setup=(probe_capture.CAPTURE_DECL, probe_capture.MOMENTS_DECL),
+        OneBounceMethod.PASSES, setup=(probe_capture.CAPTURE_DECL, probe_relocate.DECL, probe_capture.MOMENTS_DECL),
         # The SH encoding's passes, then the irradiance encoding's (ProbesConfig.encoding picks one).
         solve=(probe_project.SHADE_DECL, probe_project.PROJECT_DECL, probe_lookup.BOUNCE_DECL,
                probe_project.REPROJECT_DECL, probe_project.CONVOLVE_DECL, probe_lookup.IRRADIANCE_BOUNCE_DECL,
@@ -37,6 +41,7 @@ class ProbesMethod(OneBounceMethod):
         self.probes_config = probes_config if probes_config is not None else ProbesConfig()
         self.grid: ProbeGrid | None = None
         self.probes_lit = 0  # probes captured and lit (ProbesConfig.only_read_probes)
+        self.probes_moved = 0  # probes relocated off their grid positions (ProbesConfig.relocate)
 
     def set_scene(self, scene) -> None:
         super().set_scene(scene)
@@ -55,6 +60,7 @@ class ProbesMethod(OneBounceMethod):
         self.light = self._light[0]
         self.moments = be.texture(size)
         self.state = be.texture(grid.state_size)
+        self.offset = probe_relocate.allocate(be, grid)
         far = probe_capture.far_m(self.bounds_m)
         attrs = triangle_attributes(self.scene)  # every triangle: emitters and camera-hidden objects block
         mesh = be.mesh(be.program(probe_capture.SPEC), attrs, "triangles") if attrs is not None else None
@@ -64,16 +70,39 @@ class ProbesMethod(OneBounceMethod):
         self.probes_lit = grid.count if needed is None else int(needed.sum())
         probe_capture.run(be, self._atlas_target, self.atlas, mesh, grid, probe_capture.face_matrices(grid, far),
                           needed)
-        probe_capture.moments(be, self.atlas, self.moments, self.state, grid, cfg.backface_share, needed)
+        self.probes_moved = self.relocate(mesh, far) if cfg.relocate else 0
+        probe_capture.moments(be, self.atlas, self.moments, self.state, grid, cfg.backface_share, self.offset,
+                              needed)
+
+    def relocate(self, mesh, far: float) -> int:
+        """Move probes out of solids and off near surfaces (probe_relocate), capturing the moved ones
+        again after each of RELOCATE_ROUNDS steps; returns how many probes end off their grid position.
+        A step needs the capture from the positions the previous one chose, hence one capture per step;
+        the probes a step leaves alone keep theirs."""
+        be, grid = self.backend, self.grid
+        for _ in range(RELOCATE_ROUNDS):
+            offsets_m, moved = probe_relocate.step(be, self.atlas, self.offset, grid, self.bounds_m)
+            if not moved.any():
+                break
+            probe_relocate.clear_moved(be, self.atlas, self.offset, grid)
+            positions_m = grid.positions_m() + offsets_m
+            probe_capture.draw(be, self._atlas_target, mesh, grid, probe_capture.face_matrices(grid, far, positions_m),
+                               moved, positions_m)
+        return int(np.count_nonzero(np.any(offsets_m != 0.0, axis=1)))
+
+    def offsets_m(self) -> np.ndarray:
+        """(count, 3) each probe's move off its grid position (m), in probe order (0 without relocation)."""
+        return self.backend.read(self.offset).reshape(-1, 4)[:, :3].astype(np.float64)
 
     def work(self) -> dict[str, int]:
-        """The probes the grid has, and those captured and lit (the rest no lookup reads)."""
-        return {"probes": self.grid.count if self.grid else 0, "probes_lit": self.probes_lit}
+        """The probes the grid has, those captured and lit (the rest no lookup reads), and those relocated."""
+        return {"probes": self.grid.count if self.grid else 0, "probes_lit": self.probes_lit,
+                "probes_moved": self.probes_moved}
 
     def field(self) -> dict:
         """The light field the lookup reads."""
         return {"irradiance" if self.irradiance_encoding else "sh": self.light, "moments": self.moments,
-                "state": self.state}
+                "state": self.state, "probe_offset": self.offset}
 
     def begin_solve(self, timings: dict[str, float]) -> None:
         zero.images(self.backend, [self.atlas_direct])

@@ -17,12 +17,13 @@ from ..config import GatherConfig, ProbesConfig
 from ..probe_grid import ProbeGrid
 from .declare import GBUF_NORMAL, GBUF_POSITION, INDIRECT, PassDecl
 from .gather_quads import FINE_PLANE, FINE_RADIANCE, QUAD_CORNERS, QUAD_RADIANCE
-from .probe_capture import GRID_UNIFORMS, MOMENTS, STATE
+from .probe_capture import GRID_UNIFORMS, MOMENTS, OFFSET, STATE
 from .probe_lookup import MIN_VARIANCE_RATIO
 from .rsm_gather import MAX_LOOP_ITERATIONS
 
 DECL = PassDecl("gather_form_factor", "gather",
-                (GBUF_POSITION, GBUF_NORMAL, QUAD_RADIANCE, QUAD_CORNERS, FINE_RADIANCE, FINE_PLANE, MOMENTS, STATE),
+                (GBUF_POSITION, GBUF_NORMAL, QUAD_RADIANCE, QUAD_CORNERS, FINE_RADIANCE, FINE_PLANE, MOMENTS, STATE,
+                 OFFSET),
                 (INDIRECT,), "every probe's quad lights around each pixel, by their form factors")
 
 ITEMS = 48  # (probe, face) pairs a receiver visits: 8 probes x 6 faces
@@ -35,7 +36,7 @@ def _spec(form_factor: str) -> ShaderSpec:
         local_size=(8, 8, 1),
         samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("quad_radiance", "2D"),
                   Sampler("quad_corners", "2D"), Sampler("fine_radiance", "2D"), Sampler("fine_plane", "2D"),
-                  Sampler("moments", "2D"), Sampler("state", "2D")),
+                  Sampler("moments", "2D"), Sampler("state", "2D"), Sampler("probe_offset", "2D")),
         images=(Image("indirect", "2D", "RGBA32F", "read_write"),),
         uniforms=(*GRID_UNIFORMS, Var("normal_bias_m", "float"), Var("min_variance_m2", "float"),
                   Var("visibility", "int"), Var("face_quads", "int"), Var("item_begin", "int"),
@@ -55,15 +56,16 @@ def items_per_dispatch(face_texels: int, face_quads: int) -> int:
     return max(1, min(ITEMS, MAX_LOOP_ITERATIONS // per_item))
 
 
-def run(backend: Backend, position, normal, quads: dict, moments, state, indirect, grid: ProbeGrid,
+def run(backend: Backend, position, normal, quads: dict, moments, state, offset, indirect, grid: ProbeGrid,
         probes: ProbesConfig, config: GatherConfig) -> None:
     """indirect := the quad lights of the probes around every texel of the G-buffer `position` / `normal`
-    (`quads`: the gather_quads textures by port name)."""
+    (`quads`: the gather_quads textures by port name; `offset`: the probes' relocation, OFFSET)."""
     spec = SPECS[config.form_factor]
     uniforms = {**grid.uniforms(), "normal_bias_m": probes.normal_bias * grid.spacing_m,
                 "min_variance_m2": MIN_VARIANCE_RATIO * grid.spacing_m ** 2,
                 "visibility": int(probes.chebyshev_visibility), "face_quads": config.face_quads}
     samplers = {"gbuf_position": position, "gbuf_normal": normal, "moments": moments, "state": state,
+                "probe_offset": offset,
                 **{k: quads[k] for k in ("quad_radiance", "quad_corners", "fine_radiance", "fine_plane")}}
     step = items_per_dispatch(grid.face_texels, config.face_quads)
     for begin in range(0, ITEMS, step):

@@ -24,7 +24,15 @@ from __future__ import annotations
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..probe_grid import ProbeGrid
 from .declare import PassDecl, Port
-from .probe_capture import ATLAS_ALBEDO, ATLAS_NORMAL, ATLAS_POSITION, ATLAS_UNIFORMS, GRID_UNIFORMS, grid_uniforms
+from .probe_capture import (
+    ATLAS_ALBEDO,
+    ATLAS_NORMAL,
+    ATLAS_POSITION,
+    ATLAS_UNIFORMS,
+    GRID_UNIFORMS,
+    OFFSET,
+    grid_uniforms,
+)
 from .probe_project import ATLAS_DIRECT, ATLAS_INDIRECT
 
 FINE_RADIANCE = Port("gather", "fine_radiance", "RGBA32F", "probe_atlas",
@@ -37,7 +45,7 @@ QUAD_CORNERS = Port("gather", "quad_corners", "RGBA32F", "probe_quads",
                     "distance (m) from the probe to a whole quad's 4 corners")
 
 TEXELS_DECL = PassDecl("gather_texels", "solve", (ATLAS_POSITION, ATLAS_NORMAL, ATLAS_ALBEDO, ATLAS_DIRECT,
-                                                   ATLAS_INDIRECT),
+                                                   ATLAS_INDIRECT, OFFSET),
                        (FINE_RADIANCE, FINE_PLANE), "each probe texel's radiance and its surface's plane")
 QUADS_DECL = PassDecl("gather_quads", "solve", (FINE_RADIANCE, FINE_PLANE), (QUAD_RADIANCE, QUAD_CORNERS),
                       "each probe face's texels merged into M x M quad lights (split over depth edges)")
@@ -49,7 +57,8 @@ def _texels_spec(bounce: bool) -> ShaderSpec:
         compute="gather/texels.comp.glsl",
         local_size=(8, 8, 1),
         samplers=(Sampler("atlas_position", "2D"), Sampler("atlas_normal", "2D"), Sampler("atlas_albedo", "2D"),
-                  Sampler("atlas_direct", "2D")) + ((Sampler("atlas_indirect", "2D"),) if bounce else ()),
+                  Sampler("atlas_direct", "2D"), Sampler("probe_offset", "2D"))
+        + ((Sampler("atlas_indirect", "2D"),) if bounce else ()),
         images=(Image("fine_radiance", "2D", "RGBA32F", "write"), Image("fine_plane", "2D", "RGBA32F", "write")),
         uniforms=GRID_UNIFORMS,
         defines=(("BOUNCE", "1"),) if bounce else (),
@@ -75,12 +84,14 @@ def allocate(backend: Backend, grid: ProbeGrid, face_quads: int) -> dict:
             QUAD_RADIANCE.name: backend.texture(quads), QUAD_CORNERS.name: backend.texture(quads)}
 
 
-def texels(backend: Backend, atlas: dict, atlas_direct, out: dict, grid: ProbeGrid, atlas_indirect=None) -> None:
+def texels(backend: Backend, atlas: dict, atlas_direct, out: dict, grid: ProbeGrid, offset,
+           atlas_indirect=None) -> None:
     """out["fine_radiance"], out["fine_plane"] := every atlas texel's radiance (albedo x (direct
-    [+ atlas_indirect])) and the plane of the surface it sees."""
+    [+ atlas_indirect])) and the plane of the surface it sees, relative to its probe (at its grid position
+    + `offset`, the OFFSET texture)."""
     spec = TEXELS_SPECS[atlas_indirect is not None]
     samplers = {"atlas_position": atlas["position"], "atlas_normal": atlas["normal"], "atlas_albedo": atlas["albedo"],
-                "atlas_direct": atlas_direct}
+                "atlas_direct": atlas_direct, "probe_offset": offset}
     if atlas_indirect is not None:
         samplers["atlas_indirect"] = atlas_indirect
     backend.dispatch(backend.program(spec), group_count(grid.atlas_size, spec.local_size),

@@ -55,10 +55,13 @@ ATLAS = (_atlas("position", "world position (m) a probe texel sees, w = 1 where 
 ATLAS_POSITION, ATLAS_NORMAL, ATLAS_ALBEDO = ATLAS
 MOMENTS = _atlas("moments", "probe-to-surface distance: mean (m), mean square (m^2) over a texel window")
 STATE = Port("probes", "state", "RGBA32F", "probes", "x: 1 probe on, 0 off (inside geometry); y: back-face share")
+# Written by probe_relocate (ProbesConfig.relocate); all 0 without it.
+OFFSET = Port("probes", "offset", "RGBA32F", "probes",
+              "xyz: the probe's move off its grid position (m); w: 1 where the last relocation step moved it")
 
 CAPTURE_DECL = PassDecl("probe_capture", "setup", (TRIANGLES,), ATLAS,
                         "every probe's six faces rasterized into the atlas G-buffer")
-MOMENTS_DECL = PassDecl("probe_moments", "setup", (ATLAS_POSITION, ATLAS_NORMAL), (MOMENTS, STATE),
+MOMENTS_DECL = PassDecl("probe_moments", "setup", (ATLAS_POSITION, ATLAS_NORMAL, OFFSET), (MOMENTS, STATE),
                         "distance moments per atlas texel; probes inside geometry switched off")
 
 SPEC = ShaderSpec(
@@ -75,7 +78,7 @@ MOMENTS_SPEC = ShaderSpec(
     name="probe_moments",
     compute="probes/moments.comp.glsl",
     local_size=(8, 8, 1),
-    samplers=(Sampler("atlas_position", "2D"),),
+    samplers=(Sampler("atlas_position", "2D"), Sampler("probe_offset", "2D")),
     images=(Image("moments", "2D", "RGBA32F", "write"),),
     uniforms=(*GRID_UNIFORMS, Var("max_distance_m", "float"), Var("moment_radius", "int")),
 )
@@ -96,38 +99,50 @@ def far_m(bounds_m) -> float:
     return 2.0 * float(np.linalg.norm(hi - lo)) + 1e-3
 
 
-def face_matrices(grid: ProbeGrid, far: float) -> list[np.ndarray]:
-    """The view-projection of every probe's faces, in probe order then face order."""
+def face_matrices(grid: ProbeGrid, far: float, positions_m: np.ndarray | None = None) -> list[np.ndarray]:
+    """The view-projection of every probe's faces, in probe order then face order, from the probes at
+    `positions_m` ((count, 3); default their grid positions)."""
     near = NEAR_RATIO * grid.spacing_m
-    return [face_view_projection(c, f, near, far) for c in grid.positions_m() for f in range(6)]
+    centres = grid.positions_m() if positions_m is None else positions_m
+    return [face_view_projection(c, f, near, far) for c in centres for f in range(6)]
 
 
 def run(backend: Backend, target, atlas: dict, mesh, grid: ProbeGrid, matrices: list[np.ndarray],
-        needed: np.ndarray | None = None) -> None:
-    """Fill the atlas G-buffer (`atlas` = the ATLAS textures, attached to `target` with a depth); with
-    `needed` ((count,) bool, ProbeGrid.read_by) only those probes' faces: the others' texels stay empty,
-    so the per-light shading skips them too (it skips texels that see no geometry)."""
+        needed: np.ndarray | None = None, positions_m: np.ndarray | None = None) -> None:
+    """Fill the atlas G-buffer (`atlas` = the ATLAS textures, attached to `target` with a depth) from the
+    probes at `positions_m` (default: the grid's; `matrices` from the same positions); with `needed`
+    ((count,) bool, ProbeGrid.read_by) only those probes' faces: the others' texels stay empty, so the
+    per-light shading skips them too (it skips texels that see no geometry)."""
     zero.images(backend, [atlas[p.name] for p in ATLAS])
+    draw(backend, target, mesh, grid, matrices, np.ones(grid.count, bool) if needed is None else needed,
+         grid.positions_m() if positions_m is None else positions_m)
+
+
+def draw(backend: Backend, target, mesh, grid: ProbeGrid, matrices: list[np.ndarray], probes: np.ndarray,
+         positions_m: np.ndarray) -> None:
+    """Draw the faces of the `probes` ((count,) bool) into their tiles, over what the tiles hold (run
+    and relocation clear them first)."""
     backend.clear(target, color=None, depth=1.0)
     if mesh is None:
         return
     program = backend.program(SPEC)
     n = grid.face_texels
-    positions = grid.positions_m()
-    for p in range(grid.count) if needed is None else np.flatnonzero(needed):
+    for p in np.flatnonzero(probes):
         for f in range(6):
             x, y = grid.face_origin(p, f)
             backend.draw(program, target, mesh, depth_test=True, viewport=(x, y, n, n),
-                         uniforms={"view_projection": matrices[6 * p + f], "camera_pos_ws": positions[p]})
+                         uniforms={"view_projection": matrices[6 * p + f], "camera_pos_ws": positions_m[p]})
 
 
 def moments(backend: Backend, atlas: dict, out_moments, out_state, grid: ProbeGrid, backface_share: float,
-            needed: np.ndarray | None = None) -> None:
-    """The distance moments and the probes' state; probes not `needed` (not captured) are off."""
+            offset, needed: np.ndarray | None = None) -> None:
+    """The distance moments (from each probe's position: its grid position + `offset`, the OFFSET
+    texture) and the probes' state; probes not `needed` (not captured) are off."""
     backend.dispatch(backend.program(MOMENTS_SPEC), group_count(out_moments.size, MOMENTS_SPEC.local_size),
                      uniforms={**grid_uniforms(MOMENTS_SPEC, grid), "moment_radius": MOMENT_RADIUS,
                                "max_distance_m": MAX_DISTANCE_RATIO * grid.spacing_m},
-                     samplers={"atlas_position": atlas["position"]}, images={"moments": out_moments})
+                     samplers={"atlas_position": atlas["position"], "probe_offset": offset},
+                     images={"moments": out_moments})
     backend.dispatch(backend.program(CLASSIFY_SPEC), group_count(out_state.size, CLASSIFY_SPEC.local_size),
                      uniforms={**grid_uniforms(CLASSIFY_SPEC, grid), "backface_share": backface_share},
                      samplers={"atlas_normal": atlas["normal"]}, images={"state": out_state})
