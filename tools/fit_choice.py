@@ -147,6 +147,32 @@ def agreement(records: list[dict], features: dict, cache: Path, ridge: float, re
     return out
 
 
+def verified(records: list[dict], features: dict, ridge: float, agreed: list[dict]) -> dict:
+    """Per budget and scene: the choice of `render --method auto --error-budget E --verify`
+    (choice.verify) by a model fitted without the scene, each candidate's run-time estimate taken from
+    `agreed` (`agreement`: its image against the same check row's, from the bench's runs); where no
+    candidate's estimate is within the budget, the model's own choice, as `render` falls back to."""
+    estimates = {(a["scene"], a["row"]): a["agree"] for a in agreed}
+    out = {str(budget): [] for budget in BUDGETS}
+    for held in sorted(features):
+        train_feats = {s: f for s, f in features.items() if s != held}
+        train = [r for r in records if r["scene"] != held]
+        model = choice.fit(train, train_feats, ridge)
+        model.margin = margin_of(train, train_feats, ridge)
+        measured = {choice.row_key(r["method"], r["setting"]): r for r in records if r["scene"] == held}
+        for budget in BUDGETS:
+            key, tried = choice.verify(model, features[held], budget, lambda k, held=held: estimates.get((held, k)))
+            accepted = key is not None
+            key = key if accepted else choice.choose(model, features[held], error_budget=budget).key
+            got = measured.get(key)
+            within = [r for r in measured.values() if r["rel_rmse_8"] <= budget]
+            out[str(budget)].append({
+                "scene": held, "choice": key, "accepted": accepted, "tries": len(tried),
+                "measured": got["rel_rmse_8"] if got else None, "ms": got["total_ms"] if got else None,
+                "fastest_ms": min(r["total_ms"] for r in within) if within else None})
+    return out
+
+
 def summary(judged: dict) -> dict:
     s = {}
     for budget, rows in judged["budgets"].items():
@@ -163,6 +189,14 @@ def summary(judged: dict) -> dict:
                        <= ESTIMATE_FACTOR)
         s[budget] = {"scenes": n, "met": met, "possible": possible, "within_2x": fast, "estimate_within_1.5x": est,
                      "self_check_within_1.5x": self_est}
+        checked = judged.get("verified", {}).get(budget, [])
+        if checked:
+            s[budget]["verified_met"] = sum(1 for r in checked if r["measured"] is not None
+                                            and r["measured"] <= float(budget))
+            s[budget]["verified_within_2x"] = sum(1 for r in checked if r["measured"] is not None
+                                                  and r["measured"] <= float(budget) and r["fastest_ms"]
+                                                  and r["ms"] <= 2.0 * r["fastest_ms"])
+            s[budget]["verified_mean_tries"] = float(np.mean([r["tries"] for r in checked]))
     ratios = [e["predicted"] / e["measured"] for e in judged["estimates"]]
     s["all_rows_estimate_within_1.5x"] = float(np.mean([1 / ESTIMATE_FACTOR <= x <= ESTIMATE_FACTOR for x in ratios]))
     for kind in ("model", "agree", "blend"):
@@ -182,13 +216,19 @@ def report(results_path: str, judged: dict, summ: dict, model: choice.Model) -> 
              "budget; possible: some measured setting is; within 2x: met, and its time at most twice the fastest "
              "setting measured within the budget; estimate: the choice's predicted error within a factor 1.5 of "
              "its measured one; self-check: `render --self-check`'s estimate (the difference from the image of the "
-             "row of another method the model expects most accurate) within that factor.", "",
-             "| budget | scenes | met | possible | within 2x | estimate within 1.5x | self-check within 1.5x |",
-             "| --- | --- | --- | --- | --- | --- | --- |"]
+             "row of another method the model expects most accurate) within that factor; verified: the choice "
+             f"of `--verify` (the first of the rows predicted within {choice.VERIFY_LOOSEN:g} budgets, fastest "
+             "first, whose self-check estimate is within the budget; at most "
+             f"{choice.VERIFY_MAX_TRIES} rendered; else the model's choice), met and within 2x as above, and the "
+             "mean number of rows it rendered besides their check rows.", "",
+             "| budget | scenes | met | possible | within 2x | estimate within 1.5x | self-check within 1.5x | "
+             "verified: met | within 2x | rows tried |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for budget in map(str, BUDGETS):
         s = summ[budget]
         lines.append(f"| {budget} | {s['scenes']} | {s['met']} | {s['possible']} | {s['within_2x']} | "
-                     f"{s['estimate_within_1.5x']} | {s['self_check_within_1.5x']} |")
+                     f"{s['estimate_within_1.5x']} | {s['self_check_within_1.5x']} | {s.get('verified_met', '-')} | "
+                     f"{s.get('verified_within_2x', '-')} | {s.get('verified_mean_tries', float('nan')):.1f} |")
     lines += ["", f"Every measured row's estimate within a factor 1.5: {summ['all_rows_estimate_within_1.5x']:.0%}.",
               ""]
     if "run_time_agree_within_1.5x" in summ:
@@ -197,13 +237,18 @@ def report(results_path: str, judged: dict, summ: dict, model: choice.Model) -> 
                   f"model expects most accurate {summ['run_time_agree_within_1.5x']:.0%}; their geometric mean "
                   f"{summ['run_time_blend_within_1.5x']:.0%}.", ""]
     for budget in map(str, BUDGETS):
-        lines += [f"## Budget {budget}", "", "| scene | choice | predicted | measured | ms | fastest within | ms |",
-                  "| --- | --- | --- | --- | --- | --- | --- |"]
+        lines += [f"## Budget {budget}", "", "| scene | choice | predicted | measured | ms | fastest within | ms | "
+                  "verified choice | measured | ms |", "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+        checked = {r["scene"]: r for r in judged.get("verified", {}).get(budget, [])}
+
+        def f(x, fmt="{:.3f}"):
+            return "-" if x is None else fmt.format(x)
         for r in judged["budgets"][budget]:
-            def f(x, fmt="{:.3f}"):
-                return "-" if x is None else fmt.format(x)
+            v = checked.get(r["scene"], {})
             lines.append(f"| {r['scene']} | {r['choice']} | {f(r['predicted'])} | {f(r['measured'])} | "
-                         f"{f(r['ms'], '{:.0f}')} | {r['fastest_within'] or '-'} | {f(r['fastest_ms'], '{:.0f}')} |")
+                         f"{f(r['ms'], '{:.0f}')} | {r['fastest_within'] or '-'} | {f(r['fastest_ms'], '{:.0f}')} | "
+                         f"{v.get('choice', '-')}{'' if v.get('accepted', True) else ' (none verified)'} | "
+                         f"{f(v.get('measured'))} | {f(v.get('ms'), '{:.0f}')} |")
         lines.append("")
     lines += ["## Features of the scenes", "", "| scene | " + " | ".join(choice.FEATURES) + " |",
               "| --- |" + " --- |" * len(choice.FEATURES)]
@@ -232,6 +277,7 @@ def main(argv=None) -> int:
     judged = judge(records, features, args.ridge)
     ref_glob = f"*-r{results['res']}-spp{results['ref_spp']}-b{results['bounces']}-seed0"
     judged["agreement"] = agreement(records, features, args.cache, args.ridge, ref_glob)
+    judged["verified"] = verified(records, features, args.ridge, judged["agreement"])
     summ = summary(judged)
     model = choice.fit(records, features, args.ridge)
     model.margin = margin_of(records, features, args.ridge)

@@ -12,6 +12,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import bpy
+import numpy as np
 
 from ..engine import choice, methods, metrics, registry
 from ..engine.backends.moderngl_backend import ModernGLBackend
@@ -62,9 +63,52 @@ def run_self_check(be, captured, settings: dict, decided: dict, written: dict) -
             "estimated_rel_rmse_8": choice.self_estimate(difference, decided["estimated_rel_rmse_8"])}
 
 
+def verify_choice(be, captured, requested: dict, settings: dict, decided: dict, error_budget: float,
+                  progress: Callable[[str], None]) -> tuple[dict, dict]:
+    """`--verify`: the candidates of choice.verify rendered on the captured scene, each against its
+    check row (choice.check_row), the first whose difference is within `error_budget` taken. Returns the
+    settings to run (`requested` with that row's setting; the model's choice, `settings`, when none is
+    within) and `decided` with choice["verified"] = the rows tried and their estimates."""
+    model = choice.load()
+    feats = decided["features"]
+    able = tuple(m for m in registry.NAMES if registry.get(m).max_bounces >= requested["gi"].bounces)
+    rendered: dict[str, np.ndarray] = {}
+
+    def image(key: str) -> np.ndarray:
+        if key not in rendered:
+            row = model.rows[key]
+            progress(f"verify: rendering {key}")
+            method = methods.create(be, choice.apply_row(requested, row["method"], row["setting"]))
+            method.set_scene(captured)
+            rendered[key] = method.run().images["indirect"]
+        return rendered[key]
+
+    def difference(key: str) -> float | None:
+        other = choice.check_row(model, feats, key, able)
+        if other is None:
+            return None
+        ours, theirs = image(key), image(other)
+        return metrics.rel_rmse_8(ours[..., :3], theirs[..., :3], ours[..., 3] > 0.5)
+
+    key, tried = choice.verify(model, feats, error_budget, difference, able)
+    decided["choice"]["verified"] = {"tried": tried, "accepted": key}
+    if key is None or key == decided["choice"]["row"]:
+        return settings, decided
+    row = model.rows[key]
+    predicted, predicted_ms = model.predict(key, feats)
+    estimate = next(t["estimated_rel_rmse_8"] for t in tried if t["row"] == key)
+    decided["choice"].update(method=row["method"], setting=row["setting"], row=key, predicted_rel_rmse_8=predicted,
+                             predicted_ms=predicted_ms, meets_budget=True,
+                             why=f"fastest of the settings tried whose image is within rel_rmse_8 {error_budget:g} of "
+                                 f"its check row's: {estimate:.3f}")
+    # The run-time estimate, not the model's: it is the better judge on held-out scenes (REPORT.md).
+    decided.update(estimated_rel_rmse_8=choice.self_estimate(estimate, predicted), estimate_row=key)
+    return choice.apply_row(requested, row["method"], row["setting"]), decided
+
+
 def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
                 progress: Callable[[str], None] = lambda step: None, profile_updates: bool = False,
-                budget: dict | None = None, self_check: bool = False) -> dict:
+                budget: dict | None = None, self_check: bool = False, verify: bool = False) -> dict:
     """Render `blend` with {group: config} settings (config.settings' form; missing groups take their
     defaults); write <product>.exr for each product and stats.json; return stats.
 
@@ -75,7 +119,8 @@ def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
     captured scene (engine/choice.py) and stats["choice"] says which and why; every render's stats carry
     the choice model's `estimated_rel_rmse_8` where it knows the settings. self_check: also render the
     row of another method the model expects most accurate and estimate the error from the two images'
-    difference (stats["self_check"]).
+    difference (stats["self_check"]). verify (with an error budget): the choice is checked on the scene
+    itself before it runs (verify_choice; stats["choice"]["verified"]).
     """
     settings = complete_settings(**settings)
     gi = settings["gi"]
@@ -89,10 +134,13 @@ def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
     captured = SceneCache().update(bpy.context.evaluated_depsgraph_get(), width, height)
     if budget:
         progress("choosing the method for the budget")
+    requested = settings
     settings, decided = choice.decide(captured, settings, width * height, **(budget or {}))
+    be = backend()
+    if verify and budget and "error_budget" in budget:
+        settings, decided = verify_choice(be, captured, requested, settings, decided, budget["error_budget"], progress)
     gi = settings["gi"]
     progress(f"method {gi.method}: uploading {captured.triangle_count} triangles, warm-up run (compiles shaders)")
-    be = backend()
     method = methods.create(be, settings)
     method.set_scene(captured)
     method.run()  # warm-up

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 
+from ..engine.errors import ConfigError
 from ._args import add_quiet, existing_blend, output_dir, progress
 from ._settings import add_budget_flags, add_config_flags, budget, check_bounces, configs
 
@@ -25,6 +26,10 @@ def add_arguments(p) -> None:
     p.add_argument("--self-check", action="store_true",
                    help="also render the method the choice model expects most accurate here and estimate the "
                         "error from the two images' difference (stats.json self_check; costs that render)")
+    p.add_argument("--verify", action="store_true",
+                   help="with --method auto --error-budget E: render the candidate settings (fastest first) and "
+                        "each one's check row on this scene, and take the first whose difference is within E "
+                        "(stats.json choice.verified; costs those renders once)")
     add_quiet(p)
     add_config_flags(p)
     add_budget_flags(p)
@@ -33,6 +38,8 @@ def add_arguments(p) -> None:
 def run(args) -> int:
     settings = configs(args)
     chosen_for = budget(args)
+    if args.verify and not (chosen_for and "error_budget" in chosen_for):
+        raise ConfigError("--verify checks the choice for an error budget: give it with --method auto --error-budget E")
     if chosen_for is None:
         check_bounces(settings["gi"])
     blend = existing_blend(args.blend)
@@ -40,7 +47,8 @@ def run(args) -> int:
     from ..bridge.pipeline import render_file  # imports bpy: only when actually rendering
 
     stats = render_file(blend, out, settings, repeat=max(1, args.repeat), progress=progress(args.quiet),
-                        profile_updates=args.profile_updates, budget=chosen_for, self_check=args.self_check)
+                        profile_updates=args.profile_updates, budget=chosen_for, self_check=args.self_check,
+                        verify=args.verify)
     summary = {"out": str(out), "total_ms": round(stats["total_ms"], 2), "notes": stats["notes"]}
     if "choice" in stats:
         summary["choice"] = {k: stats["choice"][k] for k in ("method", "setting", "why")}

@@ -61,6 +61,30 @@ def test_budget_flags_refused_alone_or_out_of_range(cornell_blend, tmp_path, cap
     assert message in capsys.readouterr().err and not out.exists()
 
 
+def test_render_verify_runs_a_row_whose_estimate_is_within_the_budget(cornell_blend, tmp_path):
+    # --verify: the rows tried are listed with their run-time estimates; the one accepted is the first
+    # within the budget and is what ran, with that estimate. On the Cornell box most rows are within
+    # 0.3 (benchmarks/choice/REPORT.md), so one is accepted.
+    out = tmp_path / "verify"
+    assert main(["render", str(cornell_blend), "--out", str(out), "--method", "auto", "--error-budget", "0.3",
+                 "--verify", "--res", "32", "--repeat", "1", "--quiet"]) == 0
+    stats = json.loads((out / "stats.json").read_text())
+    c = stats["choice"]
+    tried, accepted = c["verified"]["tried"], c["verified"]["accepted"]
+    assert 1 <= len(tried) <= choice.VERIFY_MAX_TRIES and accepted is not None
+    assert tried[-1]["row"] == accepted == c["row"] and tried[-1]["estimated_rel_rmse_8"] <= 0.3
+    assert all(t["estimated_rel_rmse_8"] > 0.3 for t in tried[:-1])
+    assert stats["estimated_rel_rmse_8"] == pytest.approx(tried[-1]["estimated_rel_rmse_8"])
+    assert stats["method"] == c["method"]
+
+
+def test_verify_needs_an_error_budget(cornell_blend, tmp_path, capsys):
+    out = tmp_path / "bad"
+    assert main(["render", str(cornell_blend), "--out", str(out), "--method", "auto", "--time-budget", "100",
+                 "--verify"]) == 2
+    assert "--verify" in capsys.readouterr().err and not out.exists()
+
+
 def test_bake_auto_records_the_choice(cornell_blend, tmp_path):
     out = tmp_path / "bake"
     assert main(["bake", str(cornell_blend), "--out", str(out), "--objects", "Floor", "--size", "16",

@@ -143,6 +143,54 @@ def test_choose_the_fastest_within_an_error_budget_and_the_best_within_a_time_bu
         choice.choose(model, f, error_budget=0.1, time_budget_ms=10)
 
 
+def test_verify_takes_the_fastest_candidate_whose_estimate_is_within_the_budget():
+    # Rows predicted 0.3 / 0.15 / 0.05 in 10 / 100 / 1000 ms on every scene, margin 1. At E = 0.2 the
+    # candidates are those predicted within VERIFY_LOOSEN x 0.2 = 0.4: all three, fastest first.
+    rng = np.random.default_rng(4)
+    scenes = {f"s{i}": features(rng) for i in range(6)}
+    rows = {"m x=1": ("m", {"g.x": 1}), "m x=2": ("m", {"g.x": 2}), "m x=3": ("m", {"g.x": 3})}
+    a = {"m x=1": math.log(0.3), "m x=2": math.log(0.15), "m x=3": math.log(0.05)}
+    c = {"m x=1": math.log(10), "m x=2": math.log(100), "m x=3": math.log(1000)}
+    model = choice.fit(synthetic(rows, scenes, a, np.zeros(len(choice.FEATURES)), c), scenes, ridge=1e-9)
+    f = scenes["s0"]
+    asked = []
+
+    def estimates(values):
+        def difference(key):
+            asked.append(key)
+            return values[key]
+        return difference
+
+    # The fastest row measures within the budget although the model expects 0.3: it is taken, and
+    # nothing slower is rendered.
+    key, tried = choice.verify(model, f, 0.2, estimates({"m x=1": 0.18, "m x=2": 0.1, "m x=3": 0.05}))
+    assert key == "m x=1" and asked == ["m x=1"] and tried == [{"row": "m x=1", "estimated_rel_rmse_8": 0.18}]
+    # The model's own choice (x=2) measures 0.25 here: the next candidate is taken.
+    asked.clear()
+    key, tried = choice.verify(model, f, 0.2, estimates({"m x=1": 0.35, "m x=2": 0.25, "m x=3": 0.08}))
+    assert key == "m x=3" and asked == ["m x=1", "m x=2", "m x=3"]
+    # None within: None, every candidate tried once. A row without an estimate is skipped, not counted.
+    asked.clear()
+    key, tried = choice.verify(model, f, 0.2, estimates({"m x=1": 0.5, "m x=2": None, "m x=3": 0.3}))
+    assert key is None and [t["row"] for t in tried] == ["m x=1", "m x=3"]
+    # At E = 0.1 only rows predicted within 0.2 are candidates: the 0.3 row is never rendered.
+    asked.clear()
+    choice.verify(model, f, 0.1, estimates({"m x=1": 0.01, "m x=2": 0.5, "m x=3": 0.5}))
+    assert asked == ["m x=2", "m x=3"]
+
+
+def test_verify_renders_at_most_its_cap():
+    rng = np.random.default_rng(5)
+    scenes = {f"s{i}": features(rng) for i in range(4)}
+    n = choice.VERIFY_MAX_TRIES + 3
+    rows = {f"m x={i}": ("m", {"g.x": i}) for i in range(n)}
+    a = {k: math.log(0.1) for k in rows}
+    c = {k: float(i) for i, k in enumerate(rows)}
+    model = choice.fit(synthetic(rows, scenes, a, np.zeros(len(choice.FEATURES)), c), scenes, ridge=1e-9)
+    key, tried = choice.verify(model, scenes["s0"], 0.1, lambda k: 1.0)
+    assert key is None and len(tried) == choice.VERIFY_MAX_TRIES
+
+
 def test_model_round_trips_through_json():
     rng = np.random.default_rng(3)
     scenes = {f"s{i}": features(rng) for i in range(4)}
