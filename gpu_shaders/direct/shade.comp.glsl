@@ -1,4 +1,5 @@
-// Shadow-mapped direct diffuse light of one light face at every G-buffer pixel, added to `direct`.
+// Shadow-mapped direct diffuse light of one light face at every G-buffer pixel, added to `direct` (or in
+// its place: `accumulate`, main()).
 // Output unit: Cycles' Diffuse Direct pass = irradiance / pi (W/m^2/sr per unit albedo).
 // Compiled per kind of light (passes/direct_light.py): POLYGONS for a light with its shape, SOFT_SUN for
 // a sun with an angle. llvmpipe pays for a branch's code even where no invocation takes it: a spot
@@ -86,15 +87,9 @@ float soft_sun_visibility(vec2 uv, ivec2 size, float receiver, float bias_m, flo
     return lit / float(SOFT_SAMPLES);
 }
 
-void main() {
-    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
-    if (any(greaterThanEqual(px, textureSize(gbuf_position, 0)))) {
-        return;
-    }
-    vec4 pos = texelFetch(gbuf_position, px, 0);
-    if (pos.w == 0.0) {
-        return;
-    }
+// This face's direct light (irradiance / pi) at G-buffer pixel px, which sees geometry: 0 where
+// another face shades it, where the light does not reach it, or in its shadow.
+vec3 face_light(ivec2 px, vec4 pos) {
     vec3 p = pos.xyz;
     vec3 n = texelFetch(gbuf_normal, px, 0).xyz;
     vec3 irradiance;
@@ -119,7 +114,7 @@ void main() {
     }
 #ifndef POLYGONS
     if (all(equal(irradiance, vec3(0.0)))) {
-        return;
+        return vec3(0.0);
     }
 #endif
     // Shadow test against the RSM's stored positions. The receiver is pushed off its surface by 1.5 RSM
@@ -128,7 +123,7 @@ void main() {
     vec3 p_test = p + n * (1.5 * texel_m);
     float bias_m = shadow_bias_texels * texel_m;
     if (face_index >= 0 && cube_face(p_test - light_pos_ws) != face_index) {
-        return;  // another face of this point light shades this pixel: the one p_test projects into
+        return vec3(0.0);  // another face of this point light shades this pixel: the one p_test projects into
     }
 #ifdef POLYGONS
     // A light with its shape (an area light's patch, an emissive mesh's triangles; never a sun): the
@@ -136,7 +131,7 @@ void main() {
     // shades this pixel pays for the integral; light_pos_ws is where its shadow is taken from.
     irradiance = emitter_irradiance(emitters, poly_first, poly_count, p, n);
     if (all(equal(irradiance, vec3(0.0)))) {
-        return;
+        return vec3(0.0);
     }
 #endif
     vec4 clip = light_view_projection * vec4(p_test, 1.0);
@@ -157,6 +152,26 @@ void main() {
         }
 #endif
     }
-    vec4 acc = imageLoad(direct, px);
-    imageStore(direct, px, acc + vec4(irradiance * (lit / PI), 0.0));
+    return irradiance * (lit / PI);
+}
+
+// Adds this face's light to `direct`, or with accumulate = 0 (a solve's first face on the probe atlas)
+// puts it in place of what `direct` holds, so that the atlas needs no zeroing pass before each solve
+// (texels that see no geometry are never written: 0 since set-up). One store, after the shading: a
+// store on each of its early ways out cost llvmpipe a third more time.
+void main() {
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(px, textureSize(gbuf_position, 0)))) {
+        return;
+    }
+    vec4 pos = texelFetch(gbuf_position, px, 0);
+    if (pos.w == 0.0) {
+        return;
+    }
+    vec3 light = face_light(px, pos);
+    if (accumulate != 0 && all(equal(light, vec3(0.0)))) {
+        return;
+    }
+    vec4 acc = accumulate != 0 ? imageLoad(direct, px) : vec4(0.0);
+    imageStore(direct, px, acc + vec4(light, 0.0));
 }

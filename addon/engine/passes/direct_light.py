@@ -35,6 +35,7 @@ def _spec(polygons: bool, soft_sun: bool) -> ShaderSpec:
             Var("light_color_intensity", "vec3"), Var("face_index", "int"),
             Var("spot_cos_half", "float"), Var("spot_blend", "float"), Var("shadow_bias_texels", "float"),
             Var("poly_first", "int"), Var("poly_count", "int"), Var("sun_tan_half", "float"),
+            Var("accumulate", "int"),
         ),
         defines=((("POLYGONS", "1"),) if polygons else ()) + ((("SOFT_SUN", "1"),) if soft_sun else ()),
     )
@@ -48,11 +49,14 @@ DECL = PassDecl("direct_light", "gather", (GBUF_POSITION, GBUF_NORMAL, RSM_POSIT
 
 
 def run(backend: Backend, gbuf_position, gbuf_normal, rsm_position, direct, view: LightView,
-        shadow_bias_texels: float, emitters) -> None:
-    """`emitters`: the emitter table texture; the view's uniforms give its rows (poly_first, poly_count)."""
+        shadow_bias_texels: float, emitters, accumulate: bool = True) -> None:
+    """`emitters`: the emitter table texture; the view's uniforms give its rows (poly_first, poly_count).
+    accumulate: add to `direct`; False: replace its pixels that see geometry (those that see none are not
+    written: the caller keeps them 0)."""
     names = {u.name for u in SPECS[(False, False)].uniforms}
     uniforms = {"poly_first": 0, "poly_count": 0, **{k: v for k, v in view.uniforms.items() if k in names}}
     uniforms["shadow_bias_texels"] = shadow_bias_texels
+    uniforms["accumulate"] = int(accumulate)
     soft_sun = uniforms["light_kind"] == KIND_CODE["SUN"] and uniforms["sun_tan_half"] > 0.0
     spec = SPECS[(uniforms["poly_count"] > 0, soft_sun)]
     backend.dispatch(backend.program(spec), group_count(direct.size, spec.local_size), uniforms=uniforms,
