@@ -21,6 +21,7 @@ int cube_face(vec3 d) {
     return d.z >= 0.0 ? 4 : 5;
 }
 
+#ifdef SOFT_SUN
 // Soft sun shadows (percentage-closer soft shadows): a sun of angular diameter 2 atan(sun_tan_half)
 // casts a penumbra (receiver depth - blocker depth) x sun_tan_half wide on each side. The mean depth of
 // the blockers found in a disc of the widest penumbra sizes the filter; the lit share of a disc that
@@ -86,6 +87,7 @@ float soft_sun_visibility(vec2 uv, ivec2 size, float receiver, float bias_m, flo
     }
     return lit / float(SOFT_SAMPLES);
 }
+#endif
 
 // This face's direct light (irradiance / pi) at G-buffer pixel px, which sees geometry: 0 where
 // another face shades it, where the light does not reach it, or in its shadow.

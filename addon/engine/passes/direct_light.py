@@ -17,16 +17,16 @@ from .light_views import KIND_CODE, LightView
 
 
 def _spec(polygons: bool, soft_sun: bool) -> ShaderSpec:
-    """The pass for one kind of light: with its polygons' irradiance (POLYGONS) or a point's, with a
-    sun's soft shadows (SOFT_SUN) or a hard shadow test. One program each, because llvmpipe runs the
-    code of a branch no invocation takes: with both kinds in one program a spot's shading of the probe
-    atlas took 4.5 x as long (docs/PROBES.md, "Light update")."""
+    """The pass for one kind of light: with its polygons' irradiance (POLYGONS: the emitter table and
+    its rows) or a point's, with a sun's soft shadows (SOFT_SUN: the sun's angle) or a hard shadow test.
+    One program each, because llvmpipe runs the code of a branch no invocation takes: with both kinds in
+    one program a spot's shading of the probe atlas took 4.5 x as long (docs/PROBES.md)."""
     return ShaderSpec(
         name="direct_shade" + ("_polygons" if polygons else "") + ("_soft_sun" if soft_sun else ""),
         compute="direct/shade.comp.glsl",
         local_size=(8, 8, 1),
-        samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("rsm_position", "2D"),
-                  Sampler("emitters", "2D")),
+        samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("rsm_position", "2D"))
+        + ((Sampler("emitters", "2D"),) if polygons else ()),
         images=(Image("direct", "2D", "RGBA32F", "read_write"),),
         uniforms=(
             Var("light_view_projection", "mat4"),
@@ -34,9 +34,9 @@ def _spec(polygons: bool, soft_sun: bool) -> ShaderSpec:
             Var("emit_axis", "vec3"), Var("light_kind", "int"),
             Var("light_color_intensity", "vec3"), Var("face_index", "int"),
             Var("spot_cos_half", "float"), Var("spot_blend", "float"), Var("shadow_bias_texels", "float"),
-            Var("poly_first", "int"), Var("poly_count", "int"), Var("sun_tan_half", "float"),
             Var("accumulate", "int"),
-        ),
+        ) + ((Var("poly_first", "int"), Var("poly_count", "int")) if polygons else ())
+        + ((Var("sun_tan_half", "float"),) if soft_sun else ()),
         defines=((("POLYGONS", "1"),) if polygons else ()) + ((("SOFT_SUN", "1"),) if soft_sun else ()),
     )
 
@@ -53,12 +53,13 @@ def run(backend: Backend, gbuf_position, gbuf_normal, rsm_position, direct, view
     """`emitters`: the emitter table texture; the view's uniforms give its rows (poly_first, poly_count).
     accumulate: add to `direct`; False: replace its pixels that see geometry (those that see none are not
     written: the caller keeps them 0)."""
-    names = {u.name for u in SPECS[(False, False)].uniforms}
-    uniforms = {"poly_first": 0, "poly_count": 0, **{k: v for k, v in view.uniforms.items() if k in names}}
+    view_uniforms = view.uniforms
+    soft_sun = view_uniforms["light_kind"] == KIND_CODE["SUN"] and view_uniforms["sun_tan_half"] > 0.0
+    spec = SPECS[(view_uniforms.get("poly_count", 0) > 0, soft_sun)]
+    names = {u.name for u in spec.uniforms}
+    uniforms = {k: v for k, v in view_uniforms.items() if k in names}
     uniforms["shadow_bias_texels"] = shadow_bias_texels
     uniforms["accumulate"] = int(accumulate)
-    soft_sun = uniforms["light_kind"] == KIND_CODE["SUN"] and uniforms["sun_tan_half"] > 0.0
-    spec = SPECS[(uniforms["poly_count"] > 0, soft_sun)]
     backend.dispatch(backend.program(spec), group_count(direct.size, spec.local_size), uniforms=uniforms,
                      samplers={"gbuf_position": gbuf_position, "gbuf_normal": gbuf_normal,
                                "rsm_position": rsm_position, "emitters": emitters},
