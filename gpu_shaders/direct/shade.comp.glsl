@@ -1,5 +1,9 @@
-// Shadow-mapped direct diffuse light of one light face at every G-buffer pixel, added to `direct`.
+// Shadow-mapped direct diffuse light of one light face at every G-buffer pixel, added to `direct` (or in
+// its place: `accumulate`, main()).
 // Output unit: Cycles' Diffuse Direct pass = irradiance / pi (W/m^2/sr per unit albedo).
+// Compiled per kind of light (passes/direct_light.py): POLYGONS for a light with its shape, SOFT_SUN for
+// a sun with an angle. llvmpipe pays for a branch's code even where no invocation takes it: a spot
+// shaded 1.1 M probe atlas texels in ~270 ms with both, ~60 ms without (docs/PROBES.md).
 #include "common/light.glsl"
 #include "common/polygon.glsl"
 
@@ -17,6 +21,7 @@ int cube_face(vec3 d) {
     return d.z >= 0.0 ? 4 : 5;
 }
 
+#ifdef SOFT_SUN
 // Soft sun shadows (percentage-closer soft shadows): a sun of angular diameter 2 atan(sun_tan_half)
 // casts a penumbra (receiver depth - blocker depth) x sun_tan_half wide on each side. The mean depth of
 // the blockers found in a disc of the widest penumbra sizes the filter; the lit share of a disc that
@@ -82,16 +87,11 @@ float soft_sun_visibility(vec2 uv, ivec2 size, float receiver, float bias_m, flo
     }
     return lit / float(SOFT_SAMPLES);
 }
+#endif
 
-void main() {
-    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
-    if (any(greaterThanEqual(px, textureSize(gbuf_position, 0)))) {
-        return;
-    }
-    vec4 pos = texelFetch(gbuf_position, px, 0);
-    if (pos.w == 0.0) {
-        return;
-    }
+// This face's direct light (irradiance / pi) at G-buffer pixel px, which sees geometry: 0 where
+// another face shades it, where the light does not reach it, or in its shadow.
+vec3 face_light(ivec2 px, vec4 pos) {
     vec3 p = pos.xyz;
     vec3 n = texelFetch(gbuf_normal, px, 0).xyz;
     vec3 irradiance;
@@ -107,44 +107,73 @@ void main() {
         dist = length(d);
         vec3 w = d / max(dist, 1e-9);
         to_light = -w;
-        if (poly_count > 0) {
-            // A light with its shape (an area light's patch, an emissive mesh's triangles): the exact
-            // unshadowed irradiance of its polygons; light_pos_ws is where its shadow is taken from.
-            irradiance = emitter_irradiance(emitters, poly_first, poly_count, p, n);
-        } else {
-            vec3 intensity = light_intensity(light_kind, w, emit_axis, light_color_intensity, spot_cos_half,
-                                             spot_blend);
-            irradiance = intensity * max(dot(n, to_light), 0.0) / max(dist * dist, 1e-12);
-        }
+#ifndef POLYGONS
+        vec3 intensity = light_intensity(light_kind, w, emit_axis, light_color_intensity, spot_cos_half,
+                                         spot_blend);
+        irradiance = intensity * max(dot(n, to_light), 0.0) / max(dist * dist, 1e-12);
+#endif
         texel_m = sqrt(texel_scale) * dist;
     }
+#ifndef POLYGONS
     if (all(equal(irradiance, vec3(0.0)))) {
-        return;
+        return vec3(0.0);
     }
+#endif
     // Shadow test against the RSM's stored positions. The receiver is pushed off its surface by 1.5 RSM
     // texels along its normal (normal-offset bias) so it does not shadow itself; every bias is in
     // texels, so the result does not depend on the scene's scale.
     vec3 p_test = p + n * (1.5 * texel_m);
     float bias_m = shadow_bias_texels * texel_m;
     if (face_index >= 0 && cube_face(p_test - light_pos_ws) != face_index) {
-        return;  // another face of this point light shades this pixel: the one p_test projects into
+        return vec3(0.0);  // another face of this point light shades this pixel: the one p_test projects into
     }
+#ifdef POLYGONS
+    // A light with its shape (an area light's patch, an emissive mesh's triangles; never a sun): the
+    // exact unshadowed irradiance of its polygons, after the face test, so that only the face that
+    // shades this pixel pays for the integral; light_pos_ws is where its shadow is taken from.
+    irradiance = emitter_irradiance(emitters, poly_first, poly_count, p, n);
+    if (all(equal(irradiance, vec3(0.0)))) {
+        return vec3(0.0);
+    }
+#endif
     vec4 clip = light_view_projection * vec4(p_test, 1.0);
     vec3 ndc = clip.xyz / clip.w;
     float lit = 1.0;
     if (clip.w > 0.0 && all(lessThanEqual(abs(ndc.xy), vec2(1.0)))) {
         ivec2 size = textureSize(rsm_position, 0);
+#ifdef SOFT_SUN
+        lit = soft_sun_visibility((ndc.xy * 0.5 + 0.5) * vec2(size), size, dot(p_test, emit_axis), bias_m, texel_m,
+                                  n);
+#else
         ivec2 texel = clamp(ivec2((ndc.xy * 0.5 + 0.5) * vec2(size)), ivec2(0), size - 1);
         vec4 occ = texelFetch(rsm_position, texel, 0);
-        if (light_kind == LIGHT_SUN && sun_tan_half > 0.0) {
-            lit = soft_sun_visibility((ndc.xy * 0.5 + 0.5) * vec2(size), size, dot(p_test, emit_axis), bias_m,
-                                      texel_m, n);
-        } else if (occ.w > 0.0) {
+        if (occ.w > 0.0) {
             float receiver = light_kind == LIGHT_SUN ? dot(p_test, emit_axis) : length(p_test - light_pos_ws);
             float occluder = light_kind == LIGHT_SUN ? dot(occ.xyz, emit_axis) : length(occ.xyz - light_pos_ws);
             lit = receiver <= occluder + bias_m ? 1.0 : 0.0;
         }
+#endif
     }
-    vec4 acc = imageLoad(direct, px);
-    imageStore(direct, px, acc + vec4(irradiance * (lit / PI), 0.0));
+    return irradiance * (lit / PI);
+}
+
+// Adds this face's light to `direct`, or with accumulate = 0 (a solve's first face on the probe atlas)
+// puts it in place of what `direct` holds, so that the atlas needs no zeroing pass before each solve
+// (texels that see no geometry are never written: 0 since set-up). One store, after the shading: a
+// store on each of its early ways out cost llvmpipe a third more time.
+void main() {
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(px, textureSize(gbuf_position, 0)))) {
+        return;
+    }
+    vec4 pos = texelFetch(gbuf_position, px, 0);
+    if (pos.w == 0.0) {
+        return;
+    }
+    vec3 light = face_light(px, pos);
+    if (accumulate != 0 && all(equal(light, vec3(0.0)))) {
+        return;
+    }
+    vec4 acc = accumulate != 0 ? imageLoad(direct, px) : vec4(0.0);
+    imageStore(direct, px, acc + vec4(light, 0.0));
 }

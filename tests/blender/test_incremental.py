@@ -108,6 +108,19 @@ def test_light_move_solves_again(gl, cornell_scene, case):
     _assert_same(method.read(), _fresh_images(gl, case, replace(cornell_scene, lights=lights)))
 
 
+@pytest.mark.parametrize("case", ["probes", "gather"])
+def test_lights_removed_leave_no_light(gl, cornell_scene, case):
+    # No pass zeroes the probes' atlas before a solve: the solve's first light face replaces the last
+    # solve's light. With every light gone there is no first face, and the atlas must still go dark.
+    method = _method(gl, case)
+    method.set_scene(cornell_scene)
+    method.compute()
+    assert method.read()["indirect"][..., :3].max() > 0
+    method.set_lights([])
+    method.compute(run_gbuffer=False)
+    assert method.read()["indirect"][..., :3].max() == 0.0
+
+
 def test_lights_changed_in_place_are_noticed(gl, cornell_scene):
     # The light field remembers the lights it was solved for, not whether set_lights was called.
     method = _method(gl, "rsm")

@@ -212,3 +212,30 @@ def test_every_update_starts_from_a_cleared_gbuffer(gl):
     method.set_camera(up)
     method.run()
     assert np.all(method.backend.read(method.gbuf["position"])[..., 3] == 0.0)
+
+
+def test_first_face_replaces_what_the_texture_holds(gl):
+    """accumulate=False (the probes' first light face of a solve): every pixel that sees geometry gets
+    that face's light in place of what `direct` held, so the faces after it, added, give exactly the
+    image of a zeroed texture with every face added (the same sums in the same order: bit for bit);
+    pixels that see nothing are not written. A point light: six faces, each shading the pixels it owns."""
+    from addon.engine.passes import direct_light
+
+    method = DirectMethod(gl, GIConfig(), RsmConfig(resolution=64))
+    scene = make_scene(Light("POINT", [0, 0, H], [0, 0, -1], [1, 1, 1], power_w=300.0))
+    method.set_scene(scene)
+    expected = method.run().images["direct"][::-1]  # back to texture row order
+    junk = np.full((SIZE, SIZE, 4), 7.0, np.float32)
+    direct = gl.texture((SIZE, SIZE), data=junk)
+    views = method.light_views()
+    assert len(views) == 6
+    for i, view in enumerate(views):
+        method._draw_rsm(view, 0, {})
+        shadow, shadow_view = method.shadow_map(view)
+        direct_light.run(gl, method.gbuf["position"], method.gbuf["normal"], shadow, direct, shadow_view,
+                         method.rsm_config.shadow_bias_texels, method.emitters, accumulate=i > 0)
+    got = gl.read(direct)
+    seen = gl.read(method.gbuf["position"])[..., 3] != 0.0
+    assert seen.any() and not seen.all()
+    np.testing.assert_array_equal(got[seen][:, :3], expected[seen][:, :3])
+    assert np.all(got[~seen] == 7.0)

@@ -43,6 +43,7 @@ class GatherMethod(ProbesMethod):
         self.quads = gather_quads.allocate(self.backend, self.grid, self.gather_config.face_quads)
 
     def finish_solve(self, timings: dict[str, float]) -> None:
+        self.finish_direct()
         be, grid = self.backend, self.grid
         indirect = None
         if self.gi.bounces > 1:

@@ -42,6 +42,7 @@ class ProbesMethod(OneBounceMethod):
         self.grid: ProbeGrid | None = None
         self.probes_lit = 0  # probes captured and lit (ProbesConfig.only_read_probes)
         self.probes_moved = 0  # probes relocated off their grid positions (ProbesConfig.relocate)
+        self._faces_shaded = 0  # light faces shaded into atlas_direct in the running solve
 
     def set_scene(self, scene) -> None:
         super().set_scene(scene)
@@ -52,6 +53,7 @@ class ProbesMethod(OneBounceMethod):
         self.atlas = declare.allocate(be, probe_capture.ATLAS, size)
         self._atlas_target = be.target(list(self.atlas.values()), be.depth_texture(size))
         self.atlas_direct = be.texture(size)
+        zero.images(be, [self.atlas_direct])  # its texels that see no geometry stay 0 (probe_project.shade)
         self.atlas_indirect = be.texture(size) if self.gi.bounces > 1 else None
         # Two light tables (SH, or irradiance maps): a bounce reads one while the next pass writes the other.
         self.irradiance_encoding = cfg.encoding == "irradiance"
@@ -105,16 +107,25 @@ class ProbesMethod(OneBounceMethod):
                 "state": self.state, "probe_offset": self.offset}
 
     def begin_solve(self, timings: dict[str, float]) -> None:
-        zero.images(self.backend, [self.atlas_direct])
+        # No zeroing pass over the atlas (1.57 M texels on cornell, ~27 ms on llvmpipe): the first face
+        # replaces the last solve's light.
+        self._faces_shaded = 0
 
     def solve_view(self, view: LightView, timings: dict[str, float]) -> None:
         with self.step(timings, probe_project.SHADE_DECL):
             shadow, shadow_view = self.shadow_map(view)
             probe_project.shade(self.backend, self.atlas, self.atlas_direct, shadow, shadow_view,
-                                self.rsm_config.shadow_bias_texels, self.emitters)
+                                self.rsm_config.shadow_bias_texels, self.emitters, first=self._faces_shaded == 0)
+        self._faces_shaded += 1
 
     def finish_solve(self, timings: dict[str, float]) -> None:
+        self.finish_direct()
         self.encode_bounces(timings, self.gi.bounces)
+
+    def finish_direct(self) -> None:
+        """A solve with no light face replaced none of the last solve's direct light: zeroed here."""
+        if self._faces_shaded == 0:
+            zero.images(self.backend, [self.atlas_direct])
 
     def _encoding(self) -> tuple:
         """(first bounce's pass, later bounces' pass, the bounce lookup, the encoding's function)."""

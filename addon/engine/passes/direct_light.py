@@ -13,24 +13,35 @@ from __future__ import annotations
 
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from .declare import DIRECT, EMITTERS, GBUF_NORMAL, GBUF_POSITION, LIGHT_VIEWS, RSM_POSITION, PassDecl
-from .light_views import LightView
+from .light_views import KIND_CODE, LightView
 
-SPEC = ShaderSpec(
-    name="direct_shade",
-    compute="direct/shade.comp.glsl",
-    local_size=(8, 8, 1),
-    samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("rsm_position", "2D"),
-              Sampler("emitters", "2D")),
-    images=(Image("direct", "2D", "RGBA32F", "read_write"),),
-    uniforms=(
-        Var("light_view_projection", "mat4"),
-        Var("light_pos_ws", "vec3"), Var("texel_scale", "float"),
-        Var("emit_axis", "vec3"), Var("light_kind", "int"),
-        Var("light_color_intensity", "vec3"), Var("face_index", "int"),
-        Var("spot_cos_half", "float"), Var("spot_blend", "float"), Var("shadow_bias_texels", "float"),
-        Var("poly_first", "int"), Var("poly_count", "int"), Var("sun_tan_half", "float"),
-    ),
-)
+
+def _spec(polygons: bool, soft_sun: bool) -> ShaderSpec:
+    """The pass for one kind of light: with its polygons' irradiance (POLYGONS: the emitter table and
+    its rows) or a point's, with a sun's soft shadows (SOFT_SUN: the sun's angle) or a hard shadow test.
+    One program each, because llvmpipe runs the code of a branch no invocation takes: with both kinds in
+    one program a spot's shading of the probe atlas took 4.5 x as long (docs/PROBES.md)."""
+    return ShaderSpec(
+        name="direct_shade" + ("_polygons" if polygons else "") + ("_soft_sun" if soft_sun else ""),
+        compute="direct/shade.comp.glsl",
+        local_size=(8, 8, 1),
+        samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("rsm_position", "2D"))
+        + ((Sampler("emitters", "2D"),) if polygons else ()),
+        images=(Image("direct", "2D", "RGBA32F", "read_write"),),
+        uniforms=(
+            Var("light_view_projection", "mat4"),
+            Var("light_pos_ws", "vec3"), Var("texel_scale", "float"),
+            Var("emit_axis", "vec3"), Var("light_kind", "int"),
+            Var("light_color_intensity", "vec3"), Var("face_index", "int"),
+            Var("spot_cos_half", "float"), Var("spot_blend", "float"), Var("shadow_bias_texels", "float"),
+            Var("accumulate", "int"),
+        ) + ((Var("poly_first", "int"), Var("poly_count", "int")) if polygons else ())
+        + ((Var("sun_tan_half", "float"),) if soft_sun else ()),
+        defines=((("POLYGONS", "1"),) if polygons else ()) + ((("SOFT_SUN", "1"),) if soft_sun else ()),
+    )
+
+
+SPECS = {(polygons, soft_sun): _spec(polygons, soft_sun) for polygons in (False, True) for soft_sun in (False, True)}
 
 
 DECL = PassDecl("direct_light", "gather", (GBUF_POSITION, GBUF_NORMAL, RSM_POSITION, LIGHT_VIEWS, EMITTERS), (DIRECT,),
@@ -38,12 +49,18 @@ DECL = PassDecl("direct_light", "gather", (GBUF_POSITION, GBUF_NORMAL, RSM_POSIT
 
 
 def run(backend: Backend, gbuf_position, gbuf_normal, rsm_position, direct, view: LightView,
-        shadow_bias_texels: float, emitters) -> None:
-    """`emitters`: the emitter table texture; the view's uniforms give its rows (poly_first, poly_count)."""
-    names = {u.name for u in SPEC.uniforms}
-    uniforms = {"poly_first": 0, "poly_count": 0, **{k: v for k, v in view.uniforms.items() if k in names}}
+        shadow_bias_texels: float, emitters, accumulate: bool = True) -> None:
+    """`emitters`: the emitter table texture; the view's uniforms give its rows (poly_first, poly_count).
+    accumulate: add to `direct`; False: replace its pixels that see geometry (those that see none are not
+    written: the caller keeps them 0)."""
+    view_uniforms = view.uniforms
+    soft_sun = view_uniforms["light_kind"] == KIND_CODE["SUN"] and view_uniforms["sun_tan_half"] > 0.0
+    spec = SPECS[(view_uniforms.get("poly_count", 0) > 0, soft_sun)]
+    names = {u.name for u in spec.uniforms}
+    uniforms = {k: v for k, v in view_uniforms.items() if k in names}
     uniforms["shadow_bias_texels"] = shadow_bias_texels
-    backend.dispatch(backend.program(SPEC), group_count(direct.size, SPEC.local_size), uniforms=uniforms,
+    uniforms["accumulate"] = int(accumulate)
+    backend.dispatch(backend.program(spec), group_count(direct.size, spec.local_size), uniforms=uniforms,
                      samplers={"gbuf_position": gbuf_position, "gbuf_normal": gbuf_normal,
                                "rsm_position": rsm_position, "emitters": emitters},
                      images={"direct": direct})

@@ -73,10 +73,11 @@ SPECS = {(bounce, encoding): _spec(bounce, encoding) for bounce in (False, True)
 
 
 def shade(backend: Backend, atlas: dict, atlas_direct, rsm_position, view: LightView, shadow_bias_texels: float,
-          emitters) -> None:
-    """atlas_direct += one light face's direct light (zeroed by the caller before the first face)."""
+          emitters, first: bool) -> None:
+    """atlas_direct += one light face's direct light; the solve's first face (`first`) replaces the last
+    solve's light instead, at every texel that sees geometry (the others the caller keeps 0)."""
     direct_light.run(backend, atlas["position"], atlas["normal"], rsm_position, atlas_direct, view,
-                     shadow_bias_texels, emitters)
+                     shadow_bias_texels, emitters, accumulate=not first)
 
 
 def run(backend: Backend, atlas: dict, atlas_direct, sh, grid: ProbeGrid, atlas_indirect=None) -> None:
