@@ -82,6 +82,14 @@ def update_costs_block(results: dict) -> str:
         met = all(_camera_pct(r["update_ms"]) <= LPV_CAMERA_TARGET_PCT for r in lpv)
         lines += ["", f"lpv's camera update costs {ratios} of its full update (target <= {LPV_CAMERA_TARGET_PCT} %: "
                       f"{'met' if met else 'not met'})."]
+    # The probes issue's target: a light update no slower than lpv's in the same run.
+    lights = {(r["scene"], r["method"]): r["update_ms"]["lights"] for r in records}
+    pairs = [(scene, ms, lights[(scene, "lpv")]) for (scene, method), ms in lights.items()
+             if method == "probes" and (scene, "lpv") in lights]
+    if pairs:
+        ratios = ", ".join(f"{100 * ms / lpv_ms:.0f} % on {scene}" for scene, ms, lpv_ms in pairs)
+        met = all(ms <= lpv_ms for _, ms, lpv_ms in pairs)
+        lines += ["", f"probes' light update costs {ratios} of lpv's (target <= 100 %: {'met' if met else 'not met'})."]
     return "\n".join(lines) + "\n"
 
 

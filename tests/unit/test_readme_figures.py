@@ -61,6 +61,12 @@ def test_update_costs_block():
     assert "| 1.0 |" not in block  # only the default rows
     assert block.endswith("lpv's camera update costs 11.0 % on cornell, 20.0 % on sponza of its full update "
                           "(target <= 15 %: not met).\n")
+    # With probes beside lpv: probes' light update as a share of lpv's, per scene (84 / 168, 180 / 150).
+    records += [_record("cornell", "probes", update_ms={"full": 900.0, "lights": 84.0, "camera": 9.0}),
+                _record("sponza", "probes", update_ms={"full": 900.0, "lights": 180.0, "camera": 9.0})]
+    block = readme_figures.update_costs_block(_results(records))
+    assert block.endswith("probes' light update costs 50 % on cornell, 120 % on sponza of lpv's (target <= 100 %: "
+                          "not met).\n")
 
 
 def test_accuracy_block():
