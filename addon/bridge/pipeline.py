@@ -40,6 +40,14 @@ def open_blend(path: Path) -> None:
         raise SceneError(f"cannot open {path}: {str(exc).strip().splitlines()[-1]}") from None
 
 
+def render_row(be, captured, settings: dict, model, key: str) -> np.ndarray:
+    """The indirect image of the choice model's row `key` (`settings` with its setting) on the captured scene."""
+    row = model.rows[key]
+    method = methods.create(be, choice.apply_row(settings, row["method"], row["setting"]))
+    method.set_scene(captured)
+    return method.run().images["indirect"]
+
+
 def run_self_check(be, captured, settings: dict, decided: dict, written: dict) -> dict:
     """The run-time estimate: the rendered indirect image against the one of the row of another method
     the choice model expects most accurate (choice.check_row), both on the same captured scene."""
@@ -47,14 +55,10 @@ def run_self_check(be, captured, settings: dict, decided: dict, written: dict) -
     if key is None or "indirect" not in written:
         return {"note": "no self-check: the choice model knows no indirect setting like this one"}
     model = choice.load()
-    able = tuple(m for m in registry.NAMES if registry.get(m).max_bounces >= settings["gi"].bounces)
-    other = choice.check_row(model, decided["features"], key, able)
+    other = choice.check_row(model, decided["features"], key, registry.computing(settings["gi"].bounces))
     if other is None:
         return {"note": "no self-check: the choice model knows no other method"}
-    row = model.rows[other]
-    method = methods.create(be, choice.apply_row(settings, row["method"], row["setting"]))
-    method.set_scene(captured)
-    theirs = method.run().images["indirect"]
+    theirs = render_row(be, captured, settings, model, other)
     ours = written["indirect"]
     difference = metrics.rel_rmse_8(ours[..., :3], theirs[..., :3], ours[..., 3] > 0.5)
     if difference is None:
@@ -71,16 +75,13 @@ def verify_choice(be, captured, requested: dict, settings: dict, decided: dict, 
     within) and `decided` with choice["verified"] = the rows tried and their estimates."""
     model = choice.load()
     feats = decided["features"]
-    able = tuple(m for m in registry.NAMES if registry.get(m).max_bounces >= requested["gi"].bounces)
+    able = registry.computing(requested["gi"].bounces)
     rendered: dict[str, np.ndarray] = {}
 
     def image(key: str) -> np.ndarray:
         if key not in rendered:
-            row = model.rows[key]
             progress(f"verify: rendering {key}")
-            method = methods.create(be, choice.apply_row(requested, row["method"], row["setting"]))
-            method.set_scene(captured)
-            rendered[key] = method.run().images["indirect"]
+            rendered[key] = render_row(be, captured, requested, model, key)
         return rendered[key]
 
     def difference(key: str) -> float | None:

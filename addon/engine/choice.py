@@ -396,7 +396,7 @@ def decide(scene: Scene, settings: dict, pixels: int, error_budget: float | None
     if budget:
         from . import registry
 
-        able = tuple(m for m in registry.NAMES if registry.get(m).max_bounces >= settings["gi"].bounces)
+        able = registry.computing(settings["gi"].bounces)
         c = choose(model, feats, error_budget, time_budget_ms, methods=able)
         settings = apply_row(settings, c.method, c.setting)
         info["choice"] = {"method": c.method, "setting": c.setting, "row": c.key,

@@ -128,6 +128,11 @@ NAMES: tuple[str, ...] = tuple(m.name for m in METHODS)
 _BY_NAME = {m.name: m for m in METHODS}
 
 
+def computing(bounces: int) -> tuple[str, ...]:
+    """The methods that compute `bounces` indirect bounces (GIConfig.bounces), in registry order."""
+    return tuple(m.name for m in METHODS if m.max_bounces >= bounces)
+
+
 def get(name: str) -> MethodSpec:
     if name not in _BY_NAME:
         raise ConfigError(f"unknown method {name!r}: known methods are {', '.join(NAMES)}")
