@@ -17,9 +17,7 @@ void main() {
     if (any(greaterThanEqual(px, imageSize(fine_radiance)))) {
         return;
     }
-    int n = face_texels;
-    ivec2 tile = px / ivec2(3 * n, 2 * n);
-    int p = tile.x + tiles_per_row * tile.y;
+    int p = atlas_probe(px);
     vec4 pos = texelFetch(atlas_position, px, 0);
     vec3 rel = pos.xyz - (p < probe_count() ? probe_position(probe_cell(p)) : vec3(0.0));
     vec3 normal = texelFetch(atlas_normal, px, 0).xyz;

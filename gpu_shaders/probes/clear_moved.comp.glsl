@@ -8,9 +8,7 @@ void main() {
     if (any(greaterThanEqual(px, imageSize(atlas_position)))) {
         return;
     }
-    int n = face_texels;
-    ivec2 tile = px / ivec2(3 * n, 2 * n);
-    int p = tile.x + tiles_per_row * tile.y;
+    int p = atlas_probe(px);
     if (p >= probe_count()) {
         return;
     }

@@ -13,12 +13,11 @@ void main() {
         return;
     }
     int n = face_texels;
-    ivec2 tile = px / ivec2(3 * n, 2 * n);
-    int p = tile.x + tiles_per_row * tile.y;
+    int p = atlas_probe(px);
     if (p >= probe_count()) {
         return;
     }
-    ivec2 in_tile = px - tile * ivec2(3 * n, 2 * n);
+    ivec2 in_tile = px - tile_origin(p, 0, n);
     int face = (in_tile.x / n) + 3 * (in_tile.y / n);
     ivec2 origin = face_origin(p, face);
     ivec2 ij = px - origin;

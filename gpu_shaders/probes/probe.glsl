@@ -36,6 +36,13 @@ ivec2 face_origin(int p, int face) {
     return tile_origin(p, face, face_texels);
 }
 
+// The probe whose tile holds atlas texel px (the capture's atlas; the inverse of tile_origin); at least
+// probe_count() for a texel past the last probe's tile.
+int atlas_probe(ivec2 px) {
+    ivec2 tile = px / ivec2(3 * face_texels, 2 * face_texels);
+    return tile.x + tiles_per_row * tile.y;
+}
+
 void face_frame(int face, out vec3 forward, out vec3 right, out vec3 up) {
     float sgn = (face % 2 == 0) ? 1.0 : -1.0;
     int axis = face / 2;
