@@ -72,18 +72,26 @@ def margin_of(records: list[dict], features: dict, ridge: float) -> float:
     return float(np.quantile(ratios, MARGIN_QUANTILE)) if ratios else 1.0
 
 
-def judge(records: list[dict], features: dict, ridge: float) -> dict:
-    """Per budget and scene: the held-out choice, its measured error and time, the fastest measured
-    row within the budget; and the estimate's ratio to the measured error."""
-    out = {"budgets": {}, "estimates": []}
-    for budget in BUDGETS:
-        out["budgets"][str(budget)] = []
+def held_out(records: list[dict], features: dict, ridge: float) -> dict[str, tuple[choice.Model, dict]]:
+    """Per scene: the model fitted without it (its margin from the others alone) and the scene's measured
+    rows by key. Shared by `judge` and `verified`: the margin is itself a leave-one-out, the costly part."""
+    out = {}
     for held in sorted(features):
         train_feats = {s: f for s, f in features.items() if s != held}
         train = [r for r in records if r["scene"] != held]
         model = choice.fit(train, train_feats, ridge)
         model.margin = margin_of(train, train_feats, ridge)
-        measured = {choice.row_key(r["method"], r["setting"]): r for r in records if r["scene"] == held}
+        out[held] = model, {choice.row_key(r["method"], r["setting"]): r for r in records if r["scene"] == held}
+    return out
+
+
+def judge(models: dict, features: dict) -> dict:
+    """Per budget and scene (`models`: held_out): the held-out choice, its measured error and time, the
+    fastest measured row within the budget; and the estimate's ratio to the measured error."""
+    out = {"budgets": {}, "estimates": []}
+    for budget in BUDGETS:
+        out["budgets"][str(budget)] = []
+    for held, (model, measured) in models.items():
         for budget in BUDGETS:
             c = choice.choose(model, features[held], error_budget=budget)
             got = measured.get(c.key)
@@ -147,19 +155,15 @@ def agreement(records: list[dict], features: dict, cache: Path, ridge: float, re
     return out
 
 
-def verified(records: list[dict], features: dict, ridge: float, agreed: list[dict]) -> dict:
+def verified(models: dict, features: dict, agreed: list[dict]) -> dict:
     """Per budget and scene: the choice of `render --method auto --error-budget E --verify`
-    (choice.verify) by a model fitted without the scene, each candidate's run-time estimate taken from
-    `agreed` (`agreement`: its image against the same check row's, from the bench's runs); where no
+    (choice.verify) by a model fitted without the scene (`models`: held_out), each candidate's run-time
+    estimate taken from `agreed` (`agreement`: its image against the same check row's, from the bench's
+    runs); where no
     candidate's estimate is within the budget, the model's own choice, as `render` falls back to."""
     estimates = {(a["scene"], a["row"]): a["agree"] for a in agreed}
     out = {str(budget): [] for budget in BUDGETS}
-    for held in sorted(features):
-        train_feats = {s: f for s, f in features.items() if s != held}
-        train = [r for r in records if r["scene"] != held]
-        model = choice.fit(train, train_feats, ridge)
-        model.margin = margin_of(train, train_feats, ridge)
-        measured = {choice.row_key(r["method"], r["setting"]): r for r in records if r["scene"] == held}
+    for held, (model, measured) in models.items():
         for budget in BUDGETS:
             key, tried = choice.verify(model, features[held], budget, lambda k, held=held: estimates.get((held, k)))
             accepted = key is not None
@@ -282,10 +286,11 @@ def main(argv=None) -> int:
         raise SystemExit("the results differ in resolution, reference spp or bounces: errors would not compare")
     records = [rec for r in runs for rec in records_of(r)]
     features = scene_features(args.cache, sorted({r["scene"] for r in records}), results["bounces"], results["res"])
-    judged = judge(records, features, args.ridge)
+    models = held_out(records, features, args.ridge)
+    judged = judge(models, features)
     ref_glob = f"*-r{results['res']}-spp{results['ref_spp']}-b{results['bounces']}-seed0"
     judged["agreement"] = agreement(records, features, args.cache, args.ridge, ref_glob)
-    judged["verified"] = verified(records, features, args.ridge, judged["agreement"])
+    judged["verified"] = verified(models, features, judged["agreement"])
     summ = summary(judged)
     model = choice.fit(records, features, args.ridge)
     model.margin = margin_of(records, features, args.ridge)

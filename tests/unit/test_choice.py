@@ -121,15 +121,20 @@ def test_fit_recovers_a_noiseless_model():
         assert ms == pytest.approx(r["total_ms"], rel=1e-6)
 
 
-def test_choose_the_fastest_within_an_error_budget_and_the_best_within_a_time_budget():
-    rng = np.random.default_rng(2)
+def three_rows(seed: int):
+    """(model, one scene's features): rows "m x=1..3" with errors 0.3, 0.15, 0.05 and times 10, 100,
+    1000 ms on every one of 6 random scenes, fitted with a negligible ridge (margin 1)."""
+    rng = np.random.default_rng(seed)
     scenes = {f"s{i}": features(rng) for i in range(6)}
     rows = {"m x=1": ("m", {"g.x": 1}), "m x=2": ("m", {"g.x": 2}), "m x=3": ("m", {"g.x": 3})}
-    # errors 0.3, 0.15, 0.05 on every scene; times 10, 100, 1000 ms
     a = {"m x=1": math.log(0.3), "m x=2": math.log(0.15), "m x=3": math.log(0.05)}
     c = {"m x=1": math.log(10), "m x=2": math.log(100), "m x=3": math.log(1000)}
     model = choice.fit(synthetic(rows, scenes, a, np.zeros(len(choice.FEATURES)), c), scenes, ridge=1e-9)
-    f = scenes["s0"]
+    return model, scenes["s0"]
+
+
+def test_choose_the_fastest_within_an_error_budget_and_the_best_within_a_time_budget():
+    model, f = three_rows(2)  # errors 0.3, 0.15, 0.05 on every scene; times 10, 100, 1000 ms
     assert choice.choose(model, f, error_budget=0.2).key == "m x=2"
     assert choice.choose(model, f, error_budget=0.4).key == "m x=1"
     assert choice.choose(model, f, time_budget_ms=500).key == "m x=2"
@@ -146,13 +151,7 @@ def test_choose_the_fastest_within_an_error_budget_and_the_best_within_a_time_bu
 def test_verify_takes_the_fastest_candidate_whose_estimate_is_within_the_budget():
     # Rows predicted 0.3 / 0.15 / 0.05 in 10 / 100 / 1000 ms on every scene, margin 1. At E = 0.2 the
     # candidates are those predicted within VERIFY_LOOSEN x 0.2 = 0.4: all three, fastest first.
-    rng = np.random.default_rng(4)
-    scenes = {f"s{i}": features(rng) for i in range(6)}
-    rows = {"m x=1": ("m", {"g.x": 1}), "m x=2": ("m", {"g.x": 2}), "m x=3": ("m", {"g.x": 3})}
-    a = {"m x=1": math.log(0.3), "m x=2": math.log(0.15), "m x=3": math.log(0.05)}
-    c = {"m x=1": math.log(10), "m x=2": math.log(100), "m x=3": math.log(1000)}
-    model = choice.fit(synthetic(rows, scenes, a, np.zeros(len(choice.FEATURES)), c), scenes, ridge=1e-9)
-    f = scenes["s0"]
+    model, f = three_rows(4)
     asked = []
 
     def estimates(values):
