@@ -50,7 +50,7 @@ def _spec(bounce: bool, encoding: str = "sh") -> ShaderSpec:
         return ShaderSpec(
             name="probe_convolve" + ("_bounce" if bounce else ""),
             compute="probes/convolve.comp.glsl",
-            local_size=(8, 8, 1),
+            local_size=(3 * IRRADIANCE_TEXELS, 2 * IRRADIANCE_TEXELS, 1),  # one probe's tile a group
             samplers=(Sampler("atlas_albedo", "2D"), Sampler("atlas_direct", "2D"))
             + ((Sampler("atlas_indirect", "2D"),) if bounce else ()),
             images=(Image("irradiance", "2D", "RGBA32F", "write"),),
