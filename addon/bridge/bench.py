@@ -481,18 +481,13 @@ def _reference(blend: Path, key: str, spp: int, bounces: int, res: int, seed: in
 
 
 def _compare(test_exr: Path, ref_exr: Path) -> dict:
-    """Errors over the reference's geometry, less the pixels whose Diffuse Color (the reference folder's
-    albedo.exr, where there is one) is black: Cycles' Diffuse passes are divided by that colour and 0
-    there (an emitter's black panel), while Bounce's light products do not depend on it."""
+    """Errors over the reference's geometry, less its black-albedo pixels (reference.reference_mask)."""
     from ..engine.metrics import compare
     from . import images
+    from .reference import reference_mask
 
     a, b = images.read_exr(test_exr), images.read_exr(ref_exr)
-    mask = b[:, :, 3] > 0.5
-    albedo = Path(ref_exr).with_name("albedo.exr")
-    if albedo.name != Path(ref_exr).name and albedo.is_file():
-        mask &= images.read_exr(albedo)[:, :, :3].max(axis=2) > 0
-    return compare(a[:, :, :3], b[:, :, :3], mask)
+    return compare(a[:, :, :3], b[:, :, :3], reference_mask(ref_exr, b))
 
 
 def _compare_full(run_dir: Path, ref_dir: Path) -> dict | None:

@@ -200,6 +200,22 @@ def render_reference(blend_path, out_dir, spp: int = 1024, bounces: int = 1, res
     return stats
 
 
+def reference_mask(ref_exr, ref_pixels: np.ndarray) -> np.ndarray | None:
+    """The pixels a reference's light is judged on: its geometry (alpha > 0.5), less the pixels whose
+    Diffuse Color (the albedo.exr beside it, where there is one) is black: Cycles' Diffuse passes are
+    divided by that colour and 0 there (an emitter's black panel), while Bounce's light products do not
+    depend on it. None for a reference without alpha (every pixel counts)."""
+    if ref_pixels.shape[2] < 4:
+        return None
+    mask = ref_pixels[:, :, 3] > 0.5
+    albedo = Path(ref_exr).with_name("albedo.exr")
+    if albedo.name != Path(ref_exr).name and albedo.is_file():
+        albedo_pixels = images.read_exr(albedo)
+        if albedo_pixels.shape[:2] == mask.shape:
+            mask &= albedo_pixels[:, :, :3].max(axis=2) > 0
+    return mask
+
+
 def _masked_compare(test_dir, ref_dir, name="indirect") -> dict:
     a = images.read_exr(Path(test_dir) / f"{name}.exr")
     b = images.read_exr(Path(ref_dir) / f"{name}.exr")

@@ -1,7 +1,9 @@
 """`python -m addon compare A.exr B.exr`: errors of A against the reference B, as one JSON object.
 
 If B has an alpha channel it is the reference's geometry mask (alpha > 0.5 counts, as written by
-`reference`); a plain RGB reference counts every pixel. Images of different sizes: exit 2. HDR-FLIP is
+`reference`), less the pixels whose albedo.exr beside B is black (an emitter's panel, where Cycles'
+Diffuse passes are 0): the pixels `bench` judges (reference.reference_mask). A plain RGB reference
+counts every pixel. Images of different sizes: exit 2. HDR-FLIP is
 added when the flip-evaluator package is installed (requirements.txt pins it), else reported as null.
 Only linear float images are compared (OpenEXR, Radiance HDR): a PNG, JPEG or TIFF holds display-encoded
 integers (sRGB), whose errors mean something else; they exit 2.
@@ -12,6 +14,7 @@ from __future__ import annotations
 import json
 
 from ..bridge import images
+from ..bridge.reference import reference_mask
 from ..engine.errors import BackendUnavailable, ConfigError
 from ..engine.metrics import compare, hdr_flip
 
@@ -57,8 +60,8 @@ def compare_files(test_path, reference_path) -> dict:
                           f"{reference_path} is {b.shape[1]}x{b.shape[0]}")
     if a.shape[2] < 3 or b.shape[2] < 3:
         raise ConfigError("compare needs RGB or RGBA images")
-    masked = b.shape[2] >= 4
-    mask = b[:, :, 3] > 0.5 if masked else None
+    mask = reference_mask(reference_path, b)
+    masked = mask is not None
     try:
         flip = hdr_flip(a[:, :, :3], b[:, :, :3], mask)
     except BackendUnavailable:

@@ -263,6 +263,26 @@ def test_cli_compare_rgb_and_size_mismatch(tmp_path):
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
 
 
+def test_cli_compare_leaves_out_black_albedo_pixels_as_bench_does(tmp_path):
+    # A reference folder as `reference` writes it: the light with alpha, and albedo.exr beside it. The
+    # pixel whose albedo is black (an emitter's panel: Cycles' Diffuse passes are 0 there) is left
+    # out, as the benchmark leaves it out: ours reads 1 everywhere, the reference 1 except 0 there.
+    ref = tmp_path / "ref"
+    ref.mkdir()
+    light = np.ones((4, 8, 4), np.float32)
+    light[0, 0, :3] = 0.0
+    albedo = np.full((4, 8, 4), 0.5, np.float32)
+    albedo[0, 0, :3] = 0.0
+    images.write_exr(ref / "direct.exr", light)
+    images.write_exr(ref / "albedo.exr", albedo)
+    images.write_exr(tmp_path / "ours.exr", np.ones((4, 8, 3), np.float32))
+    got = json.loads(cli("compare", tmp_path / "ours.exr", ref / "direct.exr").stdout)
+    assert (got["pixels"], got["rel_rmse"], got["bias"], got["masked"]) == (31, 0.0, 1.0, True)
+    (ref / "albedo.exr").unlink()  # without it every covered pixel counts: 1 of 32 off by the mean
+    got = json.loads(cli("compare", tmp_path / "ours.exr", ref / "direct.exr").stdout)
+    assert got["pixels"] == 32 and got["rel_rmse"] == pytest.approx(np.sqrt(1 / 32) / (31 / 32), rel=1e-6)
+
+
 @pytest.mark.slow
 @pytest.mark.blender
 @pytest.mark.parametrize("extra, message", [
