@@ -497,9 +497,10 @@ def bake_volume(blend: Path, out_dir: Path, settings: dict, overwrite: bool = Fa
 def bake_probes(blend: Path, out_dir: Path, settings: dict, overwrite: bool = False,
                 backend=None, progress: bool = True) -> dict:
     """Method `probes`' solved probe volume for engines (engine/probe_export.py; docs/BAKE.md):
-    DIR/<stem>_probes.json (the layout: grid, faces, tiles, units, files) and four EXR textures,
-    <stem>_probes_sh.exr, <stem>_probes_irradiance.exr, <stem>_probes_moments.exr and
-    <stem>_probes_offsets.exr (the probes' relocation, m). Every bounce the
+    DIR/<stem>_probes.json (the layout: grid, faces, tiles, units, files) and six EXR textures,
+    <stem>_probes_sh.exr, <stem>_probes_irradiance.exr, <stem>_probes_moments.exr,
+    <stem>_probes_offsets.exr (the probes' relocation, m), and the irradiance and moments again in
+    DDGI's octahedral layout, <stem>_probes_irradiance_oct.exr and <stem>_probes_moments_oct.exr. Every bounce the
     settings ask for is in them; no camera is involved. Returns the summary (also in bake.json's form)."""
     from ..engine import probe_export
     from ..engine.passes.probe_project import IRRADIANCE_TEXELS
@@ -512,7 +513,7 @@ def bake_probes(blend: Path, out_dir: Path, settings: dict, overwrite: bool = Fa
     settings["probes"] = replace(settings["probes"], only_read_probes=False)
     out_dir = check_output_dir(Path(out_dir))
     stem = safe_name(Path(blend).stem)
-    paths = {k: out_dir / f"{stem}_probes_{k}.exr" for k in ("sh", "irradiance", "moments", "offsets")}
+    paths = {k: out_dir / f"{stem}_probes_{k}.exr" for k in probe_export.FILES}
     layout_path = out_dir / f"{stem}_probes.json"
     existing = [str(p) for p in (*paths.values(), layout_path) if p.exists()]
     if existing and not overwrite:
@@ -526,13 +527,16 @@ def bake_probes(blend: Path, out_dir: Path, settings: dict, overwrite: bool = Fa
     if method.irradiance_encoding:
         irradiance = light[..., :3]
         coeffs = probe_export.sh_from_irradiance(grid, irradiance, IRRADIANCE_TEXELS)
+        irradiance_oct = probe_export.octahedral_irradiance(grid, None, irradiance, IRRADIANCE_TEXELS)
     else:
         coeffs = probe_export.sh_grid(grid, light)
         irradiance = probe_export.irradiance_from_sh(grid, coeffs, IRRADIANCE_TEXELS)
+        irradiance_oct = probe_export.octahedral_irradiance(grid, coeffs, None, IRRADIANCE_TEXELS)
     moments = be.read(method.moments)[..., :3].copy()
     moments[..., 2] = 0.0
     atlases = {"sh": probe_export.sh_table(grid, coeffs), "irradiance": irradiance, "moments": moments,
-               "offsets": be.read(method.offset)[..., :3]}
+               "offsets": be.read(method.offset)[..., :3], "irradiance_oct": irradiance_oct,
+               "moments_oct": probe_export.octahedral_moments(grid, moments)}
     for key, atlas in atlases.items():
         images.write_exr(paths[key], np.asarray(atlas, np.float32)[::-1])  # EXR row 0 = the atlas's top
     probes_off = np.flatnonzero(be.read(method.state)[..., 0].ravel() < 0.5)

@@ -15,6 +15,13 @@ An engine gets four textures and a layout:
 - `offsets`: each probe's move off its grid position (m; ProbesConfig.relocate, else 0), one texel per
   probe in the state's layout: the probe sits at its grid position + offset, and the moments are
   distances from there.
+- `irradiance_oct`, `moments_oct`: the same irradiance and moments in DDGI's layout (Majercik et al.
+  2019), for engines built on it: per probe a square octahedral tile of OCT_IRRADIANCE_TEXELS^2
+  (OCT_MOMENT_TEXELS^2) texels inside a one-texel border, tile (ix, iy + ny iz). Each interior texel is
+  Bounce's own lookup of that probe at the texel's direction (the cube maps read bilinearly within
+  a face, as the renderer reads them, or E evaluated from the SH); the border repeats the interior
+  texel that the octahedron folds it onto, so bilinear filtering across a tile's edge stays on the
+  sphere (`octahedral_border`).
 Atlases are (h, w, 3) float32 with row 0 the texture's first (bottom) row, as the GPU holds them.
 """
 
@@ -26,7 +33,13 @@ from . import sh
 from .probe_grid import FACE_FRAMES, SH_COEFFS, ProbeGrid, texel_directions, texel_solid_angles
 
 FORMAT = "bounce-probes"
-VERSION = 2  # 2: the offsets (relocated probes)
+FILES = ("sh", "irradiance", "moments", "offsets", "irradiance_oct", "moments_oct")
+VERSION = 3  # 2: the offsets (relocated probes); 3: the octahedral atlases
+
+# Interior texels per side of a probe's octahedral tiles, inside their one-texel border: tiles of 8 x 8
+# (irradiance) and 16 x 16 (moments), DDGI's published sizes and RTXGI's defaults.
+OCT_IRRADIANCE_TEXELS = 6
+OCT_MOMENT_TEXELS = 14
 
 
 def sh_grid(grid: ProbeGrid, sh_table: np.ndarray) -> np.ndarray:
@@ -81,6 +94,125 @@ def sh_from_irradiance(grid: ProbeGrid, atlas: np.ndarray, n: int) -> np.ndarray
     return (e_coeffs / factors[None, :, None]).reshape(nz, ny, nx, SH_COEFFS, 3)
 
 
+def octahedral_decode(uv: np.ndarray) -> np.ndarray:
+    """Unit directions (..., 3) of octahedral coordinates uv (..., 2) in [-1, 1]^2: the tile's centre
+    looks along +z, its edges' midpoints along the horizon, its corners along -z (the lower half of the
+    octahedron folded out over the square's corners)."""
+    uv = np.asarray(uv, np.float64)
+    u, v = uv[..., 0], uv[..., 1]
+    z = 1.0 - np.abs(u) - np.abs(v)
+    lower = z < 0.0
+    x = np.where(lower, (1.0 - np.abs(v)) * np.where(u >= 0.0, 1.0, -1.0), u)
+    y = np.where(lower, (1.0 - np.abs(u)) * np.where(v >= 0.0, 1.0, -1.0), v)
+    d = np.stack([x, y, z], axis=-1)
+    return d / np.linalg.norm(d, axis=-1, keepdims=True)
+
+
+def octahedral_encode(d: np.ndarray) -> np.ndarray:
+    """The inverse of octahedral_decode: uv (..., 2) of directions (..., 3)."""
+    d = np.asarray(d, np.float64)
+    d = d / np.abs(d).sum(axis=-1, keepdims=True)
+    x, y, z = d[..., 0], d[..., 1], d[..., 2]
+    sx, sy = np.where(x >= 0.0, 1.0, -1.0), np.where(y >= 0.0, 1.0, -1.0)
+    u = np.where(z < 0.0, (1.0 - np.abs(y)) * sx, x)
+    v = np.where(z < 0.0, (1.0 - np.abs(x)) * sy, y)
+    return np.stack([u, v], axis=-1)
+
+
+def octahedral_directions(k: int) -> np.ndarray:
+    """(k, k, 3) directions of a k x k octahedral tile's texel centres, [row j, column i]."""
+    c = 2.0 * (np.arange(k) + 0.5) / k - 1.0
+    v, u = np.meshgrid(c, c, indexing="ij")
+    return octahedral_decode(np.stack([u, v], axis=-1))
+
+
+def octahedral_border(tiles: np.ndarray) -> np.ndarray:
+    """Tiles (..., k, k, c) inside a one-texel border: (..., k + 2, k + 2, c). Crossing the square's
+    edge u = 1 at height v lands on the octahedron at (1, -v) from inside (and likewise for the other
+    edges), so each edge's border texel repeats the interior edge texel mirrored along that edge, and a
+    corner repeats the interior's opposite corner (DDGI's rule)."""
+    inner = np.asarray(tiles)
+    k = inner.shape[-2]
+    out = np.zeros((*inner.shape[:-3], k + 2, k + 2, inner.shape[-1]), inner.dtype)
+    out[..., 1:-1, 1:-1, :] = inner
+    out[..., 0, 1:-1, :] = inner[..., 0, ::-1, :]
+    out[..., -1, 1:-1, :] = inner[..., -1, ::-1, :]
+    out[..., 1:-1, 0, :] = inner[..., ::-1, 0, :]
+    out[..., 1:-1, -1, :] = inner[..., ::-1, -1, :]
+    out[..., 0, 0, :] = inner[..., -1, -1, :]
+    out[..., 0, -1, :] = inner[..., -1, 0, :]
+    out[..., -1, 0, :] = inner[..., 0, -1, :]
+    out[..., -1, -1, :] = inner[..., 0, 0, :]
+    return out
+
+
+def cube_bilinear(grid: ProbeGrid, atlas: np.ndarray, n: int, directions: np.ndarray) -> np.ndarray:
+    """Every probe's n x n cube-map atlas (the capture's tile layout) read at directions (d, 3) as the
+    renderer reads it (probe.glsl's face_bilinear): the face of the major axis, bilinear within that
+    face, clamped at its edges. Returns (P, d, c) in probe order p."""
+    d = np.asarray(directions, np.float64)
+    a = np.abs(d)
+    axis = np.where((a[:, 0] >= a[:, 1]) & (a[:, 0] >= a[:, 2]), 0, np.where(a[:, 1] >= a[:, 2], 1, 2))
+    face = 2 * axis + (d[np.arange(len(d)), axis] < 0.0)
+    frames = FACE_FRAMES[face]                                               # (d, 3 vectors, 3)
+    w = np.einsum("dk,dk->d", d, frames[:, 0])
+    st = np.stack([np.einsum("dk,dk->d", d, frames[:, 1]), np.einsum("dk,dk->d", d, frames[:, 2])], -1)
+    st = st / np.maximum(w, 1e-12)[:, None]
+    uv = np.clip((st + 1.0) * (0.5 * n) - 0.5, 0.0, n - 1)
+    i0 = np.floor(uv).astype(np.int64)
+    i1 = np.minimum(i0 + 1, n - 1)
+    f = uv - i0
+    cols = grid.tiles_per_row
+    p = np.arange(grid.count)[:, None]
+    x0 = 3 * n * (p % cols) + n * (face % 3)
+    y0 = 2 * n * (p // cols) + n * (face // 3)
+    src = np.asarray(atlas, np.float64)
+
+    def at(ix, iy):
+        return src[y0 + iy, x0 + ix]                                         # (P, d, c)
+
+    fx, fy = f[:, 0][None, :, None], f[:, 1][None, :, None]
+    return ((1 - fx) * (1 - fy) * at(i0[:, 0], i0[:, 1]) + fx * (1 - fy) * at(i1[:, 0], i0[:, 1])
+            + (1 - fx) * fy * at(i0[:, 0], i1[:, 1]) + fx * fy * at(i1[:, 0], i1[:, 1]))
+
+
+def octahedral_size(grid: ProbeGrid, k: int) -> tuple[int, int]:
+    """(width, height) of an octahedral atlas of k x k tiles inside their borders."""
+    nx, ny, nz = grid.dims
+    return (k + 2) * nx, (k + 2) * ny * nz
+
+
+def octahedral_atlas(grid: ProbeGrid, per_probe: np.ndarray) -> np.ndarray:
+    """(P, k, k, c) tiles in probe order -> the atlas ((k + 2) ny nz, (k + 2) nx, c): each tile inside its
+    border (octahedral_border), probe (ix, iy, iz) at tile (ix, iy + ny iz)."""
+    nx, ny, nz = grid.dims
+    tiles = octahedral_border(np.asarray(per_probe))
+    k2, c = tiles.shape[1], tiles.shape[3]
+    return tiles.reshape(nz, ny, nx, k2, k2, c).transpose(0, 1, 3, 2, 4, 5).reshape(nz * ny * k2, nx * k2, c)
+
+
+def octahedral_irradiance(grid: ProbeGrid, coeffs: np.ndarray | None, irradiance: np.ndarray | None,
+                          n: int, k: int = OCT_IRRADIANCE_TEXELS) -> np.ndarray:
+    """The irradiance in DDGI's octahedral layout (octahedral_atlas of k x k tiles), W/m^2: from the SH
+    (nz, ny, nx, 9, 3) when given, E = max(0, sum_i A_l c_i Y_i(d)) exactly as the lookup evaluates it,
+    else from the irradiance cube atlas of n x n faces read as the lookup reads it (cube_bilinear)."""
+    dirs = octahedral_directions(k).reshape(-1, 3)
+    if coeffs is not None:
+        per_probe = np.asarray(coeffs, np.float64).reshape(grid.count, SH_COEFFS, 3)
+        e = np.maximum(np.einsum("pck,dc->pdk", per_probe, sh.cosine_lobe_l2(dirs)), 0.0)
+    else:
+        e = cube_bilinear(grid, np.asarray(irradiance)[..., :3], n, dirs)
+    return octahedral_atlas(grid, e.reshape(grid.count, k, k, 3))
+
+
+def octahedral_moments(grid: ProbeGrid, moments: np.ndarray, k: int = OCT_MOMENT_TEXELS) -> np.ndarray:
+    """The distance moments (mean m, mean square m^2, 0) in DDGI's octahedral layout (k x k tiles), read
+    from the capture's moment atlas as the lookup reads it (cube_bilinear)."""
+    m = cube_bilinear(grid, np.asarray(moments)[..., :2], grid.face_texels, octahedral_directions(k).reshape(-1, 3))
+    m = np.concatenate([m, np.zeros_like(m[..., :1])], axis=-1)
+    return octahedral_atlas(grid, m.reshape(grid.count, k, k, 3))
+
+
 def layout(grid: ProbeGrid, origin_m, encoding: str, irradiance_texels: int, probes_off: list[int],
            files: dict[str, str], relocated: bool = False) -> dict:
     """The JSON description an engine needs to read the atlases (origin_m: the solve's frame in world
@@ -117,6 +249,20 @@ def layout(grid: ProbeGrid, origin_m, encoding: str, irradiance_texels: int, pro
                     "texel": "probe (ix, iy, iz) at (ix, iy + ny iz)",
                     "units": "RGB: the probe's move off its grid position (m, world axes); within 0.45 spacing "
                              "per axis"},
+        "octahedral": {
+            "irradiance": {"file": files["irradiance_oct"], "texels": OCT_IRRADIANCE_TEXELS,
+                           "size": list(octahedral_size(grid, OCT_IRRADIANCE_TEXELS)),
+                           "units": "as irradiance"},
+            "moments": {"file": files["moments_oct"], "texels": OCT_MOMENT_TEXELS,
+                        "size": list(octahedral_size(grid, OCT_MOMENT_TEXELS)), "units": "as moments"},
+            "tile": ("probe (ix, iy, iz) owns a (k + 2) x (k + 2) tile at texel ((k + 2) ix, (k + 2) (iy + ny iz)); "
+                     "its interior texel (i, j) of k x k at tile + (1 + i, 1 + j), the rest a one-texel border"),
+            "texel_direction": ("interior texel (i, j) at u = 2 (i + 0.5) / k - 1, v = 2 (j + 0.5) / k - 1 looks along "
+                                "normalize(u, v, 1 - |u| - |v|) where |u| + |v| <= 1, else "
+                                "normalize((1 - |v|) sign u, (1 - |u|) sign v, 1 - |u| - |v|) (sign 0 = +1)"),
+            "border": ("each edge texel repeats the interior texel beside it mirrored along that edge, each corner "
+                       "the interior's opposite corner: bilinear filtering across an edge stays on the sphere"),
+        },
         "probes_off": [int(p) for p in probes_off],
         "lookup": ("docs/PROBES.md: weight the 8 probes of the grid cell around p + normal_bias * spacing * n "
                    "(cells and trilinear weights from the grid positions) by trilinear x back-face x Chebyshev "

@@ -118,6 +118,7 @@ def test_probes_follow_their_documented_layout(blends, tmp_path, encoding):
     # rows) and world position (first_probe_m). Tolerance 1e-4 of the mean: float32 positions put
     # weights of ~1e-6 on the neighbouring probes. With the SH encoding the SH file must give the same E
     # by the documented formula; with the irradiance encoding the SH file is a fit (checked for its mean).
+    # The octahedral irradiance atlas likewise, at its interior texels' directions.
     import bpy
 
     from addon.bridge.capture import SceneCache
@@ -136,6 +137,9 @@ def test_probes_follow_their_documented_layout(blends, tmp_path, encoding):
     doc = json.loads((out / "cornell_probes.json").read_text())
     keys = ("sh", "irradiance", "moments", "offsets")
     atlas = {k: read_exr(out / doc[k]["file"])[::-1] for k in keys}  # row 0 = bottom
+    octahedral = {k: read_exr(out / doc["octahedral"][k]["file"])[::-1] for k in ("irradiance", "moments")}
+    for k in octahedral:
+        assert list(octahedral[k].shape[1::-1]) == doc["octahedral"][k]["size"] and octahedral[k].min() >= 0
     for k in atlas:
         assert list(atlas[k].shape[1::-1]) == doc[k]["size"] and np.isfinite(atlas[k]).all()
     assert atlas["irradiance"].min() >= 0 and atlas["moments"].min() >= 0
@@ -152,7 +156,17 @@ def test_probes_follow_their_documented_layout(blends, tmp_path, encoding):
     assert doc["dims"] == list(grid.dims) and doc["spacing_m"] == pytest.approx(grid.spacing_m)
 
     n_tex = doc["irradiance"]["face_texels"]
-    normals = texel_directions(n_tex).reshape(-1, 3)                        # face, row j, column i
+    cube_normals = texel_directions(n_tex).reshape(-1, 3)                   # face, row j, column i
+    # The octahedral tiles' interior texel directions, by the layout's own formula (row j, column i).
+    k_oct = doc["octahedral"]["irradiance"]["texels"]
+    c = 2.0 * (np.arange(k_oct) + 0.5) / k_oct - 1.0
+    v, u = (a.ravel() for a in np.meshgrid(c, c, indexing="ij"))
+    z = 1.0 - np.abs(u) - np.abs(v)
+    sign_u, sign_v = np.where(u >= 0, 1.0, -1.0), np.where(v >= 0, 1.0, -1.0)
+    oct_normals = np.where((z < 0)[:, None], np.stack([(1 - np.abs(v)) * sign_u, (1 - np.abs(u)) * sign_v, z], 1),
+                           np.stack([u, v, z], 1))
+    oct_normals /= np.linalg.norm(oct_normals, axis=1, keepdims=True)
+    normals = np.concatenate([cube_normals, oct_normals])
     nx, ny, nz = doc["dims"]
     probes = [(ix, iy, iz) for iz in range(nz) for iy in range(ny) for ix in range(nx)]
     world = np.array(doc["first_probe_m"]) + np.array(probes) * doc["spacing_m"]
@@ -168,9 +182,13 @@ def test_probes_follow_their_documented_layout(blends, tmp_path, encoding):
     probe_lookup.run(be, be.texture(size, data=pos), be.texture(size, data=nrm), method.field(), indirect, grid,
                      config)
     looked_up = be.read(indirect)[..., :3] * np.pi                           # (probe, normal, rgb): E
+    looked_up_oct = looked_up[:, len(cube_normals):]
+    looked_up = looked_up[:, :len(cube_normals)]
+    normals = cube_normals
 
     cols = doc["tiles_per_row"]
     exported = np.zeros_like(looked_up)
+    exported_oct = np.zeros_like(looked_up_oct)
     from_sh = np.zeros_like(looked_up)
     lobe = sh.cosine_lobe_l2(normals)
     for row, (ix, iy, iz) in enumerate(probes):
@@ -180,12 +198,17 @@ def test_probes_follow_their_documented_layout(blends, tmp_path, encoding):
             face, j, i = np.unravel_index(k, (6, n_tex, n_tex))
             x, y = tile + [n_tex * (face % 3) + i, n_tex * (face // 3) + j]
             exported[row, k] = atlas["irradiance"][y, x, :3]
+        tile = octahedral["irradiance"][(k_oct + 2) * (iy + ny * iz):(k_oct + 2) * (iy + ny * iz + 1),
+                                        (k_oct + 2) * ix:(k_oct + 2) * (ix + 1), :3]
+        exported_oct[row] = tile[1:-1, 1:-1].reshape(-1, 3)
         coeffs = np.stack([atlas["sh"][iy + ny * iz, c * nx + ix, :3] for c in range(9)])  # (9, rgb)
         from_sh[row] = np.maximum(lobe @ coeffs, 0.0)
     off = set(doc["probes_off"])
     on = np.array([ix + nx * (iy + ny * iz) not in off for ix, iy, iz in probes])
     assert looked_up[on].mean() > 0
     assert np.abs(exported[on] - looked_up[on]).max() <= 1e-4 * looked_up[on].mean()
+    # DDGI's octahedral irradiance: what the lookup gives at each interior texel's direction.
+    assert np.abs(exported_oct[on] - looked_up_oct[on]).max() <= 1e-4 * looked_up_oct[on].mean()
     if encoding == "sh":
         assert np.abs(from_sh[on] - looked_up[on]).max() <= 1e-4 * looked_up[on].mean()
     else:

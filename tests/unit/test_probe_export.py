@@ -83,9 +83,88 @@ def test_irradiance_round_trips_to_sh():
 def test_layout_is_json_and_in_world_space():
     g = grid()
     doc = probe_export.layout(g, np.array([10.0, 0.0, -1.0]), "sh", 4, [3],
-                              {"sh": "a.exr", "irradiance": "b.exr", "moments": "c.exr", "offsets": "d.exr"})
+                              {k: f"{k}.exr" for k in probe_export.FILES})
     again = json.loads(json.dumps(doc))
     assert again["first_probe_m"] == [10.5, -1.0, 1.0]
     assert again["dims"] == [3, 2, 4] and again["probes_off"] == [3]
     assert again["irradiance"]["size"] == list(g.tiled_size(4)) and again["moments"]["size"] == list(g.atlas_size)
-    assert again["offsets"] == {**doc["offsets"], "file": "d.exr", "size": [3, 8]} and again["relocated"] is False
+    assert again["offsets"] == {**doc["offsets"], "file": "offsets.exr", "size": [3, 8]} and again["relocated"] is False
+    oct_doc = again["octahedral"]
+    assert oct_doc["irradiance"]["size"] == [8 * 3, 8 * 2 * 4] and oct_doc["moments"]["size"] == [16 * 3, 16 * 2 * 4]
+
+
+def test_octahedral_map_round_trips_and_covers_the_sphere():
+    # Directions on every octant (and the poles and the horizon, where the two halves meet) come back
+    # from their octahedral coordinates to float64 rounding; a tile's texel centres are unit directions
+    # on both halves, the centre texels beside +z and the corner texels beside -z.
+    rng = np.random.default_rng(3)
+    d = rng.normal(size=(4000, 3))
+    d = np.concatenate([d, np.eye(3), -np.eye(3), [[1.0, 1.0, 0.0], [-1.0, 0.5, 0.0]]])
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    uv = probe_export.octahedral_encode(d)
+    assert np.abs(uv).max() <= 1.0 + 1e-12
+    assert np.abs(probe_export.octahedral_decode(uv) - d).max() < 1e-12
+    k = 6
+    dirs = probe_export.octahedral_directions(k)
+    assert np.allclose(np.linalg.norm(dirs, axis=-1), 1.0)
+    # As many texels on the lower half as on the upper; k = 6 puts the 12 centres with |u| + |v| = 1
+    # (u, v in +-1/6, +-3/6, +-5/6) on the horizon, z = 0.
+    assert (dirs[..., 2] > 1e-9).sum() == (dirs[..., 2] < -1e-9).sum() == 12
+    assert dirs[k // 2, k // 2, 2] > 0.9 and dirs[0, 0, 2] < -0.9
+
+
+def test_octahedral_border_repeats_the_texel_the_octahedron_folds_onto():
+    # A border texel's centre lies half a texel past an edge of the square. Folding uv back across
+    # the edge it crossed (u > 1: (2 - u, -v); u < -1: (-2 - u, -v); likewise for v with u negated),
+    # as the octahedron's edges are glued, lands on an interior texel's centre: the border must repeat
+    # that texel's value, so that bilinear filtering across the edge reads the sphere's neighbours.
+    # And the fold is a direction's identity: the border texel's extended decode meets the folded one.
+    k = 5
+    tiles = np.arange(k * k * 2, dtype=np.float64).reshape(k, k, 2)
+    out = probe_export.octahedral_border(tiles)
+    assert out.shape == (k + 2, k + 2, 2) and np.array_equal(out[1:-1, 1:-1], tiles)
+    for y in range(k + 2):
+        for x in range(k + 2):
+            u, v = 2.0 * (x - 1 + 0.5) / k - 1.0, 2.0 * (y - 1 + 0.5) / k - 1.0
+            while abs(u) > 1.0 or abs(v) > 1.0:
+                if abs(u) > 1.0:
+                    u, v = np.sign(u) * 2.0 - u, -v
+                else:
+                    u, v = -u, np.sign(v) * 2.0 - v
+            i, j = round((u + 1.0) * k / 2.0 - 0.5), round((v + 1.0) * k / 2.0 - 0.5)
+            assert np.array_equal(out[y, x], tiles[j, i]), (x, y)
+
+
+def test_octahedral_irradiance_is_the_lookup_at_each_texel_direction():
+    # From SH: every interior texel holds E = max(0, sum_i A_l c_i Y_i(d)) at its direction (float64
+    # rounding). From an irradiance cube atlas holding a field linear in the normal, E(n) = a + b . n
+    # at its texel centres: the octahedral texels read it bilinearly within a face, clamped at the
+    # face's edges, as the renderer does, so each is a weighted mean of a + b . c over texel centres c
+    # less than a texel diagonal (2 sqrt 2 / n in face coordinates, no more as an angle) from its
+    # direction d: within |b| 2 sqrt 2 / n of a + b . d. A constant atlas gives a constant tile (to rounding);
+    # the exact reading is held end to end against the renderer's lookup (tests/blender/test_bake_batch).
+    g = grid(dims=(2, 1, 3))
+    k = probe_export.OCT_IRRADIANCE_TEXELS
+    rng = np.random.default_rng(5)
+    coeffs = rng.normal(size=(*g.dims[::-1], 9, 3))
+    coeffs[..., 0, :] += 5.0
+    atlas = probe_export.octahedral_irradiance(g, coeffs, None, 4)
+    w, h = probe_export.octahedral_size(g, k)
+    assert atlas.shape == (h, w, 3)
+    dirs = probe_export.octahedral_directions(k).reshape(-1, 3)
+    nx, ny, _ = g.dims
+    for iz, iy, ix in [(0, 0, 0), (2, 0, 1)]:
+        tile = atlas[(k + 2) * (iy + ny * iz):(k + 2) * (iy + ny * iz + 1), (k + 2) * ix:(k + 2) * (ix + 1)]
+        expected = np.maximum(sh.cosine_lobe_l2(dirs) @ coeffs[iz, iy, ix], 0.0)
+        assert np.allclose(tile[1:-1, 1:-1].reshape(-1, 3), expected, atol=1e-12)
+    a, b = np.array([2.0, 1.0, 3.0]), np.array([0.5, -0.3, 0.2])
+    n = 4
+    cube = np.zeros((*g.tiled_size(n)[::-1], 3))
+    rows, cols = probe_export._face_texels(g, n)
+    cube[rows, cols] = a + (texel_directions(n) @ b)[None, ..., None]
+    oct_atlas = probe_export.octahedral_irradiance(g, None, cube, n)
+    tile = oct_atlas[:k + 2, :k + 2][1:-1, 1:-1].reshape(-1, 3)
+    err = np.abs(tile - (a + (dirs @ b)[:, None]))
+    assert 0 < err.max() <= np.linalg.norm(b) * 2 * np.sqrt(2) / n
+    flat = probe_export.octahedral_irradiance(g, None, np.full_like(cube, 1.5), n)
+    assert np.allclose(flat, 1.5, rtol=1e-15, atol=0)  # bilinear weights summing to 1 in float64
