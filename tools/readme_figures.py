@@ -25,6 +25,9 @@ DEFAULTS_JSON = ROOT / "benchmarks" / "defaults" / "results.json"
 EEVEE_JSON = ROOT / "benchmarks" / "eevee" / "results.json"
 LPV_DOC = ROOT / "docs" / "LPV.md"
 OCTREE_JSON = ROOT / "benchmarks" / "octree" / "results.json"
+DIFFUSION_DOC = ROOT / "docs" / "DIFFUSION.md"
+DIFFUSION_JSON = (ROOT / "benchmarks" / "diffusion" / "b1" / "results.json",
+                  ROOT / "benchmarks" / "diffusion" / "b2" / "results.json")
 LPV_CAMERA_TARGET_PCT = 15  # the issue's target: lpv's camera update <= 15 % of its full update
 _BLOCK = re.compile(r"(<!-- figures:(?P<name>[a-z0-9-]+):begin -->\n)(?P<body>.*?)(<!-- figures:(?P=name):end -->)",
                     re.S)
@@ -270,6 +273,60 @@ def octree_block(results: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+# The side-by-side grids: per method, its registry rows at 16, 32 (the defaults) and 64 cells.
+GRID_COLUMNS = (
+    ("lpv", {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.grid_cells": 16}, 16),
+    ("lpv", None, 32),
+    ("lpv", {"lpv.variant": "improved", "lpv.geometry_volume": True, "lpv.grid_cells": 64}, 64),
+    ("diffusion", {"diffusion.grid_cells": 16}, 16),
+    ("diffusion", None, 32),
+    ("diffusion", {"diffusion.grid_cells": 64}, 64),
+)
+
+
+def diffusion_block(*runs: dict) -> str:
+    """Table: per scene and bounce count (one results.json per bounce count), lpv and diffusion at
+    16, 32 and 64 cells: rel_rmse_8 and the full update's ms; then, per grid and bounce count, on how
+    many scenes diffusion's error is at most lpv's, and its time against lpv's (median ratio)."""
+    def pick(records: list[dict], scene: str, method: str, setting: dict | None) -> dict | None:
+        return next((r for r in records if r["scene"] == scene and r["method"] == method
+                     and (r["default"] if setting is None else r["setting"] == setting)), None)
+
+    lines = ["**diffusion beside lpv, grids of 16, 32 and 64 cells.**", ""]
+    lines += [_produced_by(run) + f" {run['res']} px long side, {run['bounces']} bounce(s), Cycles reference "
+              f"{run['ref_spp']} spp." for run in runs]
+    lines += ["", "Cells: rel_rmse_8 against Cycles' Diffuse Indirect, time of one full update (ms; both on the "
+              "run's machine, ratios only).", "",
+              "| scene | bounces | " + " | ".join(f"{m} {c}" for m, _, c in GRID_COLUMNS) + " |",
+              "| --- " * (2 + len(GRID_COLUMNS)) + "|"]
+    for run in runs:
+        records = run["records"]
+        for scene in dict.fromkeys(r["scene"] for r in records):
+            cells = []
+            for method, setting, _ in GRID_COLUMNS:
+                r = pick(records, scene, method, setting)
+                cells.append("–" if r is None or r["rel_rmse_8"] is None else f"{r['rel_rmse_8']:.3f}, {r['total_ms']:.0f}")
+            lines.append(f"| {scene} | {run['bounces']} | " + " | ".join(cells) + " |")
+    lines.append("")
+    for run in runs:
+        records = run["records"]
+        scenes = list(dict.fromkeys(r["scene"] for r in records))
+        parts = []
+        for (_, lpv_setting, cells), (_, diff_setting, _) in zip(GRID_COLUMNS[:3], GRID_COLUMNS[3:]):
+            pairs = [(s, pick(records, s, "diffusion", diff_setting), pick(records, s, "lpv", lpv_setting))
+                     for s in scenes]
+            pairs = [(s, d, lp) for s, d, lp in pairs if d and lp and d["rel_rmse_8"] is not None
+                     and lp["rel_rmse_8"] is not None]
+            if not pairs:
+                continue
+            wins = [s for s, d, lp in pairs if d["rel_rmse_8"] <= lp["rel_rmse_8"]]
+            ratio = _median([d["total_ms"] / lp["total_ms"] for _, d, lp in pairs])
+            parts.append(f"at {cells} cells on {len(wins)} of {len(pairs)} scenes"
+                         + (f" ({', '.join(wins)})" if wins else "") + f", in {ratio:.2f}x lpv's time")
+        lines.append(f"- {run['bounces']} bounce(s): diffusion's error is at most lpv's " + "; ".join(parts) + ".")
+    return "\n".join(lines) + "\n"
+
+
 # block name -> (the file it is in, its results.json file(s), the function that formats them)
 BLOCKS: dict[str, tuple[Path, tuple[Path, ...], Callable[..., str]]] = {
     "headline": (README, (DEFAULTS_JSON, EEVEE_JSON), headline_block),
@@ -277,6 +334,7 @@ BLOCKS: dict[str, tuple[Path, tuple[Path, ...], Callable[..., str]]] = {
     "accuracy": (README, (DEFAULTS_JSON,), accuracy_block),
     "methods": (README, (DEFAULTS_JSON,), methods_block),
     "lpv-octree": (LPV_DOC, (OCTREE_JSON,), octree_block),
+    "diffusion-grids": (DIFFUSION_DOC, DIFFUSION_JSON, diffusion_block),
 }
 
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from addon.engine import methods
-from addon.engine.config import METHODS, GIConfig, LpvConfig, RsmConfig, VctConfig
+from addon.engine.config import METHODS, DiffusionConfig, GIConfig, LpvConfig, RsmConfig, VctConfig
 from addon.engine.scene import Camera, Light, Scene
 from addon.engine.transforms import look_along, perspective
 
@@ -101,7 +101,8 @@ def sun(direction, strength, color=(1, 1, 1)):
 
 def make(gl, name, rsm_res=128, vpl=64):
     """A method by name; "rsm+voxel" is the rsm method with voxel-traced visibility, "lpv+classes" lpv
-    with emitter classes, "lpv+octree" lpv's octree variant, "vct+filtered" vct with filtered injection."""
+    with emitter classes, "lpv+octree" lpv's octree variant, "vct+filtered" vct with filtered injection,
+    "diffusion+cellsN" diffusion on a grid of N cells."""
     method, _, variant = name.partition("+")
     kw = {"resolution": rsm_res, "vpl_samples": vpl}
     if variant == "classes":
@@ -110,6 +111,9 @@ def make(gl, name, rsm_res=128, vpl=64):
     if variant == "octree":
         return methods.create(gl, {"gi": GIConfig(method=method), "rsm": RsmConfig(**kw),
                                    "lpv": LpvConfig(variant="octree")})
+    if variant.startswith("cells"):
+        return methods.create(gl, {"gi": GIConfig(method=method), "rsm": RsmConfig(**kw),
+                                   "diffusion": DiffusionConfig(grid_cells=int(variant[len("cells"):]))})
     if variant == "filtered":
         return methods.create(gl, {"gi": GIConfig(method=method), "rsm": RsmConfig(**kw),
                                    "vct": VctConfig(filtered_injection=True)})

@@ -32,7 +32,17 @@ pytestmark = pytest.mark.gpu
 FACES = [ax for ax in np.eye(3).tolist() + (-np.eye(3)).tolist()]
 
 
-@pytest.mark.parametrize("name", ALL_METHODS)
+# diffusion at 16 cells: the image reads 1.044 P from a field that absorbed 0.951 P (24 cells: 0.982
+# from 0.934; 32, the default: 0.938 from 0.908), so the reconstruction adds light, by a share that
+# shrinks as the cells do. Likely why: the walls pass through cell centres, the half cells along every
+# edge lie in cells no light can reach, their light is absorbed by the neighbouring cells, and the
+# strips' pixels read those neighbours' flux / area again. docs/DIFFUSION.md, "Measured limits".
+COARSE_DIFFUSION = pytest.param("diffusion+cells16", marks=pytest.mark.xfail(
+    strict=True, reason="diffusion at 16 cells: indirect flux 1.044 P in a closed white box from a field that "
+                        "absorbed 0.951 P (the reconstruction over-reads near the edges)"))
+
+
+@pytest.mark.parametrize("name", (*ALL_METHODS, COARSE_DIFFUSION))
 def test_white_closed_box_conserves_flux(gl, figures, name):
     # A cube [-1, 1]^3, albedo 1 everywhere, a P = 100 W point light at L = (0.2, -0.1, 0.3) inside.
     # A camera at the centre with six 90-degree faces sees exactly one wall per face, and each pixel of a
