@@ -102,10 +102,10 @@ METHODS: tuple[MethodSpec, ...] = (
         module="probes", class_name="ProbesMethod", products=("direct", "indirect", "albedo"), max_bounces=8,
         reads=(*_IMAGE, "gi.bounces", *_LIGHT_VIEWS, "probes.*"),
         # The defaults (16 probes along the longest side, 8^2 texels a face), coarser grids (the paper's
-        # 16^2 faces at 8 a side), and the trilinear and back-face weights alone (no visibility),
-        # docs/PROBES.md.
+        # 16^2 faces at 8 a side), the trilinear and back-face weights alone (no visibility), and the
+        # irradiance encoding (DDGI's maps in the cube layout) beside the default SH, docs/PROBES.md.
         bench=({}, {"probes.probes_per_side": 12}, {"probes.probes_per_side": 8, "probes.face_texels": 16},
-               {"probes.chebyshev_visibility": False})),
+               {"probes.chebyshev_visibility": False}, {"probes.encoding": "irradiance"})),
     MethodSpec(
         name="diffusion", summary="occupancy-aware SH diffusion through the voxels, re-emitted at surfaces (paper 000)",
         module="diffusion", class_name="DiffusionMethod", products=("direct", "indirect", "albedo"), max_bounces=8,
