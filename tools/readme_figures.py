@@ -26,6 +26,8 @@ EEVEE_JSON = ROOT / "benchmarks" / "eevee" / "results.json"
 LPV_DOC = ROOT / "docs" / "LPV.md"
 OCTREE_JSON = ROOT / "benchmarks" / "octree" / "results.json"
 DIFFUSION_DOC = ROOT / "docs" / "DIFFUSION.md"
+PROBES_DOC = ROOT / "docs" / "PROBES.md"
+PROBES_JSON = ROOT / "benchmarks" / "probes" / "results.json"
 DIFFUSION_JSON = (ROOT / "benchmarks" / "diffusion" / "b1" / "results.json",
                   ROOT / "benchmarks" / "diffusion" / "b2" / "results.json")
 LPV_CAMERA_TARGET_PCT = 15  # the issue's target: lpv's camera update <= 15 % of its full update
@@ -286,8 +288,9 @@ GRID_COLUMNS = (
 
 def diffusion_block(*runs: dict) -> str:
     """Table: per scene and bounce count (one results.json per bounce count), lpv and diffusion at
-    16, 32 and 64 cells: rel_rmse_8 and the full update's ms; then, per grid and bounce count, on how
-    many scenes diffusion's error is at most lpv's, and its time against lpv's (median ratio)."""
+    16, 32 and 64 cells: rel_rmse_8 and the benchmark's ms; then, per grid and bounce count, on how
+    many scenes diffusion's error is at most lpv's, and its time against lpv's (median ratio); and the
+    paper's cone transfer's error against the default directional one's."""
     def pick(records: list[dict], scene: str, method: str, setting: dict | None) -> dict | None:
         return next((r for r in records if r["scene"] == scene and r["method"] == method
                      and (r["default"] if setting is None else r["setting"] == setting)), None)
@@ -295,8 +298,8 @@ def diffusion_block(*runs: dict) -> str:
     lines = ["**diffusion beside lpv, grids of 16, 32 and 64 cells.**", ""]
     lines += [_produced_by(run) + f" {run['res']} px long side, {run['bounces']} bounce(s), Cycles reference "
               f"{run['ref_spp']} spp." for run in runs]
-    lines += ["", "Cells: rel_rmse_8 against Cycles' Diffuse Indirect, time of one full update (ms; both on the "
-              "run's machine, ratios only).", "",
+    lines += ["", "Cells: rel_rmse_8 against Cycles' Diffuse Indirect, the benchmark's time (ms: the median of its "
+              "updates after a warm-up; both on the run's machine, ratios only).", "",
               "| scene | bounces | " + " | ".join(f"{m} {c}" for m, _, c in GRID_COLUMNS) + " |",
               "| --- " * (2 + len(GRID_COLUMNS)) + "|"]
     for run in runs:
@@ -305,14 +308,15 @@ def diffusion_block(*runs: dict) -> str:
             cells = []
             for method, setting, _ in GRID_COLUMNS:
                 r = pick(records, scene, method, setting)
-                cells.append("–" if r is None or r["rel_rmse_8"] is None else f"{r['rel_rmse_8']:.3f}, {r['total_ms']:.0f}")
+                missing = r is None or r["rel_rmse_8"] is None
+                cells.append("–" if missing else f"{r['rel_rmse_8']:.3f}, {r['total_ms']:.0f}")
             lines.append(f"| {scene} | {run['bounces']} | " + " | ".join(cells) + " |")
     lines.append("")
     for run in runs:
         records = run["records"]
         scenes = list(dict.fromkeys(r["scene"] for r in records))
         parts = []
-        for (_, lpv_setting, cells), (_, diff_setting, _) in zip(GRID_COLUMNS[:3], GRID_COLUMNS[3:]):
+        for (_, lpv_setting, cells), (_, diff_setting, _) in zip(GRID_COLUMNS[:3], GRID_COLUMNS[3:], strict=True):
             pairs = [(s, pick(records, s, "diffusion", diff_setting), pick(records, s, "lpv", lpv_setting))
                      for s in scenes]
             pairs = [(s, d, lp) for s, d, lp in pairs if d and lp and d["rel_rmse_8"] is not None
@@ -324,6 +328,42 @@ def diffusion_block(*runs: dict) -> str:
             parts.append(f"at {cells} cells on {len(wins)} of {len(pairs)} scenes"
                          + (f" ({', '.join(wins)})" if wins else "") + f", in {ratio:.2f}x lpv's time")
         lines.append(f"- {run['bounces']} bounce(s): diffusion's error is at most lpv's " + "; ".join(parts) + ".")
+        cone = [(pick(records, s, "diffusion", {"diffusion.transfer": "cone"}), pick(records, s, "diffusion", None))
+                for s in scenes]
+        ratios = [c["rel_rmse_8"] / d["rel_rmse_8"] for c, d in cone if c and d and c["rel_rmse_8"] is not None
+                  and d["rel_rmse_8"]]
+        if ratios:
+            lines.append(f"- {run['bounces']} bounce(s): the paper's cone transfer (32 cells) has a median "
+                         f"{_median(ratios):.2f}x the directional transfer's error, below it on "
+                         f"{sum(r < 1 for r in ratios)} of {len(ratios)} scenes.")
+    return "\n".join(lines) + "\n"
+
+
+def encodings_block(results: dict) -> str:
+    """Table: per scene, probes with the SH encoding (its defaults) and the irradiance encoding:
+    rel_rmse_8 / bias and the benchmark's ms; then on how many scenes each is the more accurate."""
+    probes = [r for r in results["records"] if r["method"] == "probes"]
+
+    def pick(scene: str, setting: dict | None) -> dict | None:
+        return next((r for r in probes if r["scene"] == scene
+                     and (r["default"] if setting is None else r["setting"] == setting)), None)
+
+    irradiance = {"probes.encoding": "irradiance"}
+    lines = ["**probes: the two encodings.**", "",
+             _produced_by(results) + f" {results['res']} px long side, {results['bounces']} bounce(s), Cycles "
+             f"reference {results['ref_spp']} spp. Cells: rel_rmse_8 / bias against Cycles' Diffuse Indirect, "
+             "the benchmark's time (ms: the median of its updates after a warm-up, on the run's machine).", "",
+             "| scene | SH (default) | irradiance |", "| --- | --- | --- |"]
+    better = total = 0
+    for scene in dict.fromkeys(r["scene"] for r in probes):
+        pair = [pick(scene, None), pick(scene, irradiance)]
+        cells = ["–" if r is None or r["rel_rmse_8"] is None
+                 else f"{r['rel_rmse_8']:.3f} / {r['bias']:.3f}, {r['total_ms']:.0f}" for r in pair]
+        lines.append(f"| {scene} | " + " | ".join(cells) + " |")
+        if all(r is not None and r["rel_rmse_8"] is not None for r in pair):
+            total += 1
+            better += pair[1]["rel_rmse_8"] < pair[0]["rel_rmse_8"]
+    lines += ["", f"The irradiance encoding is the more accurate on {better} of {total} scenes."]
     return "\n".join(lines) + "\n"
 
 
@@ -335,6 +375,7 @@ BLOCKS: dict[str, tuple[Path, tuple[Path, ...], Callable[..., str]]] = {
     "methods": (README, (DEFAULTS_JSON,), methods_block),
     "lpv-octree": (LPV_DOC, (OCTREE_JSON,), octree_block),
     "diffusion-grids": (DIFFUSION_DOC, DIFFUSION_JSON, diffusion_block),
+    "probes-encodings": (PROBES_DOC, (PROBES_JSON,), encodings_block),
 }
 
 
