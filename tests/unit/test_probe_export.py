@@ -168,3 +168,17 @@ def test_octahedral_irradiance_is_the_lookup_at_each_texel_direction():
     assert 0 < err.max() <= np.linalg.norm(b) * 2 * np.sqrt(2) / n
     flat = probe_export.octahedral_irradiance(g, None, np.full_like(cube, 1.5), n)
     assert np.allclose(flat, 1.5, rtol=1e-15, atol=0)  # bilinear weights summing to 1 in float64
+
+
+def test_octahedral_moments_keep_both_moments_and_a_zero_third_channel():
+    # Moments constant over the capture (mean 2 m, mean square 5 m^2) read back constant in every
+    # texel of every tile, border included, at DDGI's moment tile size; the third channel is 0.
+    g = grid(dims=(2, 2, 1), face_texels=4)
+    w, h = g.atlas_size
+    moments = np.zeros((h, w, 4))
+    moments[..., 0], moments[..., 1], moments[..., 2] = 2.0, 5.0, 7.0
+    got = probe_export.octahedral_moments(g, moments)
+    k = probe_export.OCT_MOMENT_TEXELS
+    assert got.shape == (2 * (k + 2), 2 * (k + 2), 3) == (*probe_export.octahedral_size(g, k)[::-1], 3)
+    assert np.allclose(got[..., 0], 2.0, rtol=1e-15) and np.allclose(got[..., 1], 5.0, rtol=1e-15)
+    assert np.all(got[..., 2] == 0.0)
