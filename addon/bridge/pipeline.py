@@ -64,7 +64,7 @@ def run_self_check(be, captured, settings: dict, decided: dict, written: dict) -
     if difference is None:
         return {"against": other, "note": "no self-check: the image holds no geometry"}
     return {"against": other, "rel_rmse_8_between": difference,
-            "estimated_rel_rmse_8": choice.self_estimate(difference, decided["estimated_rel_rmse_8"])}
+            "estimated_rel_rmse_8": choice.self_estimate(difference)}
 
 
 def verify_choice(be, captured, requested: dict, settings: dict, decided: dict, error_budget: float,
@@ -93,17 +93,19 @@ def verify_choice(be, captured, requested: dict, settings: dict, decided: dict, 
 
     key, tried = choice.verify(model, feats, error_budget, difference, able)
     decided["choice"]["verified"] = {"tried": tried, "accepted": key}
-    if key is None or key == decided["choice"]["row"]:
+    if key is None:
+        return settings, decided
+    estimate = next(t["estimated_rel_rmse_8"] for t in tried if t["row"] == key)
+    # The run-time estimate, not the model's: it is the better judge on held-out scenes (REPORT.md).
+    decided.update(estimated_rel_rmse_8=choice.self_estimate(estimate), estimate_row=key)
+    if key == decided["choice"]["row"]:
         return settings, decided
     row = model.rows[key]
     predicted, predicted_ms = model.predict(key, feats)
-    estimate = next(t["estimated_rel_rmse_8"] for t in tried if t["row"] == key)
     decided["choice"].update(method=row["method"], setting=row["setting"], row=key, predicted_rel_rmse_8=predicted,
                              predicted_ms=predicted_ms, meets_budget=True,
                              why=f"fastest of the settings tried whose image is within rel_rmse_8 {error_budget:g} of "
                                  f"its check row's: {estimate:.3f}")
-    # The run-time estimate, not the model's: it is the better judge on held-out scenes (REPORT.md).
-    decided.update(estimated_rel_rmse_8=choice.self_estimate(estimate, predicted), estimate_row=key)
     return choice.apply_row(requested, row["method"], row["setting"]), decided
 
 

@@ -425,10 +425,10 @@ def check_row(model: Model, features: dict, key: str, methods: tuple[str, ...] |
     return min(others, key=lambda k: model.predict(k, features)[0]) if others else None
 
 
-def self_estimate(difference: float, predicted: float) -> float:
+def self_estimate(difference: float) -> float:
     """The run-time estimate of a row's rel_rmse_8 from its image's rel_rmse_8 against the check row's
-    (`difference`); the model's prediction (`predicted`) is kept beside it in stats, not blended in.
-    Judged on held-out scenes by tools/fit_choice.py (benchmarks/choice/REPORT.md): within a factor 1.5
-    of the measured error for 92 % of the benchmark rows, against 64 % for the model alone and 79 % for
-    the geometric mean of the two."""
+    (`difference`); the model's prediction is kept beside it in stats, not blended in. Judged on
+    held-out scenes by tools/fit_choice.py (benchmarks/choice/REPORT.md): within a factor 1.5 of the
+    measured error for 78 % of the benchmark rows, against 58 % for the model alone and 70 % for the
+    geometric mean of the two."""
     return max(difference, 0.0)
