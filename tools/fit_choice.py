@@ -159,20 +159,22 @@ def verified(models: dict, features: dict, agreed: list[dict]) -> dict:
     """Per budget and scene: the choice of `render --method auto --error-budget E --verify`
     (choice.verify) by a model fitted without the scene (`models`: held_out), each candidate's run-time
     estimate taken from `agreed` (`agreement`: its image against the same check row's, from the bench's
-    runs); where no
-    candidate's estimate is within the budget, the model's own choice, as `render` falls back to."""
+    runs); where no candidate's estimate is within the budget, the one tried with the least estimate
+    (choice.least_estimated), and where none could be tried the model's own choice, as `render` does."""
     estimates = {(a["scene"], a["row"]): a["agree"] for a in agreed}
     out = {str(budget): [] for budget in BUDGETS}
     for held, (model, measured) in models.items():
         for budget in BUDGETS:
             key, tried = choice.verify(model, features[held], budget, lambda k, held=held: estimates.get((held, k)))
             accepted = key is not None
-            key = key if accepted else choice.choose(model, features[held], error_budget=budget).key
+            if not accepted:  # as render: the least estimate tried, else the model's own choice
+                key = choice.least_estimated(tried) or choice.choose(model, features[held], error_budget=budget).key
             got = measured.get(key)
             within = [r for r in measured.values() if r["rel_rmse_8"] <= budget]
-            # What stats.json then reports as estimated_rel_rmse_8: the accepted row's run-time estimate,
-            # else the model's prediction of its own choice.
-            estimate = tried[-1]["estimated_rel_rmse_8"] if accepted else model.predict(key, features[held])[0]
+            # What stats.json then reports as estimated_rel_rmse_8: the run-time estimate of the row that
+            # runs where one was tried, else the model's prediction of its own choice.
+            estimate = next((t["estimated_rel_rmse_8"] for t in tried if t["row"] == key),
+                            model.predict(key, features[held])[0])
             out[str(budget)].append({
                 "scene": held, "choice": key, "accepted": accepted, "tries": len(tried), "estimate": estimate,
                 "measured": got["rel_rmse_8"] if got else None, "ms": got["total_ms"] if got else None,
@@ -229,9 +231,10 @@ def report(results_path: str, judged: dict, summ: dict, model: choice.Model) -> 
              "row of another method the model expects most accurate) within that factor; verified: the choice "
              f"of `--verify` (the first of the rows predicted within {choice.VERIFY_LOOSEN:g} budgets, fastest "
              "first, whose self-check estimate is within the budget; at most "
-             f"{choice.VERIFY_MAX_TRIES} rendered; else the model's choice), met and within 2x as above, and the "
-             "mean number of rows it rendered besides their check rows, and its estimate (the accepted row's "
-             "self-check, else the model's) within a factor 1.5 of the measured error.", "",
+             f"{choice.VERIFY_MAX_TRIES} rendered; else the one rendered whose estimate is least; else the model's "
+             "choice), met and within 2x as above, and the mean number of rows it rendered besides their check "
+             "rows, and its estimate (the self-check of the row that runs, else the model's) within a factor 1.5 "
+             "of the measured error.", "",
              "| budget | scenes | met | possible | within 2x | estimate within 1.5x | self-check within 1.5x | "
              "verified: met | within 2x | rows tried | estimate within 1.5x |",
              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]

@@ -78,6 +78,25 @@ def test_render_verify_runs_a_row_whose_estimate_is_within_the_budget(cornell_bl
     assert stats["method"] == c["method"]
 
 
+def test_render_verify_with_none_within_runs_the_least_estimate(cornell_blend, tmp_path, monkeypatch):
+    # When no candidate's estimate is within the budget, the one whose estimate is least runs, reported
+    # as not meeting the budget and with that estimate. On the Cornell box real candidates verify, so
+    # choice.verify is made to report two rows tried, neither accepted.
+    model = choice.load()
+    # Two rows, the second the model's own choice here or not: the verdict is the same either way.
+    first, second = [k for k, row in model.rows.items() if row["method"] in ("probes", "vct")][:2]
+    tried = [{"row": first, "estimated_rel_rmse_8": 0.5}, {"row": second, "estimated_rel_rmse_8": 0.3}]
+    monkeypatch.setattr(choice, "verify", lambda *args, **kwargs: (None, [dict(t) for t in tried]))
+    out = tmp_path / "none"
+    assert main(["render", str(cornell_blend), "--out", str(out), "--method", "auto", "--error-budget", "0.2",
+                 "--verify", "--res", "32", "--repeat", "1", "--quiet"]) == 0
+    stats = json.loads((out / "stats.json").read_text())
+    c = stats["choice"]
+    assert c["verified"] == {"tried": tried, "accepted": None}
+    assert c["row"] == second and c["meets_budget"] is False and stats["estimated_rel_rmse_8"] == pytest.approx(0.3)
+    assert stats["method"] == model.rows[second]["method"]
+
+
 def test_verify_needs_an_error_budget(cornell_blend, tmp_path, capsys):
     out = tmp_path / "bad"
     assert main(["render", str(cornell_blend), "--out", str(out), "--method", "auto", "--time-budget", "100",

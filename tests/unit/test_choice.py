@@ -190,6 +190,13 @@ def test_verify_renders_at_most_its_cap():
     assert key is None and len(tried) == choice.VERIFY_MAX_TRIES
 
 
+def test_with_none_within_the_row_of_least_estimate_runs():
+    tried = [{"row": "a", "estimated_rel_rmse_8": 0.4}, {"row": "b", "estimated_rel_rmse_8": 0.25},
+             {"row": "c", "estimated_rel_rmse_8": 0.3}]
+    assert choice.least_estimated(tried) == "b"
+    assert choice.least_estimated([]) is None  # nothing tried: the caller keeps the model's choice
+
+
 def test_model_round_trips_through_json():
     rng = np.random.default_rng(3)
     scenes = {f"s{i}": features(rng) for i in range(4)}
