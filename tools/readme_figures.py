@@ -232,14 +232,17 @@ def _propagation_ms(record: dict) -> float:
     return sum(record["timings_ms"].get(k, 0.0) for k in PROPAGATION_PASSES)
 
 
+def pick(records: list[dict], scene: str, method: str, setting: dict | None) -> dict | None:
+    """The record of `method` on `scene` at the registry row `setting` (None: the method's defaults)."""
+    return next((r for r in records if r["scene"] == scene and r["method"] == method
+                 and (r["default"] if setting is None else r["setting"] == setting)), None)
+
+
 def octree_block(results: dict) -> str:
     """Table: per scene, lpv's far field (its default), one grid and the three octree rows side by side:
     rel_rmse_8 / bias, propagation ms and cell-steps (results.json `work`); then, per octree row, on how
     many scenes it beats one grid and the far field, and its propagation time against one grid's."""
     lpv = [r for r in results["records"] if r["method"] == "lpv"]
-    def pick(scene: str, setting: dict | None) -> dict | None:
-        return next((r for r in lpv if r["scene"] == scene
-                     and (r["default"] if setting is None else r["setting"] == setting)), None)
 
     scenes = list(dict.fromkeys(r["scene"] for r in lpv))
     lines = ["**lpv: the octree against the far field and one grid.**", "",
@@ -252,7 +255,7 @@ def octree_block(results: dict) -> str:
     for scene in scenes:
         cells = []
         for _, setting in OCTREE_COLUMNS:
-            r = pick(scene, setting)
+            r = pick(lpv, scene, "lpv", setting)
             if r is None or r["rel_rmse_8"] is None:
                 cells.append("–")
                 continue
@@ -262,7 +265,8 @@ def octree_block(results: dict) -> str:
         lines.append(f"| {scene} | " + " | ".join(cells) + " |")
     lines.append("")
     for title, setting in OCTREE_COLUMNS[2:]:
-        pairs = [(pick(s, setting), pick(s, OCTREE_COLUMNS[1][1]), pick(s, None)) for s in scenes]
+        pairs = [(pick(lpv, s, "lpv", setting), pick(lpv, s, "lpv", OCTREE_COLUMNS[1][1]), pick(lpv, s, "lpv", None))
+                 for s in scenes]
         pairs = [(o, g, f) for o, g, f in pairs if o and g and f and None not in
                  (o["rel_rmse_8"], g["rel_rmse_8"], f["rel_rmse_8"])]
         if not pairs:
@@ -291,10 +295,6 @@ def diffusion_block(*runs: dict) -> str:
     16, 32 and 64 cells: rel_rmse_8 and the benchmark's ms; then, per grid and bounce count, on how
     many scenes diffusion's error is at most lpv's, and its time against lpv's (median ratio); and the
     paper's cone transfer's error against the default directional one's."""
-    def pick(records: list[dict], scene: str, method: str, setting: dict | None) -> dict | None:
-        return next((r for r in records if r["scene"] == scene and r["method"] == method
-                     and (r["default"] if setting is None else r["setting"] == setting)), None)
-
     lines = ["**diffusion beside lpv, grids of 16, 32 and 64 cells.**", ""]
     lines += [_produced_by(run) + f" {run['res']} px long side, {run['bounces']} bounce(s), Cycles reference "
               f"{run['ref_spp']} spp." for run in runs]
@@ -344,10 +344,6 @@ def encodings_block(results: dict) -> str:
     rel_rmse_8 / bias and the benchmark's ms; then on how many scenes each is the more accurate."""
     probes = [r for r in results["records"] if r["method"] == "probes"]
 
-    def pick(scene: str, setting: dict | None) -> dict | None:
-        return next((r for r in probes if r["scene"] == scene
-                     and (r["default"] if setting is None else r["setting"] == setting)), None)
-
     irradiance = {"probes.encoding": "irradiance"}
     lines = ["**probes: the two encodings.**", "",
              _produced_by(results) + f" {results['res']} px long side, {results['bounces']} bounce(s), Cycles "
@@ -356,7 +352,7 @@ def encodings_block(results: dict) -> str:
              "| scene | SH (default) | irradiance |", "| --- | --- | --- |"]
     better = total = 0
     for scene in dict.fromkeys(r["scene"] for r in probes):
-        pair = [pick(scene, None), pick(scene, irradiance)]
+        pair = [pick(probes, scene, "probes", None), pick(probes, scene, "probes", irradiance)]
         cells = ["–" if r is None or r["rel_rmse_8"] is None
                  else f"{r['rel_rmse_8']:.3f} / {r['bias']:.3f}, {r['total_ms']:.0f}" for r in pair]
         lines.append(f"| {scene} | " + " | ".join(cells) + " |")
