@@ -1,7 +1,7 @@
 """The probe volume for engines (`bake --target probes`; docs/BAKE.md, docs/PROBES.md): what method
 `probes` solved, as arrays in a documented layout. numpy only; the bridge writes the files.
 
-An engine gets four textures and a layout:
+An engine gets six textures and a layout:
 - `sh`: the L2 SH of the radiance arriving at each probe (W/m^2/sr, by direction of arrival), the
   paper's nine coefficients per colour (sh.py's basis and order). With the SH encoding these are the
   solve's own; with the irradiance encoding they are the irradiance cube maps projected to SH and
@@ -56,24 +56,32 @@ def sh_table(grid: ProbeGrid, coeffs: np.ndarray) -> np.ndarray:
     return np.asarray(coeffs).transpose(0, 1, 3, 2, 4).reshape(ny * nz, SH_COEFFS * nx, 3)
 
 
+def _face_origin(grid: ProbeGrid, n: int, p, face) -> tuple:
+    """Atlas column and row of texel (0, 0) of probe p's face in an n x n tiled atlas (probe.glsl's
+    tile_origin); p and face broadcast."""
+    cols = grid.tiles_per_row
+    return 3 * n * (p % cols) + n * (face % 3), 2 * n * (p // cols) + n * (face // 3)
+
+
 def _face_texels(grid: ProbeGrid, n: int) -> tuple[np.ndarray, np.ndarray]:
     """Atlas rows and columns (P, 6, n, n) of every probe's face texels in an n x n tiled atlas."""
-    cols = grid.tiles_per_row
-    p = np.arange(grid.count)[:, None, None, None]
-    f = np.arange(6)[None, :, None, None]
+    x0, y0 = _face_origin(grid, n, np.arange(grid.count)[:, None, None, None], np.arange(6)[None, :, None, None])
     j = np.arange(n)[None, None, :, None]
     i = np.arange(n)[None, None, None, :]
-    x = 3 * n * (p % cols) + n * (f % 3) + i
-    y = 2 * n * (p // cols) + n * (f // 3) + j
-    return np.broadcast_to(y, (grid.count, 6, n, n)), np.broadcast_to(x, (grid.count, 6, n, n))
+    return np.broadcast_to(y0 + j, (grid.count, 6, n, n)), np.broadcast_to(x0 + i, (grid.count, 6, n, n))
+
+
+def _sh_irradiance(grid: ProbeGrid, coeffs: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """(P, d, 3) irradiance of SH radiance (nz, ny, nx, 9, 3) at unit normals (d, 3), clamped at 0, as
+    the lookup evaluates it: E = max(0, sum_i A_l c_i Y_i(n))."""
+    per_probe = np.asarray(coeffs, np.float64).reshape(grid.count, SH_COEFFS, 3)  # probe order p
+    return np.maximum(np.einsum("pck,dc->pdk", per_probe, sh.cosine_lobe_l2(normals)), 0.0)
 
 
 def irradiance_from_sh(grid: ProbeGrid, coeffs: np.ndarray, n: int) -> np.ndarray:
     """The irradiance atlas (grid.tiled_size(n) as (h, w, 3), W/m^2) of SH radiance (nz, ny, nx, 9, 3):
     E at every face texel's centre normal, clamped at 0, as the lookup evaluates it."""
-    lobe = sh.cosine_lobe_l2(texel_directions(n).reshape(-1, 3))                  # (6 n n, 9)
-    per_probe = np.asarray(coeffs, np.float64).reshape(grid.count, SH_COEFFS, 3)  # probe order p
-    e = np.maximum(np.einsum("pck,dc->pdk", per_probe, lobe), 0.0).reshape(grid.count, 6, n, n, 3)
+    e = _sh_irradiance(grid, coeffs, texel_directions(n).reshape(-1, 3)).reshape(grid.count, 6, n, n, 3)
     w, h = grid.tiled_size(n)
     atlas = np.zeros((h, w, 3))
     rows, cols = _face_texels(grid, n)
@@ -162,10 +170,7 @@ def cube_bilinear(grid: ProbeGrid, atlas: np.ndarray, n: int, directions: np.nda
     i0 = np.floor(uv).astype(np.int64)
     i1 = np.minimum(i0 + 1, n - 1)
     f = uv - i0
-    cols = grid.tiles_per_row
-    p = np.arange(grid.count)[:, None]
-    x0 = 3 * n * (p % cols) + n * (face % 3)
-    y0 = 2 * n * (p // cols) + n * (face // 3)
+    x0, y0 = _face_origin(grid, n, np.arange(grid.count)[:, None], face)
     src = np.asarray(atlas, np.float64)
 
     def at(ix, iy):
@@ -198,8 +203,7 @@ def octahedral_irradiance(grid: ProbeGrid, coeffs: np.ndarray | None, irradiance
     else from the irradiance cube atlas of n x n faces read as the lookup reads it (cube_bilinear)."""
     dirs = octahedral_directions(k).reshape(-1, 3)
     if coeffs is not None:
-        per_probe = np.asarray(coeffs, np.float64).reshape(grid.count, SH_COEFFS, 3)
-        e = np.maximum(np.einsum("pck,dc->pdk", per_probe, sh.cosine_lobe_l2(dirs)), 0.0)
+        e = _sh_irradiance(grid, coeffs, dirs)
     else:
         e = cube_bilinear(grid, np.asarray(irradiance)[..., :3], n, dirs)
     return octahedral_atlas(grid, e.reshape(grid.count, k, k, 3))
