@@ -8,8 +8,9 @@ An engine gets six textures and a layout:
   divided by the cosine lobe's band factors (E = A_l L per band, so L = E / A_l: exact for a field of
   bands 0..2, a least-squares fit otherwise).
 - `irradiance`: each probe's irradiance cube map E(n) (W/m^2) at IRRADIANCE_TEXELS^2 normals a face, in
-  the capture's tile layout. With the SH encoding, E(n) = max(0, sum_i A_l c_i Y_i(n)), what the
-  renderer's lookup evaluates; with the irradiance encoding, the solve's own maps.
+  the capture's tile layout. With the SH encoding, E(n) = max(0, sum_i h_l A_l c_i Y_i(n)), what the
+  renderer's lookup evaluates (h_l: sh.IRRADIANCE_WINDOW_L2, the deringing window); with the
+  irradiance encoding, the solve's own maps.
 - `moments`: the mean and mean square of the distance (m, m^2) from each probe to what its capture
   texels see (the lookup's Chebyshev visibility), at the capture's face_texels^2 a face.
 - `offsets`: each probe's move off its grid position (m; ProbesConfig.relocate, else 0), one texel per
@@ -73,9 +74,9 @@ def _face_texels(grid: ProbeGrid, n: int) -> tuple[np.ndarray, np.ndarray]:
 
 def _sh_irradiance(grid: ProbeGrid, coeffs: np.ndarray, normals: np.ndarray) -> np.ndarray:
     """(P, d, 3) irradiance of SH radiance (nz, ny, nx, 9, 3) at unit normals (d, 3), clamped at 0, as
-    the lookup evaluates it: E = max(0, sum_i A_l c_i Y_i(n))."""
+    the lookup evaluates it: E = max(0, sum_i h_l A_l c_i Y_i(n)), h_l the deringing window."""
     per_probe = np.asarray(coeffs, np.float64).reshape(grid.count, SH_COEFFS, 3)  # probe order p
-    return np.maximum(np.einsum("pck,dc->pdk", per_probe, sh.cosine_lobe_l2(normals)), 0.0)
+    return np.maximum(np.einsum("pck,dc->pdk", per_probe, sh.windowed_cosine_lobe_l2(normals)), 0.0)
 
 
 def irradiance_from_sh(grid: ProbeGrid, coeffs: np.ndarray, n: int) -> np.ndarray:
@@ -199,7 +200,7 @@ def octahedral_atlas(grid: ProbeGrid, per_probe: np.ndarray) -> np.ndarray:
 def octahedral_irradiance(grid: ProbeGrid, coeffs: np.ndarray | None, irradiance: np.ndarray | None,
                           n: int, k: int = OCT_IRRADIANCE_TEXELS) -> np.ndarray:
     """The irradiance in DDGI's octahedral layout (octahedral_atlas of k x k tiles), W/m^2: from the SH
-    (nz, ny, nx, 9, 3) when given, E = max(0, sum_i A_l c_i Y_i(d)) exactly as the lookup evaluates it,
+    (nz, ny, nx, 9, 3) when given, E = max(0, sum_i h_l A_l c_i Y_i(d)) exactly as the lookup evaluates it,
     else from the irradiance cube atlas of n x n faces read as the lookup reads it (cube_bilinear)."""
     dirs = octahedral_directions(k).reshape(-1, 3)
     if coeffs is not None:
@@ -242,7 +243,10 @@ def layout(grid: ProbeGrid, origin_m, encoding: str, irradiance_texels: int, pro
         "sh": {"file": files["sh"], "size": list(grid.sh_size),
                "texel": "coefficient c (sh.py order: 1, y, z, x, xy, yz, 3z^2-1, xz, x^2-y^2) of probe (ix, iy, iz) "
                         "at (c nx + ix, iy + ny iz)",
-               "units": "L2 SH of arriving radiance, W/m^2/sr per colour, by direction of arrival"},
+               "units": "L2 SH of arriving radiance, W/m^2/sr per colour, by direction of arrival",
+               "lookup_irradiance": ("E(n) = max(0, sum_c h_l A_l c Y_c(n)) per colour, band l of c: A_l = (pi, "
+                                     f"2 pi / 3, pi / 4), h_l = {list(sh.IRRADIANCE_WINDOW_L2)} (the renderer's "
+                                     "deringing window; h_l = 1 is the plain clamped-cosine convolution)")},
         "irradiance": {"file": files["irradiance"], "face_texels": irradiance_texels,
                        "size": list(grid.tiled_size(irradiance_texels)),
                        "units": "irradiance W/m^2 on a surface whose normal is the texel's direction; "

@@ -18,6 +18,16 @@ Y2_XX_YY = 0.25 * np.sqrt(15.0 / np.pi)  # 0.546274 (x^2 - y^2)
 
 BAND_FACTORS = (np.pi, 2.0 * np.pi / 3.0, np.pi / 4.0)
 
+# Per-band window on the L2 irradiance (Hann, h_l = (1 + cos(pi l / w)) / 2), against L2's ringing: a
+# single bright direction d (a sun patch seen by a probe) has the L2 irradiance, per unit of its
+# irradiance at d, E(-d) = 1/4 - h_1 / 2 + 5/16 h_2 at the opposite normal, 1/16 unwindowed, where the
+# true value is 0. With x = cos(pi / w), h_1 = (1 + x) / 2 and h_2 = x^2, so E(-d) = x (5/16 x - 1/4),
+# which vanishes at x = 0.8 (w = 4.88): the widest Hann window (the least blur) that leaks nothing to
+# the opposite side; narrower ones go negative there. Band 0 is untouched, so a uniform field keeps
+# E = pi L exactly. Used where probes are read (gpu_shaders/common/sh.glsl, sh2_windowed_cosine_lobe;
+# docs/PROBES.md, "Deringing").
+IRRADIANCE_WINDOW_L2 = (1.0, 0.9, 0.64)
+
 
 def basis_l1(dirs: np.ndarray) -> np.ndarray:
     """Y_i(d) for unit directions d (..., 3) -> (..., 4) in the order (1, y, z, x)."""
@@ -52,6 +62,12 @@ def cosine_lobe_l2(normals: np.ndarray) -> np.ndarray:
     """Projection of the clamped cosine about n onto L2 (9 coefficients)."""
     factors = np.array([BAND_FACTORS[band_of(i)] for i in range(9)])
     return basis_l2(normals) * factors
+
+
+def windowed_cosine_lobe_l2(normals: np.ndarray) -> np.ndarray:
+    """`cosine_lobe_l2` with each band scaled by IRRADIANCE_WINDOW_L2: what a probe lookup evaluates."""
+    window = np.array([IRRADIANCE_WINDOW_L2[band_of(i)] for i in range(9)])
+    return cosine_lobe_l2(normals) * window
 
 
 def irradiance(coeffs: np.ndarray, normals: np.ndarray) -> np.ndarray:

@@ -52,6 +52,11 @@ float sh2_basis(int i, vec3 d) {
     return SH_Y2_XXYY * (d.x * d.x - d.y * d.y);
 }
 
-float sh2_cosine_lobe(int i, vec3 n) {
-    return (i == 0 ? SH_A0 : (i < 4 ? SH_A1 : SH_A2)) * sh2_basis(i, n);
+// The clamped-cosine lobe with sh.py's IRRADIANCE_WINDOW_L2 per band (1, 0.9, 0.64): the Hann window
+// under which a single bright direction's L2 irradiance is 0 at the opposite normal (sh.py says why).
+const float SH_WINDOW1 = 0.9;
+const float SH_WINDOW2 = 0.64;
+
+float sh2_windowed_cosine_lobe(int i, vec3 n) {
+    return (i == 0 ? SH_A0 : (i < 4 ? SH_WINDOW1 * SH_A1 : SH_WINDOW2 * SH_A2)) * sh2_basis(i, n);
 }

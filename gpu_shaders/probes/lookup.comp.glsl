@@ -27,7 +27,7 @@ vec3 probe_irradiance(ivec3 q, vec3 n) {
 vec3 probe_irradiance(ivec3 q, vec3 n) {
     vec3 e = vec3(0.0);
     for (int c = 0; c < 9; ++c) {
-        e += texelFetch(sh, ivec2(c * probe_dims.x + q.x, probe_row(q)), 0).rgb * sh2_cosine_lobe(c, n);
+        e += texelFetch(sh, ivec2(c * probe_dims.x + q.x, probe_row(q)), 0).rgb * sh2_windowed_cosine_lobe(c, n);
     }
     return max(e, vec3(0.0));
 }

@@ -190,7 +190,7 @@ def test_probes_follow_their_documented_layout(blends, tmp_path, encoding):
     exported = np.zeros_like(looked_up)
     exported_oct = np.zeros_like(looked_up_oct)
     from_sh = np.zeros_like(looked_up)
-    lobe = sh.cosine_lobe_l2(normals)
+    lobe = sh.windowed_cosine_lobe_l2(normals)
     for row, (ix, iy, iz) in enumerate(probes):
         p = ix + nx * (iy + ny * iz)
         tile = np.array([3 * n_tex * (p % cols), 2 * n_tex * (p // cols)])

@@ -48,7 +48,8 @@ def test_constant_radiance_gives_pi_l_everywhere():
 
 def test_irradiance_atlas_places_each_face_where_the_grid_says():
     # A field brighter towards +x than -x: every texel of every face, found where ProbeGrid.face_origin
-    # (the capture's layout) puts it, holds sh.irradiance at that texel's centre direction.
+    # (the capture's layout) puts it, holds the lookup's (windowed) irradiance at that texel's centre
+    # direction.
     g = grid(face_texels=2)
     coeffs = np.zeros((*g.dims[::-1], 9, 3))
     coeffs[..., 0, :] = 1.0
@@ -60,7 +61,8 @@ def test_irradiance_atlas_places_each_face_where_the_grid_says():
             x0, y0 = g.face_origin(p, face)  # this grid's tiles for n = 2 are the capture's own layout
             for j in range(2):
                 for i in range(2):
-                    want = sh.irradiance(coeffs.reshape(g.count, 9, 3)[p, :, 0], dirs[face, j, i])
+                    lobe = sh.windowed_cosine_lobe_l2(dirs[face, j, i])
+                    want = max(0.0, lobe @ coeffs.reshape(g.count, 9, 3)[p, :, 0])
                     assert abs(atlas[y0 + j, x0 + i, 0] - want) < 1e-12
 
 
@@ -77,7 +79,10 @@ def test_irradiance_round_trips_to_sh():
     atlas = probe_export.irradiance_from_sh(g, coeffs, 4)
     assert atlas[atlas.any(axis=-1)].min() > 0  # the clamp did not act
     back = probe_export.sh_from_irradiance(g, atlas, 4)
-    assert np.abs(back - coeffs).max() < 3e-3 * 2.0
+    # The atlas is the lookup's irradiance, each band l windowed by h_l (sh.IRRADIANCE_WINDOW_L2), which
+    # the projection (divided by A_l only, the irradiance encoding's exact maps) keeps.
+    window = np.array([sh.IRRADIANCE_WINDOW_L2[sh.band_of(i)] for i in range(9)])[:, None]
+    assert np.abs(back - coeffs * window).max() < 3e-3 * 2.0
 
 
 def test_layout_is_json_and_in_world_space():
@@ -155,7 +160,7 @@ def test_octahedral_irradiance_is_the_lookup_at_each_texel_direction():
     nx, ny, _ = g.dims
     for iz, iy, ix in [(0, 0, 0), (2, 0, 1)]:
         tile = atlas[(k + 2) * (iy + ny * iz):(k + 2) * (iy + ny * iz + 1), (k + 2) * ix:(k + 2) * (ix + 1)]
-        expected = np.maximum(sh.cosine_lobe_l2(dirs) @ coeffs[iz, iy, ix], 0.0)
+        expected = np.maximum(sh.windowed_cosine_lobe_l2(dirs) @ coeffs[iz, iy, ix], 0.0)
         assert np.allclose(tile[1:-1, 1:-1].reshape(-1, 3), expected, atol=1e-12)
     a, b = np.array([2.0, 1.0, 3.0]), np.array([0.5, -0.3, 0.2])
     n = 4

@@ -60,3 +60,18 @@ def test_irradiance_of_a_directional_lobe_is_clamped(quad):
     # the difference is the truncated band 2 and up).
     exact_l1 = 0.886227**2 + 1.023327**2
     assert sh.irradiance(coeffs, np.array([0.0, 0.0, 1.0])) == pytest.approx(exact_l1, rel=1e-4)
+
+
+def test_the_irradiance_window_leaks_nothing_opposite_a_single_direction():
+    # A unit of radiant intensity from one direction d has the L2 coefficients Y_i(d) and the exact
+    # irradiance max(0, n . d): 1 facing it, 0 opposite. Its L2 irradiance lobe(n) . Y(d) is
+    # sum_l A_l (2 l + 1) / (4 pi) P_l(n . d): at n = -d 1/4 - 1/2 + 5/16 = 1/16 unwindowed (the floor
+    # under a probe that sees a sun patch below it), exactly 0 windowed (1/4 - 0.45 + 0.2).
+    # Band 0 is not windowed, so a uniform radiance keeps E = pi L.
+    d = np.array([0.36, -0.48, 0.8])
+    unit = sh.basis_l2(d)
+    assert sh.cosine_lobe_l2(-d) @ unit == pytest.approx(1.0 / 16.0, rel=1e-12)
+    assert sh.windowed_cosine_lobe_l2(-d) @ unit == pytest.approx(0.0, abs=1e-15)
+    uniform = np.zeros(9)
+    uniform[0] = 2.0 * np.sqrt(np.pi)  # L = 1 in every direction
+    assert sh.windowed_cosine_lobe_l2(d) @ uniform == pytest.approx(np.pi, rel=1e-12)
