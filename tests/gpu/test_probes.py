@@ -161,9 +161,9 @@ def test_closed_box_keeps_its_flux_over_bounces(gl):
     # the box again, so the indirect irradiance integrated over its 24 m^2 after N bounces is exactly
     # P (rho + ... + rho^N) = 50, 75, 87.5 W. Each camera looks at one face from the centre (90 degrees),
     # so the integral is 4 m^2 x sum over the faces of pi x mean(Diffuse Indirect). Measured (the
-    # defaults, 16 probes a side): 1.019, 1.021, 1.022 x exact (the first bounce over-reads by 2 %: L2 SH
-    # and the probes' interpolation; later bounces add no more than that share; 8 a side: 1.056);
-    # bound 1 +- 0.03.
+    # defaults, 16 probes a side): 1.005, 1.006, 1.006 x exact (the first bounce over-reads by 0.5 %: L2
+    # SH and the probes' interpolation; later bounces add no more than that share; without the deringing
+    # window 1.019, 1.021, 1.022); bound 1 +- 0.03.
     from addon.engine import methods
     from addon.engine.config import GIConfig, RsmConfig
     from addon.engine.scene import Camera, Light, Scene
