@@ -19,9 +19,9 @@ Y2_XX_YY = 0.25 * np.sqrt(15.0 / np.pi)  # 0.546274 (x^2 - y^2)
 BAND_FACTORS = (np.pi, 2.0 * np.pi / 3.0, np.pi / 4.0)
 
 # Per-band window on the L2 irradiance (Hann, h_l = (1 + cos(pi l / w)) / 2), against L2's ringing: a
-# single bright direction d (a sun patch seen by a probe) has the L2 irradiance, per unit of its
-# irradiance at d, E(-d) = 1/4 - h_1 / 2 + 5/16 h_2 at the opposite normal, 1/16 unwindowed, where the
-# true value is 0. With x = cos(pi / w), h_1 = (1 + x) / 2 and h_2 = x^2, so E(-d) = x (5/16 x - 1/4),
+# unit intensity from one bright direction d (a sun patch seen by a probe; exact irradiance 1 facing
+# it) has the L2 irradiance E(-d) = 1/4 - h_1 / 2 + 5/16 h_2 at the opposite normal, 1/16 unwindowed,
+# where the true value is 0. With x = cos(pi / w), h_1 = (1 + x) / 2 and h_2 = x^2, so E(-d) = x (5/16 x - 1/4),
 # which vanishes at x = 0.8 (w = 4.88): the widest Hann window (the least blur) that leaks nothing to
 # the opposite side; narrower ones go negative there. Band 0 is untouched, so a uniform field keeps
 # E = pi L exactly. Used where probes are read (gpu_shaders/common/sh.glsl, sh2_windowed_cosine_lobe;

@@ -2,7 +2,8 @@
 // probes' own atlas) from the 8 probes around it, weighted as probes/weights.glsl says (trilinear x
 // back-face x Chebyshev visibility, taken at the point moved normal_bias_m along the normal so a
 // receiver on a wall is tested from just in front of it) and renormalised. Each probe's irradiance is
-// the clamped-cosine convolution of its L2 SH about n, clamped at 0: E = max(0, sum_i c_i A_l Y_i(n)),
+// the windowed clamped-cosine convolution of its L2 SH about n, clamped at 0:
+// E = max(0, sum_i c_i h_l A_l Y_i(n)) with the deringing window h_l (common/sh.glsl),
 // or with IRRADIANCE its irradiance cube map read at n; the output is E / pi, Cycles' Diffuse Indirect
 // (alpha 0).
 #include "common/sh.glsl"
@@ -23,7 +24,7 @@ vec3 probe_irradiance(ivec3 q, vec3 n) {
     return mix(mix(e00, e10, f.x), mix(e01, e11, f.x), f.y);
 }
 #else
-// The SH encoding: the clamped-cosine convolution of the probe's L2 SH about n, clamped at 0.
+// The SH encoding: the windowed clamped-cosine convolution of the probe's L2 SH about n, clamped at 0.
 vec3 probe_irradiance(ivec3 q, vec3 n) {
     vec3 e = vec3(0.0);
     for (int c = 0; c < 9; ++c) {
