@@ -95,6 +95,7 @@ class BlenderGPUBackend(Backend):
     def __init__(self):
         ensure_gpu()
         self._programs: dict[ShaderSpec, Program] = {}
+        self._live_uniforms: dict[ShaderSpec, set[str]] = {}  # per program, the uniforms it reads
         self._sync = None
 
     @property
@@ -176,6 +177,16 @@ class BlenderGPUBackend(Backend):
             raise ShaderCompileError(f"{spec.name}: {failed}\n{mapped.strip()}") from None
         prog = Program(spec, shader)
         self._programs[spec] = prog
+        # The GLSL compiler drops a push constant its variant never reads (direct_light's POLYGONS
+        # program has no use for a point's intensity), and setting a dropped one raises.
+        live = set()
+        for u in spec.uniforms:
+            try:
+                shader.uniform_from_name(u.name)
+                live.add(u.name)
+            except ValueError:
+                pass
+        self._live_uniforms[spec] = live
         return prog
 
     def _bind(self, prog: Program, uniforms, samplers) -> None:
@@ -183,6 +194,8 @@ class BlenderGPUBackend(Backend):
         sh.bind()
         types = {u.name: u.type for u in prog.spec.uniforms}
         for name, value in (uniforms or {}).items():
+            if name not in self._live_uniforms[prog.spec]:
+                continue  # the compiler dropped it (program(), below)
             arr = np.asarray(value)
             if arr.shape == (4, 4):
                 arr = arr.T  # numpy row-major maths -> GLSL column-major

@@ -197,7 +197,8 @@ def test_navigating_gives_preview_then_full_quality(cornell):
     np.testing.assert_array_equal(full.view, preview.view)
 
 
-@pytest.mark.parametrize("name", ["direct", "direct-world", "rsm", "lpv", "lpv-far-field", "lpv-emitter-classes",
+@pytest.mark.parametrize("name", ["direct", "direct-world", "direct-area", "direct-emissive", "rsm", "lpv",
+                                  "lpv-far-field", "lpv-emitter-classes",
                                   "lpv-octree", "lpv-octree-index", "vct", "vct-filtered", "diffusion", "probes",
                                   "probes-irradiance", "probes-relocate", "gather", "gather-point"])
 def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, name):
@@ -207,6 +208,8 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
     # downsampling and the index merge's shader;
     # "vct-filtered" the filtered injection (gl_VertexID, the projected-area fetches);
     # "direct-world" the sky's shadow atlas (a draw per tile's viewport) and its fused direct pass;
+    # "direct-area" and "direct-emissive" the direct pass of lights with a shape (its POLYGONS program,
+    # which reads fewer uniforms than a point's: the compiler drops the rest);
     # "gather-point" the gather's point-to-point form factor; "probes-relocate" the relocation step,
     # the moved probes' tiles cleared and drawn again, and every probe shader at the moved positions.
     from addon.bridge import scenes
@@ -223,8 +226,8 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
     )
 
     # vct: its glossy product too; direct-world: Blender's default grey world besides the spot.
-    scenes.build("cornell-glossy" if name.startswith("vct") else "cornell-grey-world" if name == "direct-world"
-                 else "cornell")
+    scenes.build({"direct-world": "cornell-grey-world", "direct-area": "cornell-large-area",
+                  "direct-emissive": "emissive"}.get(name, "cornell-glossy" if name.startswith("vct") else "cornell"))
     scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 64, 48)
     method_name, grid_cells = ("lpv", 32) if name == "lpv-far-field" else (name.split("-")[0], 16)
     gi = GIConfig(method=method_name, resolution=64)

@@ -82,3 +82,14 @@ def test_overlay_follows_a_moved_light(shots, method):
     # The spot moved 25 cm: its pool of light and the bounce off it move; a visible share of the view
     # changes by more than 8-bit noise.
     assert (change.max(axis=2) > 3 / 255).mean() > 0.01
+
+
+def test_an_area_light_draws_in_a_real_window(shots):
+    # Lights with a shape have their own direct-light program, which reads fewer uniforms than a point's;
+    # Blender's compiler drops the others, and setting one it dropped raised before the backend skipped
+    # them. The spot is hidden, a 0.5 m area light lights the box instead.
+    result, crop = shots
+    entry = result["area_light"]
+    assert entry["error"] is None and entry["gpu_runs"] >= 1, entry
+    added = crop(entry["shot"]) - crop(result["off"])
+    assert (added.max(axis=2) > 4 / 255).mean() > 0.05

@@ -95,6 +95,27 @@ def steps():
         settings.enabled = False
         redraw()
         yield 0.5
+    # A light with a shape (its own direct-light program, POLYGONS) in place of the spot: a 0.5 m square
+    # area light under the ceiling, drawn by `direct`.
+    spot.hide_viewport = spot.hide_render = True
+    area_light = bpy.data.lights.new("Area", "AREA")
+    area_light.size, area_light.energy = 0.5, 100.0
+    area = bpy.data.objects.new("Area", area_light)
+    area.location = (0.0, 0.0, 1.9)
+    bpy.context.scene.collection.objects.link(area)
+    settings.gi.method = "direct"
+    runs = viewport.gpu_runs
+    settings.enabled = True
+    t0 = time.perf_counter()
+    while viewport.gpu_runs == runs or live.STATE.quality != "full" or bpy.app.timers.is_registered(live.tick):
+        if live.STATE.error or time.perf_counter() - t0 > WAIT_S:
+            break
+        redraw()
+        yield 0.25
+    redraw()
+    yield 1.0
+    result["area_light"] = {"shot": shot("area_light"), "status": live.status(), "error": live.STATE.error,
+                            "gpu_runs": viewport.gpu_runs - runs}
 
 
 _steps = steps()
