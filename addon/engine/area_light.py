@@ -10,8 +10,8 @@ polygon, clipped to the receiver's horizon):
                                                      g_i = unit (a_i x a_i+1)
 
 so each light is split into `patches` (a grid over a rectangle, sectors of an ellipse): each patch has
-its exact unshadowed irradiance and the shadow of its own centre (an RSM per patch), so shadows soften
-by as many steps as there are patches, and the light's total stays exact. Emissive meshes become the
+its exact unshadowed irradiance and soft shadows from its own RSM, as a disc of its area
+(emitter_radius_m; docs/DIRECT.md), and the light's total stays exact. Emissive meshes become the
 same kind of emitter, their triangles the polygons (light_views.emissive_lights).
 
 Units: radiance W/m^2/sr per colour; polygon_irradiance returns E / L (sr, the cosine-weighted solid
@@ -133,7 +133,7 @@ def _rows(polygons: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
 def split_area_light(light, patches_per_side: int) -> list:
     """An AREA light of size > 0 as patch lights: each at its patch's centroid, with the patch's share of
     the power and its polygon(s) as its Emitter, so the direct pass integrates the shape exactly and
-    shadows each patch from its centre. Radiance L = P / (pi A) over the (polygonal) outline's area A."""
+    soft-shadows each patch from its own RSM. Radiance L = P / (pi A) over the (polygonal) outline's area A."""
     x, y, front = _local_axes(light)
     area_m2 = _polygon_area(outline(light.area_shape, light.size_x_m, light.size_y_m))
     if area_m2 <= 0.0 or light.power_w <= 0.0:
@@ -166,6 +166,16 @@ def _polygon_centroid(poly2: np.ndarray) -> np.ndarray:
     if abs(a) < 1e-300:
         return poly2.mean(axis=0)
     return np.array([((x + np.roll(x, -1)) * cross).sum(), ((y + np.roll(y, -1)) * cross).sum()]) / (6.0 * a)
+
+
+def emitter_radius_m(emitter: Emitter, closed: bool) -> float:
+    """The radius (m) of the disc an emitter looks like from its front, for its soft shadows' penumbra
+    (the direct pass): a disc of the polygons' area for a flat emitter, of a quarter of it for a closed
+    one (a sphere's silhouette is a quarter of its surface). A row's area is half its diagonals' cross
+    product, exact for a planar quad and, with the 4th corner repeating the 3rd, for a triangle."""
+    v = np.asarray(emitter.vertices, np.float64)
+    area_m2 = 0.5 * np.linalg.norm(np.cross(v[:, 2] - v[:, 0], v[:, 3] - v[:, 1]), axis=1).sum()
+    return float(np.sqrt(area_m2 / (4.0 * np.pi if closed else np.pi)))
 
 
 def emitter_table(lights: list) -> tuple[np.ndarray, list[tuple[int, int]]]:

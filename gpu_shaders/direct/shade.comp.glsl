@@ -21,12 +21,11 @@ int cube_face(vec3 d) {
     return d.z >= 0.0 ? 4 : 5;
 }
 
-#ifdef SOFT_SUN
-// Soft sun shadows (percentage-closer soft shadows): a sun of angular diameter 2 atan(sun_tan_half)
-// casts a penumbra (receiver depth - blocker depth) x sun_tan_half wide on each side. The mean depth of
-// the blockers found in a disc of the widest penumbra sizes the filter; the lit share of a disc that
-// wide is the visibility. Both discs are SOFT_SAMPLES texels on a Vogel spiral (fixed: no per-pixel
-// noise). A world region (world.py) is such a sun, as wide as its share of the sky.
+#if defined(SOFT_SUN) || defined(POLYGONS)
+// Soft shadows (percentage-closer soft shadows) of a sun with an angle or a light with a shape: the mean
+// depth of the blockers found in a disc as wide as the widest penumbra sizes the filter; the lit share of
+// a disc as wide as the penumbra there is the visibility. Both discs are SOFT_SAMPLES texels on a Vogel
+// spiral (fixed: no per-pixel noise).
 const int SOFT_SAMPLES = 16;
 const float MAX_SOFT_TEXELS = 16.0;
 
@@ -35,6 +34,11 @@ vec2 vogel(int i) {
     float a = float(i) * 2.39996323;
     return r * vec2(cos(a), sin(a));
 }
+#endif
+
+#ifdef SOFT_SUN
+// A sun of angular diameter 2 atan(sun_tan_half) casts a penumbra (receiver depth - blocker depth) x
+// sun_tan_half wide on each side. A world region (world.py) is such a sun, as wide as its share of the sky.
 
 float sun_depth(vec2 uv, ivec2 size) {
     vec4 occ = texelFetch(rsm_position, clamp(ivec2(uv), ivec2(0), size - 1), 0);
@@ -89,6 +93,115 @@ float soft_sun_visibility(vec2 uv, ivec2 size, float receiver, float bias_m, flo
 }
 #endif
 
+// Whether receiver p lies in front of the plane of the surface a shadow-map texel stores (its position
+// and its normal, which the RSM turns towards the light), so that surface cannot block p's light: a real
+// blocker crosses the segment from the light to p, so p lies behind its plane, while a wall p stands in
+// front of (a floor's last pixels looking up the wall beside them) does not, and a zero-thickness wall
+// between p and the light still does (p lies behind the side the light sees). The margin, 1 % of a
+// texel, absorbs fp32 rounding at a crease. docs/DIRECT.md, "The shadow test".
+bool in_front_of(vec3 p, vec4 occ_position, vec3 occ_normal, float texel_m) {
+    return dot(p - occ_position.xyz, occ_normal) >= -0.01 * texel_m;
+}
+
+#ifdef POLYGONS
+// A light with a shape (an area light's patch, an emissive group) is shadowed from its position c over a
+// disc of radius emitter_radius_m facing the receiver. A blocker at distance z_b from c casts, seen from
+// c, a penumbra of angular half-width r (1 / z_b - 1 / z_r) around its edge on a receiver at z_r
+// (similar triangles through the blocker's edge): in shadow-map texels that over the texel's angle
+// sqrt(texel_scale). Depths are distances from c; a disc sample is compared with the receiver's plane
+// along its own ray (the plane's distance there), so a surface lit at a slant does not shadow itself.
+const float MAX_PATCH_TEXELS = 16.0;
+
+// Distance from c along the shadow map's ray through texel position uv to the plane through p with
+// normal n; `fallback` where the ray meets the plane behind c or nearly parallel to it.
+float plane_distance_m(vec2 uv, ivec2 size, vec3 p, vec3 n, float fallback) {
+    vec4 far_point = light_view_projection_inverse * vec4(uv / vec2(size) * 2.0 - 1.0, 1.0, 1.0);
+    vec3 w = normalize(far_point.xyz / far_point.w - light_pos_ws);
+    float along = dot(n, w);
+    float t = abs(along) > 1e-6 ? dot(n, p - light_pos_ws) / along : -1.0;
+    return t > 0.0 && t < 4.0 * fallback ? t : fallback;
+}
+
+// The distance from c of the surface at texel position uv if it blocks receiver p (whose plane through
+// p_test, normal n, lies receiver_m away at the centre), else -1; 1e30 where the texel has no geometry.
+// It blocks when it is nearer c than the receiver's plane along the same ray (so a surface lit at a
+// slant does not shadow itself) and p lies behind its own plane (in_front_of).
+float patch_blocker_m(vec2 uv, ivec2 size, vec3 p, vec3 p_test, vec3 n, float receiver_m, float bias_m,
+                      float texel_m) {
+    ivec2 texel = ivec2(uv);
+    vec4 occ = texelFetch(rsm_position, texel, 0);
+    if (occ.w <= 0.0) {
+        return 1e30;
+    }
+    float d = length(occ.xyz - light_pos_ws);
+    bool nearer = d < plane_distance_m(uv, size, p_test, n, receiver_m) - bias_m;
+    return nearer && !in_front_of(p, occ, texelFetch(rsm_normal, texel, 0).xyz, texel_m) ? d : -1.0;
+}
+
+float patch_visibility(vec2 uv, ivec2 size, vec3 p, vec3 p_test, vec3 n, float bias_m, float texel_m) {
+    float receiver_m = length(p_test - light_pos_ws);
+    float texel_rad = sqrt(texel_scale);
+    vec2 lo = vec2(0.5);
+    vec2 hi = vec2(size) - 0.5;
+    float centre = patch_blocker_m(clamp(uv, lo, hi), size, p, p_test, n, receiver_m, bias_m, texel_m);
+    bool centre_lit = centre < 0.0 || centre >= 1e29;
+    // Blockers are searched for as far as those a quarter of the way from the light cast their
+    // penumbra: r (4 / z_r - 1 / z_r).
+    float search = clamp(3.0 * emitter_radius_m / (receiver_m * texel_rad), 0.5, MAX_PATCH_TEXELS);
+    float blockers = 0.0;
+    float blocker_sum_m = 0.0;
+    for (int i = 0; i < SOFT_SAMPLES; ++i) {
+        float d = patch_blocker_m(clamp(uv + search * vogel(i), lo, hi), size, p, p_test, n, receiver_m, bias_m,
+                                  texel_m);
+        if (d >= 0.0 && d < 1e29) {
+            blockers += 1.0;
+            blocker_sum_m += d;
+        }
+    }
+    if (blockers == 0.0) {
+        return centre_lit ? 1.0 : 0.0;  // none in the disc: the centre's own test decides
+    }
+    float mean_blocker_m = blocker_sum_m / blockers;
+    float radius = clamp(emitter_radius_m * (1.0 / mean_blocker_m - 1.0 / receiver_m) / texel_rad, 0.5,
+                         MAX_PATCH_TEXELS);
+    float lit = 0.0;
+    for (int i = 0; i < SOFT_SAMPLES; ++i) {
+        float d = patch_blocker_m(clamp(uv + radius * vogel(i), lo, hi), size, p, p_test, n, receiver_m, bias_m,
+                                  texel_m);
+        // A texel with no geometry counts as the centre does (a disc reaching past a closed room's outer
+        // wall must not light its inside).
+        bool sample_lit = d >= 1e29 ? centre_lit : d < 0.0;
+        lit += sample_lit ? 1.0 : 0.0;
+    }
+    return lit / float(SOFT_SAMPLES);
+}
+#endif
+
+#if !defined(SOFT_SUN) && !defined(POLYGONS)
+ivec2 shadow_texel(vec3 q, ivec2 size) {
+    vec4 clip = light_view_projection * vec4(q, 1.0);
+    return clamp(ivec2((clip.xy / clip.w * 0.5 + 0.5) * vec2(size)), ivec2(0), size - 1);
+}
+
+// The hard shadow test of point q: nothing the map stores at q's texel is nearer the light than q.
+bool shadow_lit(vec3 q, ivec2 size, float bias_m) {
+    vec4 occ = texelFetch(rsm_position, shadow_texel(q, size), 0);
+    if (occ.w <= 0.0) {
+        return true;
+    }
+    float receiver = light_kind == LIGHT_SUN ? dot(q, emit_axis) : length(q - light_pos_ws);
+    float occluder = light_kind == LIGHT_SUN ? dot(occ.xyz, emit_axis) : length(occ.xyz - light_pos_ws);
+    return receiver <= occluder + bias_m;
+}
+
+// Whether p lies in front of the plane of the surface at q's texel (nothing there: yes).
+bool in_front_of_texel(vec3 p, vec3 q, ivec2 size, float texel_m) {
+    ivec2 texel = shadow_texel(q, size);
+    vec4 occ = texelFetch(rsm_position, texel, 0);
+    return occ.w <= 0.0 || in_front_of(p, occ, texelFetch(rsm_normal, texel, 0).xyz, texel_m);
+}
+#endif
+
 // This face's direct light (irradiance / pi) at G-buffer pixel px, which sees geometry: 0 where
 // another face shades it, where the light does not reach it, or in its shadow.
 vec3 face_light(ivec2 px, vec4 pos) {
@@ -119,9 +232,9 @@ vec3 face_light(ivec2 px, vec4 pos) {
         return vec3(0.0);
     }
 #endif
-    // Shadow test against the RSM's stored positions. The receiver is pushed off its surface by 1.5 RSM
-    // texels along its normal (normal-offset bias) so it does not shadow itself; every bias is in
-    // texels, so the result does not depend on the scene's scale.
+    // Shadow test against the RSM's stored positions. The receiver is lifted off its surface by 1.5 RSM
+    // texels (normal-offset bias here; along the light's ray in the hard test below) so it does not
+    // shadow itself; every bias is in texels, so the result does not depend on the scene's scale.
     vec3 p_test = p + n * (1.5 * texel_m);
     float bias_m = shadow_bias_texels * texel_m;
     if (face_index >= 0 && cube_face(p_test - light_pos_ws) != face_index) {
@@ -141,16 +254,22 @@ vec3 face_light(ivec2 px, vec4 pos) {
     float lit = 1.0;
     if (clip.w > 0.0 && all(lessThanEqual(abs(ndc.xy), vec2(1.0)))) {
         ivec2 size = textureSize(rsm_position, 0);
-#ifdef SOFT_SUN
+#if defined(SOFT_SUN)
         lit = soft_sun_visibility((ndc.xy * 0.5 + 0.5) * vec2(size), size, dot(p_test, emit_axis), bias_m, texel_m,
                                   n);
+#elif defined(POLYGONS)
+        lit = patch_visibility((ndc.xy * 0.5 + 0.5) * vec2(size), size, p, p_test, n, bias_m, texel_m);
 #else
-        ivec2 texel = clamp(ivec2((ndc.xy * 0.5 + 0.5) * vec2(size)), ivec2(0), size - 1);
-        vec4 occ = texelFetch(rsm_position, texel, 0);
-        if (occ.w > 0.0) {
-            float receiver = light_kind == LIGHT_SUN ? dot(p_test, emit_axis) : length(p_test - light_pos_ws);
-            float occluder = light_kind == LIGHT_SUN ? dot(occ.xyz, emit_axis) : length(occ.xyz - light_pos_ws);
-            lit = receiver <= occluder + bias_m ? 1.0 : 0.0;
+        // Two lookups. Along the ray: the receiver moved towards the light by the same 1.5 texels of
+        // height over the cosine keeps its own texel (no sideways move, so real shadow edges stay put);
+        // it is lit if nothing there is nearer the light. That move can cross a surface within a few
+        // texels (a zero-thickness wall at its foot, a solid touching another), so where the ray's
+        // texel holds a surface the receiver lies behind, the normal offset's test must agree.
+        float facing = dot(n, to_light);
+        vec3 p_ray = facing > 0.0 ? p + to_light * (1.5 * texel_m / max(facing, 0.1)) : p_test;
+        lit = shadow_lit(p_ray, size, bias_m) ? 1.0 : 0.0;
+        if (lit > 0.0 && !in_front_of_texel(p, p_ray, size, texel_m)) {
+            lit = shadow_lit(p_test, size, bias_m) ? 1.0 : 0.0;
         }
 #endif
     }

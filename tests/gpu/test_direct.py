@@ -108,16 +108,17 @@ def test_occluder_casts_a_shadow(gl, kind):
     assert img[row, col] > 0.1
 
 
-def sun_shadow_errors(gl, sun_shadow_texels, away_m=0.005):
+def sun_shadow_errors(gl, sun_shadow_texels, away_m=0.005, sun_x=0.23, sun_y=0.31):
     """Floor pixels farther than away_m from the exact edge of a hard sun shadow whose visibility is not
-    exactly 0 or 1. The sun shines along (0.4, 0.4, -1): the occluder 0.3..0.7 at z = 1 shadows the floor
-    where x and y lie in [0.7, 1.1]."""
-    light = Light("SUN", [0, 0, H], [0.4, 0.4, -1.0], [1, 1, 1], sun_strength=3.0)
+    exactly 0 or 1. The sun shines along (sun_x, sun_y, -1): the occluder 0.3..0.7 at z = 1 shadows the
+    floor where x lies in [0.3, 0.7] + sun_x and y in [0.3, 0.7] + sun_y."""
+    light = Light("SUN", [0, 0, H], [sun_x, sun_y, -1.0], [1, 1, 1], sun_strength=3.0)
     method = DirectMethod(gl, GIConfig(), RsmConfig(resolution=16, sun_shadow_texels=sun_shadow_texels))
     scene = make_scene(light)
     method.set_scene(scene)
     img = method.run().images["direct"][..., 0]
-    lit_value = 3.0 * (1.0 / np.linalg.norm([0.4, 0.4, 1.0])) / np.pi  # E cos / pi
+    lit_value = 3.0 * (1.0 / np.linalg.norm([sun_x, sun_y, 1.0])) / np.pi  # E cos / pi
+    x0, x1, y0, y1 = 0.3 + sun_x, 0.7 + sun_x, 0.3 + sun_y, 0.7 + sun_y
     wrong = 0
     for row in range(SIZE):
         for col in range(SIZE):
@@ -125,9 +126,9 @@ def sun_shadow_errors(gl, sun_shadow_texels, away_m=0.005):
             seen_at_occluder = 0.8 * p[:2]
             if max(abs(p[0]), abs(p[1])) > 0.98 or np.all((0.3 <= seen_at_occluder) & (seen_at_occluder <= 0.7)):
                 continue
-            inside = 0.7 <= p[0] <= 1.1 and 0.7 <= p[1] <= 1.1
-            edge_m = min(p[0] - 0.7, p[1] - 0.7) if inside else \
-                np.hypot(max(0.7 - p[0], 0.0, p[0] - 1.1), max(0.7 - p[1], 0.0, p[1] - 1.1))
+            inside = x0 <= p[0] <= x1 and y0 <= p[1] <= y1
+            edge_m = min(p[0] - x0, x1 - p[0], p[1] - y0, y1 - p[1]) if inside else \
+                np.hypot(max(x0 - p[0], 0.0, p[0] - x1), max(y0 - p[1], 0.0, p[1] - y1))
             want = 0.0 if inside else lit_value
             wrong += edge_m > away_m and abs(img[row, col] - want) > 1e-4 * lit_value
     return wrong
@@ -135,8 +136,8 @@ def sun_shadow_errors(gl, sun_shadow_texels, away_m=0.005):
 
 def test_a_sun_shadows_from_its_own_finer_map(gl):
     # RsmConfig.sun_shadow_texels: a sun's direct light reads a shadow map of its own. With the RSM at 16
-    # texels and no map of its own, pixels more than 5 mm from the exact shadow edge come out wrong
-    # (measured: 2 of them); with a 512-texel map of its own (~5 mm texels) none does.
+    # texels (12.5 cm) and no map of its own, pixels more than 5 mm from the exact shadow edge come out
+    # wrong (measured: 10 of them); with a 512-texel map of its own (~5 mm texels) none does.
     assert sun_shadow_errors(gl, 0) > 0
     assert sun_shadow_errors(gl, 512) == 0
 
@@ -239,3 +240,71 @@ def test_first_face_replaces_what_the_texture_holds(gl):
     assert seen.any() and not seen.all()
     np.testing.assert_array_equal(got[seen][:, :3], expected[seen][:, :3])
     assert np.all(got[~seen] == 7.0)
+
+
+def test_an_area_lights_penumbra_is_soft(gl):
+    # A 1 m square light 2 m above the floor (2 x 2 patches) and a wall in the plane x = 0, 1 m high and
+    # wider than the floor. A floor point at x < 0 sees the light's part with qx <= -x (the ray to
+    # (qx, qy, 2) crosses x = 0 at height -2x / (qx - x) < 1 beyond it), so the exact light is the
+    # polygon integral of that clipped square (area_light.polygon_irradiance): a penumbra from x = -0.5
+    # to the wall. Shadowed from the patches' centres alone (qx = +-0.25) it is a step at x = -0.25: mean
+    # |error| 0.077 of the unshadowed light along the transect. The soft shadows (PCSS per patch, their
+    # penumbra capped at 16 texels) measured 0.042 with a 512-texel RSM; bound 0.05.
+    wall = [[[0, -3, 0], [0, 3, 0], [0, 3, 1]], [[0, -3, 0], [0, 3, 1], [0, -3, 1]]]
+    tris = np.array(quad(-1, 1, -1, 1, 0.0) + wall, np.float32)
+    normals = np.zeros_like(tris)
+    normals[:2, :, 2] = 1.0
+    normals[2:, :, 0] = 1.0
+    light = Light("AREA", [0, 0, H], [0, 0, -1], [1, 1, 1], power_w=300.0, area_shape="SQUARE", size_x_m=1.0,
+                  size_y_m=1.0, axis_x=[1, 0, 0])
+    cam = make_scene(light).camera
+    scene = Scene(tris, normals, np.full((4, 3), 0.8, np.float32), np.zeros((4, 3), np.float32), [light], camera=cam)
+    method = DirectMethod(gl, GIConfig(), RsmConfig(resolution=512, area_patches=2))
+    method.set_scene(scene)
+    img = method.run().images["direct"][..., 0]
+    radiance = 300.0 / np.pi  # P / (pi A), A = 1 m^2
+    up = np.array([0.0, 0.0, 1.0])
+
+    def light_up_to(qx_max, p):
+        corners = np.array([[-0.5, -0.5, H], [qx_max, -0.5, H], [qx_max, 0.5, H], [-0.5, 0.5, H]])
+        return radiance * polygon_irradiance(p, up, corners) / np.pi
+
+    row, _ = pixel_of(cam, np.zeros(3))
+    errors, hard_errors = [], []
+    for col in range(SIZE):
+        p = floor_point_at_pixel(cam, row, col)
+        if -0.75 < p[0] < -0.02:
+            exact, unshadowed = light_up_to(min(0.5, -p[0]), p), light_up_to(0.5, p)
+            hard = light_up_to(0.5 if -p[0] > 0.25 else 0.0, p)
+            errors.append(abs(img[row, col] - exact) / unshadowed)
+            hard_errors.append(abs(hard - exact) / unshadowed)
+    assert len(errors) >= 15
+    assert np.mean(hard_errors) == pytest.approx(0.077, abs=0.002)
+    assert np.mean(errors) < 0.05
+
+
+def test_the_floor_beside_a_wall_keeps_its_light(gl):
+    # A floor meeting a wall (the plane x = 0.5, 1 m high, lit on its room side) under a point light at
+    # (0, 0, 2): nothing blocks any floor point, so every floor pixel reads the point's exact irradiance
+    # up to the wall. The normal offset makes the floor's last column before the wall look up the wall's
+    # texels of the 64-texel map, nearer the light; the wall blocks only receivers behind its plane, so
+    # they stay lit (without that test: 46 pixels read 0, measured).
+    wall = [[[0.5, -1, 0], [0.5, 1, 0], [0.5, 1, 1]], [[0.5, -1, 0], [0.5, 1, 1], [0.5, -1, 1]]]
+    tris = np.array(quad(-1, 0.5, -1, 1, 0.0) + wall, np.float32)
+    normals = np.zeros_like(tris)
+    normals[:2, :, 2] = 1.0
+    normals[2:, :, 0] = -1.0
+    light = Light("POINT", [0, 0, H], [0, 0, -1], [1, 1, 1], power_w=300.0)
+    cam = make_scene(light).camera
+    scene = Scene(tris, normals, np.full((4, 3), 0.8, np.float32), np.zeros((4, 3), np.float32), [light], camera=cam)
+    method = DirectMethod(gl, GIConfig(), RsmConfig(resolution=64))
+    method.set_scene(scene)
+    img = method.run().images["direct"][..., 0]
+    checked = 0
+    for row in range(SIZE):
+        for col in range(SIZE):
+            p = floor_point_at_pixel(cam, row, col)
+            if -0.98 < p[0] < 0.49 and abs(p[1]) < 0.95:
+                assert img[row, col] == pytest.approx(point_irradiance_over_pi(300.0 / (4 * np.pi), p), rel=1e-4)
+                checked += 1
+    assert checked > 1000

@@ -7,6 +7,8 @@ import pytest
 from addon.engine.area_light import (
     ELLIPSE_SIDES,
     MAX_VERTICES,
+    Emitter,
+    emitter_radius_m,
     emitter_table,
     outline,
     polygon_irradiance,
@@ -121,3 +123,17 @@ def test_emitter_table_layout():
     assert table.shape == (4, MAX_VERTICES + 1, 4) and table.dtype == np.float32
     assert np.all(table[:, 0, 3] == 4)  # quads
     np.testing.assert_allclose(table[0, MAX_VERTICES, :3], [1.0, 0.5, 0.25] * np.array(100.0 / np.pi), rtol=1e-6)
+
+
+def test_an_emitters_radius_is_the_disc_of_its_area():
+    # The soft shadows' disc: a 1 m x 0.5 m light's two patches' area (0.5 m^2) over pi, rooted; a closed
+    # emitter (an octahedron of unit circumradius, area 4 sqrt(3)) the disc of a quarter of its area.
+    light = Light("AREA", [0, 0, 2], [0, 0, -1], [1, 1, 1], power_w=10.0, area_shape="RECTANGLE", size_x_m=1.0,
+                  size_y_m=0.5, axis_x=[1, 0, 0])
+    left = split_area_light(light, 2)[0]
+    assert emitter_radius_m(left.emitter, closed=False) == pytest.approx(np.sqrt(0.125 / np.pi), rel=1e-12)
+    corners = np.array([[1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0]], np.float64)
+    tris = [[corners[i], corners[(i + 1) % 4], np.array([0, 0, s])] for s in (1.0, -1.0) for i in range(4)]
+    verts = np.array([[*t, t[2]] for t in tris])
+    octahedron = Emitter(verts, np.full(8, 3), np.ones((8, 3)))
+    assert emitter_radius_m(octahedron, closed=True) == pytest.approx(np.sqrt(4 * np.sqrt(3) / (4 * np.pi)), rel=1e-12)

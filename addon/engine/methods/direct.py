@@ -175,15 +175,17 @@ class DirectMethod:
             self._sun_shadows[slot] = (textures, target)
         return self._sun_shadows[slot]
 
-    def shadow_map(self, view: LightView) -> tuple[object, LightView]:
+    def shadow_map(self, view: LightView) -> tuple[dict, LightView]:
         """What the direct pass tests `view`'s shadows against, and the view as that map's texels see it:
-        the RSM's position texture, or a sun's own finer map with its texel area scaled to match."""
+        the RSM's position and normal textures, or a sun's own finer map's with its texel area scaled to
+        match."""
         if not self._own_sun_shadow(view):
-            return self.rsm["position"], view
+            return {k: self.rsm[k] for k in ("position", "normal")}, view
         scale = (self.rsm_config.resolution / self.rsm_config.sun_shadow_texels) ** 2
         fine = replace(view, texel_scale=view.texel_scale * scale,
                        uniforms={**view.uniforms, "texel_scale": view.texel_scale * scale})
-        return self._sun_shadow_slot(self._slot)[0]["position"], fine
+        textures = self._sun_shadow_slot(self._slot)[0]
+        return {k: textures[k] for k in ("position", "normal")}, fine
 
     def set_camera(self, camera: Camera) -> None:
         self.source = replace(self.source, camera=camera)

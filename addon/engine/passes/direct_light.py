@@ -2,8 +2,9 @@
 
 Inputs: G-buffer position and normal, the face's RSM position (shadow test), LightView uniforms, and
 the emitter table (area_light.emitter_table): a light with polygons (poly_count > 0: an area light's
-patch, an emissive mesh's triangles) gives the exact unshadowed irradiance of its shape, shadowed from
-its position; the others are points (spots masked, area lights without a size Lambertian).
+patch, an emissive mesh's triangles) gives the exact unshadowed irradiance of its shape, soft-shadowed
+from its position as a disc of its area (emitter_radius_m); the others are points (spots masked,
+area lights without a size Lambertian).
 Output: `direct` (RGBA32F, camera resolution), accumulated over faces and lights, in the unit of
 Cycles' Diffuse Direct pass: irradiance / pi. Point-light faces split directions by major axis, so
 each pixel is shaded by exactly one face.
@@ -12,7 +13,16 @@ each pixel is shaded by exactly one face.
 from __future__ import annotations
 
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
-from .declare import DIRECT, EMITTERS, GBUF_NORMAL, GBUF_POSITION, LIGHT_VIEWS, RSM_POSITION, PassDecl
+from .declare import (
+    DIRECT,
+    EMITTERS,
+    GBUF_NORMAL,
+    GBUF_POSITION,
+    LIGHT_VIEWS,
+    RSM_NORMAL,
+    RSM_POSITION,
+    PassDecl,
+)
 from .light_views import KIND_CODE, LightView
 
 
@@ -25,7 +35,8 @@ def _spec(polygons: bool, soft_sun: bool) -> ShaderSpec:
         name="direct_shade" + ("_polygons" if polygons else "") + ("_soft_sun" if soft_sun else ""),
         compute="direct/shade.comp.glsl",
         local_size=(8, 8, 1),
-        samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("rsm_position", "2D"))
+        samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("rsm_position", "2D"),
+                  Sampler("rsm_normal", "2D"))
         + ((Sampler("emitters", "2D"),) if polygons else ()),
         images=(Image("direct", "2D", "RGBA32F", "read_write"),),
         uniforms=(
@@ -35,7 +46,8 @@ def _spec(polygons: bool, soft_sun: bool) -> ShaderSpec:
             Var("light_color_intensity", "vec3"), Var("face_index", "int"),
             Var("spot_cos_half", "float"), Var("spot_blend", "float"), Var("shadow_bias_texels", "float"),
             Var("accumulate", "int"),
-        ) + ((Var("poly_first", "int"), Var("poly_count", "int")) if polygons else ())
+        ) + ((Var("poly_first", "int"), Var("poly_count", "int"), Var("emitter_radius_m", "float"),
+               Var("light_view_projection_inverse", "mat4")) if polygons else ())
         + ((Var("sun_tan_half", "float"),) if soft_sun else ()),
         defines=((("POLYGONS", "1"),) if polygons else ()) + ((("SOFT_SUN", "1"),) if soft_sun else ()),
     )
@@ -44,13 +56,15 @@ def _spec(polygons: bool, soft_sun: bool) -> ShaderSpec:
 SPECS = {(polygons, soft_sun): _spec(polygons, soft_sun) for polygons in (False, True) for soft_sun in (False, True)}
 
 
-DECL = PassDecl("direct_light", "gather", (GBUF_POSITION, GBUF_NORMAL, RSM_POSITION, LIGHT_VIEWS, EMITTERS), (DIRECT,),
+DECL = PassDecl("direct_light", "gather", (GBUF_POSITION, GBUF_NORMAL, RSM_POSITION, RSM_NORMAL, LIGHT_VIEWS, EMITTERS),
+                (DIRECT,),
                 "one light face's shadow-mapped direct light, added")
 
 
-def run(backend: Backend, gbuf_position, gbuf_normal, rsm_position, direct, view: LightView,
+def run(backend: Backend, gbuf_position, gbuf_normal, shadow: dict, direct, view: LightView,
         shadow_bias_texels: float, emitters, accumulate: bool = True) -> None:
-    """`emitters`: the emitter table texture; the view's uniforms give its rows (poly_first, poly_count).
+    """`shadow`: the shadow map's "position" and "normal" textures (the RSM's, or a sun's own map).
+    `emitters`: the emitter table texture; the view's uniforms give its rows (poly_first, poly_count).
     accumulate: add to `direct`; False: replace its pixels that see geometry (those that see none are not
     written: the caller keeps them 0)."""
     view_uniforms = view.uniforms
@@ -62,5 +76,6 @@ def run(backend: Backend, gbuf_position, gbuf_normal, rsm_position, direct, view
     uniforms["accumulate"] = int(accumulate)
     backend.dispatch(backend.program(spec), group_count(direct.size, spec.local_size), uniforms=uniforms,
                      samplers={"gbuf_position": gbuf_position, "gbuf_normal": gbuf_normal,
-                               "rsm_position": rsm_position, "emitters": emitters},
+                               "rsm_position": shadow["position"], "rsm_normal": shadow["normal"],
+                               "emitters": emitters},
                      images={"direct": direct})

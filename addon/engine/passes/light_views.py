@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..area_light import MAX_POLYGONS_PER_LIGHT, Emitter
+from ..area_light import MAX_POLYGONS_PER_LIGHT, Emitter, emitter_radius_m
 from ..scene import Light
 from ..transforms import box_corners, look_along, orthographic, perspective
 
@@ -189,6 +189,9 @@ def _common_uniforms(light: Light, emit_axis: np.ndarray, texel_scale: float) ->
         "occluder_radius": float(light.occluder_radius_m),
         # A sun's angular radius (its tangent): its shadows' penumbra (direct_light's soft shadows).
         "sun_tan_half": float(np.tan(light.sun_angle_rad / 2.0)) if light.kind == "SUN" else 0.0,
+        # A light with a shape: the disc it looks like, its shadows' penumbra (direct_light's soft shadows).
+        "emitter_radius_m": emitter_radius_m(light.emitter, closed=light.kind != "AREA")
+        if light.emitter is not None else 0.0,
     }
 
 
@@ -196,8 +199,8 @@ def _perspective_view(light, index, axis, face, fov, near, far, resolution) -> L
     view = look_along(light.position_m, axis)
     vp = perspective(fov, near, far) @ view
     texel_scale = (2.0 * np.tan(fov / 2.0) / resolution) ** 2
-    uniforms = {"light_view_projection": vp, "face_axis": axis, "face_index": face,
-                **_common_uniforms(light, light.direction, texel_scale)}
+    uniforms = {"light_view_projection": vp, "light_view_projection_inverse": np.linalg.inv(vp),
+                "face_axis": axis, "face_index": face, **_common_uniforms(light, light.direction, texel_scale)}
     return LightView(index, vp, light.position_m, np.asarray(axis, np.float64), face, texel_scale, uniforms)
 
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..probe_grid import ProbeGrid
 from . import direct_light
-from .declare import EMITTERS, LIGHT_VIEWS, RSM_POSITION, PassDecl, Port
+from .declare import EMITTERS, LIGHT_VIEWS, RSM_NORMAL, RSM_POSITION, PassDecl, Port
 from .light_views import LightView
 from .probe_capture import ATLAS_ALBEDO, ATLAS_NORMAL, ATLAS_POSITION, ATLAS_UNIFORMS, grid_uniforms
 
@@ -31,7 +31,8 @@ IRRADIANCE = Port("probes", "irradiance", "RGBA32F", "probe_atlas",
                   "irradiance (W/m^2) per probe at 6 m^2 normals (the irradiance encoding)")
 IRRADIANCE_TEXELS = 4  # m: each face of a probe's irradiance cube map is m x m normals
 
-SHADE_DECL = PassDecl("probe_direct", "solve", (ATLAS_POSITION, ATLAS_NORMAL, RSM_POSITION, LIGHT_VIEWS, EMITTERS),
+SHADE_DECL = PassDecl("probe_direct", "solve", (ATLAS_POSITION, ATLAS_NORMAL, RSM_POSITION, RSM_NORMAL, LIGHT_VIEWS,
+                                                EMITTERS),
                       (ATLAS_DIRECT,), "one light face's shadow-mapped direct light on the probe atlas, added")
 PROJECT_DECL = PassDecl("probe_project", "solve", (ATLAS_ALBEDO, ATLAS_DIRECT), (SH,),
                         "the atlas shaded and projected to L2 SH per probe (first bounce)")
@@ -72,11 +73,11 @@ def _spec(bounce: bool, encoding: str = "sh") -> ShaderSpec:
 SPECS = {(bounce, encoding): _spec(bounce, encoding) for bounce in (False, True) for encoding in ("sh", "irradiance")}
 
 
-def shade(backend: Backend, atlas: dict, atlas_direct, rsm_position, view: LightView, shadow_bias_texels: float,
+def shade(backend: Backend, atlas: dict, atlas_direct, shadow: dict, view: LightView, shadow_bias_texels: float,
           emitters, first: bool) -> None:
     """atlas_direct += one light face's direct light; the solve's first face (`first`) replaces the last
     solve's light instead, at every texel that sees geometry (the others the caller keeps 0)."""
-    direct_light.run(backend, atlas["position"], atlas["normal"], rsm_position, atlas_direct, view,
+    direct_light.run(backend, atlas["position"], atlas["normal"], shadow, atlas_direct, view,
                      shadow_bias_texels, emitters, accumulate=not first)
 
 
