@@ -195,7 +195,7 @@ class BlenderGPUBackend(Backend):
         types = {u.name: u.type for u in prog.spec.uniforms}
         for name, value in (uniforms or {}).items():
             if name not in self._live_uniforms[prog.spec]:
-                continue  # the compiler dropped it (program(), below)
+                continue  # the compiler dropped it (program(), above)
             arr = np.asarray(value)
             if arr.shape == (4, 4):
                 arr = arr.T  # numpy row-major maths -> GLSL column-major

@@ -72,8 +72,8 @@ class RsmConfig(_Validated):
     voxel_cells: int = _num(64, 8, 512, "voxel grid cells along the scene's longest side (voxel visibility)")
     voxel_offset_cells: float = _num(1.5, 0.0, 4.0, "ray ends moved off their surfaces, in cells")
     # An area light is split into patches_per_side^2 patches (sectors for disks and ellipses), each
-    # with its exact unshadowed irradiance and soft shadows from its own RSM faces (area_light.py,
-    # docs/DIRECT.md); each patch costs its own RSM faces.
+    # with its exact unshadowed irradiance and soft shadows from its own RSM faces, which it costs
+    # (area_light.py, docs/DIRECT.md).
     area_patches: int = _num(2, 1, 8, "patches per side an area light is split into, each with its own soft shadows")
     # The world's bounce: this many suns, each a region of the sky with its exact vector irradiance
     # (world.py) and its own RSM face (the VPLs every indirect method reads): 16 kept Sponza's update

@@ -110,8 +110,6 @@ bool in_front_of(vec3 p, vec4 occ_position, vec3 occ_normal, float texel_m) {
 // (similar triangles through the blocker's edge): in shadow-map texels that over the texel's angle
 // sqrt(texel_scale). Depths are distances from c; a disc sample is compared with the receiver's plane
 // along its own ray (the plane's distance there), so a surface lit at a slant does not shadow itself.
-const float MAX_PATCH_TEXELS = 16.0;
-
 // Distance from c along the shadow map's ray through texel position uv to the plane through p with
 // normal n; `fallback` where the ray meets the plane behind c or nearly parallel to it.
 float plane_distance_m(vec2 uv, ivec2 size, vec3 p, vec3 n, float fallback) {
@@ -147,7 +145,7 @@ float patch_visibility(vec2 uv, ivec2 size, vec3 p, vec3 p_test, vec3 n, float b
     bool centre_lit = centre < 0.0 || centre >= 1e29;
     // Blockers are searched for as far as those a quarter of the way from the light cast their
     // penumbra: r (4 / z_r - 1 / z_r).
-    float search = clamp(3.0 * emitter_radius_m / (receiver_m * texel_rad), 0.5, MAX_PATCH_TEXELS);
+    float search = clamp(3.0 * emitter_radius_m / (receiver_m * texel_rad), 0.5, MAX_SOFT_TEXELS);
     float blockers = 0.0;
     float blocker_sum_m = 0.0;
     for (int i = 0; i < SOFT_SAMPLES; ++i) {
@@ -163,7 +161,7 @@ float patch_visibility(vec2 uv, ivec2 size, vec3 p, vec3 p_test, vec3 n, float b
     }
     float mean_blocker_m = blocker_sum_m / blockers;
     float radius = clamp(emitter_radius_m * (1.0 / mean_blocker_m - 1.0 / receiver_m) / texel_rad, 0.5,
-                         MAX_PATCH_TEXELS);
+                         MAX_SOFT_TEXELS);
     float lit = 0.0;
     for (int i = 0; i < SOFT_SAMPLES; ++i) {
         float d = patch_blocker_m(clamp(uv + radius * vogel(i), lo, hi), size, p, p_test, n, receiver_m, bias_m,

@@ -1,7 +1,7 @@
 """Direct-light pass: shadow-mapped direct diffuse light of one light face at every G-buffer pixel.
 
-Inputs: G-buffer position and normal, the face's RSM position (shadow test), LightView uniforms, and
-the emitter table (area_light.emitter_table): a light with polygons (poly_count > 0: an area light's
+Inputs: G-buffer position and normal, the face's RSM position and normal (shadow test), LightView
+uniforms, and the emitter table (area_light.emitter_table): a light with polygons (poly_count > 0: an area light's
 patch, an emissive mesh's triangles) gives the exact unshadowed irradiance of its shape, soft-shadowed
 from its position as a disc of its area (emitter_radius_m); the others are points (spots masked,
 area lights without a size Lambertian).

@@ -47,6 +47,20 @@ def finish(error=None):
     os._exit(0 if error is None else 1)
 
 
+def until_updated(live, viewport, runs):
+    """Delays until the overlay has drawn an update since `runs` GPU runs (or failed, or WAIT_S passed),
+    then one for that frame to reach the screen; returns the seconds it all took."""
+    t0 = time.perf_counter()
+    while viewport.gpu_runs == runs or live.STATE.quality != "full" or bpy.app.timers.is_registered(live.tick):
+        if live.STATE.error or time.perf_counter() - t0 > WAIT_S:
+            break
+        redraw()
+        yield 0.25
+    redraw()
+    yield 1.0  # the updated frame reaches the screen
+    return time.perf_counter() - t0
+
+
 def steps():
     """A generator of delays: the timer below advances it once per call."""
     live, viewport = _common.bounce("addon.bridge.live"), _common.bounce("addon.bridge.viewport")
@@ -76,16 +90,9 @@ def steps():
                 settings.enabled = True
             else:
                 spot.location.x += 0.25  # the light moves: the overlay must follow
-            t0 = time.perf_counter()
-            while viewport.gpu_runs == runs or live.STATE.quality != "full" or bpy.app.timers.is_registered(live.tick):
-                if live.STATE.error or time.perf_counter() - t0 > WAIT_S:
-                    break
-                redraw()
-                yield 0.25
-            redraw()
-            yield 1.0  # the updated frame reaches the screen
+            wait_s = yield from until_updated(live, viewport, runs)
             entry[phase] = {"shot": shot(f"{method}_{phase}"), "status": live.status(), "error": live.STATE.error,
-                            "gpu_runs": viewport.gpu_runs - runs, "wait_s": round(time.perf_counter() - t0, 2),
+                            "gpu_runs": viewport.gpu_runs - runs, "wait_s": round(wait_s, 2),
                             "samples": live.STATE.samples}
             if phase == "on":  # still: the overlay keeps refining on its own (its redraws ask for more)
                 yield 3.0
@@ -106,14 +113,7 @@ def steps():
     settings.gi.method = "direct"
     runs = viewport.gpu_runs
     settings.enabled = True
-    t0 = time.perf_counter()
-    while viewport.gpu_runs == runs or live.STATE.quality != "full" or bpy.app.timers.is_registered(live.tick):
-        if live.STATE.error or time.perf_counter() - t0 > WAIT_S:
-            break
-        redraw()
-        yield 0.25
-    redraw()
-    yield 1.0
+    yield from until_updated(live, viewport, runs)
     result["area_light"] = {"shot": shot("area_light"), "status": live.status(), "error": live.STATE.error,
                             "gpu_runs": viewport.gpu_runs - runs}
 
