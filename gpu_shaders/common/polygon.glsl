@@ -41,8 +41,15 @@ float polygon_irradiance(vec3 p, vec3 n, vec3 v[POLYGON_MAX_VERTICES], int count
     return 0.5 * abs(total);
 }
 
+// How far from a polygon's plane, as a share of the coordinates' magnitude, a receiver counts as lying on
+// it. The emitting surface's own G-buffer pixels lie a few fp32 ulps (1e-7 of the coordinates) to
+// either side of the plane; just off it the polygon fills the receiver's hemisphere (E = pi L), on it the
+// polygon is seen edge-on (E = 0), and Cycles' Diffuse Direct of a glowing surface holds no light from
+// itself. 1e-5 is ~100 ulps, and 0.1 mm in a 10 m scene: no real receiver lies nearer.
+const float ON_PLANE_SHARE = 1e-5;
+
 // Sum over rows [first, first + count) of the table: radiance x E / L, per colour (W/m^2), the rows
-// whose emitting side p does not face left out.
+// whose emitting side p does not face, or whose plane p lies on, left out.
 vec3 emitter_irradiance(sampler2D emitters, int first, int count, vec3 p, vec3 n) {
     vec3 e = vec3(0.0);
     for (int r = first; r < first + count; ++r) {
@@ -54,9 +61,13 @@ vec3 emitter_irradiance(sampler2D emitters, int first, int count, vec3 p, vec3 n
             v[i] = texelFetch(emitters, ivec2(i, r), 0).xyz;
         }
         vec4 rad = texelFetch(emitters, ivec2(POLYGON_MAX_VERTICES, r), 0);
-        float side = dot(cross(v[1] - v[0], v[2] - v[0]), p - v[0]);
-        if (rad.w * side < 0.0 || (rad.w != 0.0 && side == 0.0)) {
+        vec3 face = cross(v[1] - v[0], v[2] - v[0]);
+        float side = dot(face, p - v[0]);
+        if (rad.w * side < 0.0) {
             continue;  // p is behind this polygon's emitting side
+        }
+        if (abs(side) <= ON_PLANE_SHARE * max(length(p), length(v[0])) * length(face)) {
+            continue;  // p lies on the polygon's plane: the emitter itself, or a surface flush with it
         }
         e += rad.rgb * polygon_irradiance(p, n, v, k);
     }

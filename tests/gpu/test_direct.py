@@ -308,3 +308,39 @@ def test_the_floor_beside_a_wall_keeps_its_light(gl):
                 assert img[row, col] == pytest.approx(point_irradiance_over_pi(300.0 / (4 * np.pi), p), rel=1e-4)
                 checked += 1
     assert checked > 1000
+
+
+def test_a_glowing_surface_does_not_light_itself(gl):
+    # A 0.6 m emissive square of radiance L (albedo 0.5, as a Principled BSDF that also glows), tilted
+    # 60 degrees over a floor, seen from above. Exact answers: the square's own pixels get nothing from
+    # it (it lies in their tangent plane; Cycles' Diffuse Direct of an emitter holds no light of its
+    # own), the floor E = L x the polygon's cosine-weighted solid angle (area_light.polygon_irradiance;
+    # nothing blocks). A slanted plane puts the square's G-buffer positions a few fp32 ulps to either
+    # side of it, where the square would fill their hemisphere: before the on-plane test 38 of its 91
+    # pixels read L (measured). fp32: 1e-4 on the floor.
+    radiance = 5.0
+    t = np.radians(60.0)
+    u, v = np.array([1.0, 0.0, 0.0]), np.array([0.0, np.cos(t), np.sin(t)])
+    centre = np.array([0.1, 0.0, 0.35])
+    corners = [centre + 0.3 * a * u + 0.3 * b * v for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+    square = [[corners[0], corners[1], corners[2]], [corners[0], corners[2], corners[3]]]
+    tris = np.array(quad(-1, 1, -1, 1, 0.0) + square, np.float32)
+    normals = np.zeros_like(tris)
+    normals[:2, :, 2] = 1.0
+    normals[2:] = np.cross(u, v)
+    albedo = np.array([[0.8] * 3, [0.8] * 3, [0.5] * 3, [0.5] * 3], np.float32)
+    emission = np.zeros((4, 3), np.float32)
+    emission[2:] = radiance
+    cam = make_scene(None).camera
+    scene = Scene(tris, normals, albedo, emission, [], camera=cam)
+    method = DirectMethod(gl, GIConfig(), RsmConfig(resolution=256))
+    method.set_scene(scene)
+    images = method.run().images
+    img, on_square = images["direct"][..., 0], images["albedo"][..., 0] == 0.5
+    assert on_square.sum() > 80
+    assert np.all(img[on_square] == 0.0)
+    for world in ([-0.6, 0.5, 0.0], [0.7, -0.6, 0.0], [0.1, -0.6, 0.0]):
+        row, col = pixel_of(cam, np.array(world))
+        p = floor_point_at_pixel(cam, row, col)
+        want = radiance * polygon_irradiance(p, np.array([0.0, 0.0, 1.0]), np.array(corners)) / np.pi
+        assert img[row, col] == pytest.approx(want, rel=1e-4)
