@@ -159,7 +159,7 @@ class BlenderGPUBackend(Backend):
             if spec.varyings:
                 iface = gpu.types.GPUStageInterfaceInfo(f"{spec.name}_iface")
                 for v in spec.varyings:
-                    (iface.flat if v.type.startswith("i") else iface.smooth)(v.type.upper(), v.name)
+                    (iface.flat if v.flat else iface.smooth)(v.type.upper(), v.name)
                 info.vertex_out(iface)
             for slot, o in enumerate(spec.outputs):
                 info.fragment_out(slot, o.type.upper(), o.name)

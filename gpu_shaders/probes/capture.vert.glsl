@@ -3,6 +3,7 @@
 void main() {
     gl_Position = view_projection * vec4(pos_ws, 1.0);
     v_pos_ws = pos_ws;
+    v_plane_ws = plane_ws;
     v_normal_ws = normal_ws;
     v_albedo = albedo;
 }

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from addon.engine.config import GatherConfig, ProbesConfig
+from addon.engine.methods.direct import face_planes
 from addon.engine.passes import (
     gather_form_factor,
     gather_quads,
@@ -31,7 +32,8 @@ def _triangles(tris):
     tris = np.asarray(tris, np.float32)
     normals = np.repeat(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), 3, axis=0)
     normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
-    return {"pos_ws": tris.reshape(-1, 3), "normal_ws": normals, "albedo": np.full((len(normals), 3), ALBEDO)}
+    return {"pos_ws": tris.reshape(-1, 3), "plane_ws": np.repeat(face_planes(tris), 3, axis=0), "normal_ws": normals,
+            "albedo": np.full((len(normals), 3), ALBEDO)}
 
 
 def _square(z, half):

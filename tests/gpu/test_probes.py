@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from addon.engine.config import ProbesConfig
+from addon.engine.methods.direct import face_planes
 from addon.engine.passes import probe_capture, probe_lookup, probe_project, probe_relocate
 from addon.engine.probe_grid import RELOCATE_CLEARANCE_RATIO, ProbeGrid, relocation_step
 
@@ -33,7 +34,8 @@ def mesh_of(gl, triangles):
     tris = np.asarray(triangles, np.float32)
     normals = np.repeat(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), 3, axis=0)
     normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
-    attrs = {"pos_ws": tris.reshape(-1, 3), "normal_ws": normals, "albedo": np.full((len(normals), 3), 0.5)}
+    attrs = {"pos_ws": tris.reshape(-1, 3), "plane_ws": np.repeat(face_planes(tris), 3, axis=0), "normal_ws": normals,
+             "albedo": np.full((len(normals), 3), 0.5)}
     return gl.mesh(gl.program(probe_capture.SPEC), attrs, "triangles")
 
 
@@ -291,3 +293,19 @@ def test_a_relocated_probe_is_captured_again_where_it_moved(gl):
     clearance = RELOCATE_CLEARANCE_RATIO
     assert np.all(centre >= clearance - 1e-6)
     assert np.all(centre <= clearance / math.cos(math.atan(math.sqrt(2) / N)) + 1e-6)
+
+
+def test_the_capture_keeps_positions_on_their_triangles_plane(gl):
+    # A probe 1 mm above a 4 m floor at z = 0.37 sees it at grazing angles towards its faces' edges,
+    # where the rasterizer's interpolation left positions up to 4e-4 of their distance off the plane
+    # (the emissive scene's panel, measured), enough for a glowing floor to light itself
+    # (common/polygon.glsl); here up to 21 ulps (measured). Put back on the plane (common/face_plane.glsl)
+    # each lies within 2 ulps of the floor's fp32 height, the rounding of the projection itself.
+    z = np.float32(0.37)
+    grid = ProbeGrid(np.array([0.0, 0.0, float(z) + 1e-3]), 1.0, (1, 1, 1), N)
+    a, b, c, d = [(-2, -2, z), (2, -2, z), (2, 2, z), (-2, 2, z)]
+    atlas, _, _, _ = capture(gl, grid, [[a, b, c], [a, c, d]])
+    pos = gl.read(atlas["position"])
+    seen = pos[..., 3] == 1.0
+    assert seen.sum() >= 2 * N * N  # the lower halves of the four side faces (the face below: within its near plane)
+    assert np.abs(pos[seen][:, 2] - z).max() <= 2 * np.spacing(z)

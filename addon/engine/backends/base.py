@@ -53,10 +53,17 @@ class Image:
 
 @dataclass(frozen=True)
 class Var:
-    """A uniform, vertex attribute, varying or fragment output: GLSL type and name."""
+    """A uniform, vertex attribute, varying or fragment output: GLSL type and name; a varying's
+    interpolation ("smooth", or "flat": the provoking vertex's value, unrounded; integers are always
+    flat)."""
 
     name: str
     type: str
+    interpolation: str = "smooth"
+
+    @property
+    def flat(self) -> bool:
+        return self.interpolation == "flat" or self.type.startswith(("i", "u"))
 
 
 def push_constant_bytes(uniforms: tuple[Var, ...]) -> int:

@@ -29,13 +29,13 @@ def compute_header(spec: ShaderSpec) -> str:
 def vertex_header(spec: ShaderSpec) -> str:
     lines = ["#version 430", *defines(spec), *_uniforms(spec)]
     lines += [f"in {a.type} {a.name};" for a in spec.attributes]
-    lines += [f"out {v.type} {v.name};" for v in spec.varyings]
+    lines += [f"{'flat ' if v.flat else ''}out {v.type} {v.name};" for v in spec.varyings]
     return "\n".join(lines) + "\n"
 
 
 def fragment_header(spec: ShaderSpec) -> str:
     lines = ["#version 430", *defines(spec), *_uniforms(spec)]
-    lines += [f"in {v.type} {v.name};" for v in spec.varyings]
+    lines += [f"{'flat ' if v.flat else ''}in {v.type} {v.name};" for v in spec.varyings]
     lines += [f"layout(location={i}) out {o.type} {o.name};" for i, o in enumerate(spec.outputs)]
     return "\n".join(lines) + "\n"
 

@@ -66,15 +66,28 @@ class Result:
     timings_ms: dict[str, float] = field(default_factory=dict)
 
 
+def face_planes(positions_m: np.ndarray) -> np.ndarray:
+    """(T, 4) float32: each triangle's unit normal and offset d (m; the plane n . x = d) of its fp32
+    vertices, in float64; zeros for a degenerate triangle. The raster passes put their interpolated
+    positions back on this plane (gbuffer.frag.glsl)."""
+    p = np.asarray(positions_m, np.float32).astype(np.float64)
+    normal = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    length = np.linalg.norm(normal, axis=1, keepdims=True)
+    normal = np.divide(normal, length, out=np.zeros_like(normal), where=length > 0)
+    return np.c_[normal, np.einsum("ij,ij->i", normal, p.mean(axis=1))].astype(np.float32)
+
+
 def triangle_attributes(scene: Scene, select: np.ndarray | None = None) -> dict[str, np.ndarray] | None:
     """Per-vertex arrays for the raster passes: three vertices per triangle, flat albedo and glossy lobe
-    (specular: F0, roughness); `select` picks triangles (None: all). None when nothing is left to draw."""
+    (specular: F0, roughness), the triangle's plane (face_planes); `select` picks triangles (None: all).
+    None when nothing is left to draw."""
     sel = np.ones(scene.triangle_count, bool) if select is None else select
     n = int(sel.sum())
     if n == 0:
         return None
     return {
         "pos_ws": scene.positions_m[sel].reshape(n * 3, 3).astype(np.float32),
+        "plane_ws": np.repeat(face_planes(scene.positions_m[sel]), 3, axis=0),
         "normal_ws": scene.normals[sel].reshape(n * 3, 3).astype(np.float32),
         "albedo": np.repeat(scene.albedo[sel].astype(np.float32), 3, axis=0),
         "specular": np.repeat(np.c_[scene.specular_f0()[sel], scene.glossy_roughness()[sel]], 3, axis=0),

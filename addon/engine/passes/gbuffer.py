@@ -1,9 +1,10 @@
 """G-buffer pass: rasterize the scene from the camera.
 
-Inputs: the scene's triangles (mesh attributes pos_ws, normal_ws, albedo). Uniforms: view_projection,
-camera_pos_ws. Outputs (RGBA32F, camera resolution, GL row 0 = bottom): position (world, m; w = 1 where
-geometry), normal (world, unit, flipped towards the camera), albedo (diffuse, linear), specular (rgb = the
-glossy lobe's F0, a = roughness; Scene.specular). Depth: 32F.
+Inputs: the scene's triangles (mesh attributes pos_ws, plane_ws (methods/direct.face_planes), normal_ws,
+albedo, specular). Uniforms: view_projection, camera_pos_ws. Outputs (RGBA32F, camera resolution, GL row
+0 = bottom): position (world, m, on its triangle's plane; w = 1 where geometry), normal (world, unit,
+flipped towards the camera), albedo (diffuse, linear), specular (rgb = the glossy lobe's F0, a =
+roughness; Scene.specular). Depth: 32F.
 """
 
 from __future__ import annotations
@@ -18,8 +19,10 @@ SPEC = ShaderSpec(
     vertex="gbuffer/gbuffer.vert.glsl",
     fragment="gbuffer/gbuffer.frag.glsl",
     uniforms=(Var("view_projection", "mat4"), Var("camera_pos_ws", "vec3")),
-    attributes=(Var("pos_ws", "vec3"), Var("normal_ws", "vec3"), Var("albedo", "vec3"), Var("specular", "vec4")),
-    varyings=(Var("v_pos_ws", "vec3"), Var("v_normal_ws", "vec3"), Var("v_albedo", "vec3"), Var("v_specular", "vec4")),
+    attributes=(Var("pos_ws", "vec3"), Var("plane_ws", "vec4"), Var("normal_ws", "vec3"), Var("albedo", "vec3"),
+                Var("specular", "vec4")),
+    varyings=(Var("v_pos_ws", "vec3"), Var("v_plane_ws", "vec4", "flat"), Var("v_normal_ws", "vec3"),
+              Var("v_albedo", "vec3"), Var("v_specular", "vec4")),
     outputs=(Var("out_position", "vec4"), Var("out_normal", "vec4"), Var("out_albedo", "vec4"),
              Var("out_specular", "vec4")),
 )

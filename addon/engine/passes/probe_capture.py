@@ -69,8 +69,9 @@ SPEC = ShaderSpec(
     vertex="probes/capture.vert.glsl",
     fragment="probes/capture.frag.glsl",
     uniforms=(Var("view_projection", "mat4"), Var("camera_pos_ws", "vec3")),
-    attributes=(Var("pos_ws", "vec3"), Var("normal_ws", "vec3"), Var("albedo", "vec3")),
-    varyings=(Var("v_pos_ws", "vec3"), Var("v_normal_ws", "vec3"), Var("v_albedo", "vec3")),
+    attributes=(Var("pos_ws", "vec3"), Var("plane_ws", "vec4"), Var("normal_ws", "vec3"), Var("albedo", "vec3")),
+    varyings=(Var("v_pos_ws", "vec3"), Var("v_plane_ws", "vec4", "flat"), Var("v_normal_ws", "vec3"),
+              Var("v_albedo", "vec3")),
     outputs=(Var("out_position", "vec4"), Var("out_normal", "vec4"), Var("out_albedo", "vec4")),
 )
 
