@@ -245,7 +245,9 @@ class BlenderGPUBackend(Backend):
         with target.fbo.bind():
             gpu.state.viewport_set(*(viewport if viewport is not None else (0, 0, *target.size)))
             gpu.state.blend_set("ADDITIVE_PREMULT" if blend == "add" else "NONE")
-            gpu.state.depth_test_set("LESS_EQUAL" if depth_test else "NONE")
+            # LESS, as moderngl's default: where two surfaces tie in depth (a probe face's texel on a room's
+            # corner) the first drawn wins on both backends, and the images agree.
+            gpu.state.depth_test_set("LESS" if depth_test else "NONE")
             gpu.state.depth_mask_set(depth_test)
             gpu.state.point_size_set(1.0)
             self._bind(program, uniforms, samplers)
