@@ -68,8 +68,8 @@ def render_all(backend) -> dict[str, np.ndarray]:
 
 
 def main(argv: list[str]) -> int:
-    if len(argv) != 1:
-        print(__doc__.strip().splitlines()[2].strip(), file=sys.stderr)
+    if len(argv) != 1 or argv[0].startswith("-") or not argv[0].endswith(".npz"):
+        print("usage:", __doc__.strip().splitlines()[3].strip(), file=sys.stderr)
         return 2
     from addon.engine.backends.moderngl_backend import ModernGLBackend
 
