@@ -64,7 +64,8 @@ class ProbesMethod(OneBounceMethod):
         self.state = be.texture(grid.state_size)
         self.offset = probe_relocate.allocate(be, grid)
         far = probe_capture.far_m(self.bounds_m)
-        attrs = triangle_attributes(self.scene)  # every triangle: emitters and camera-hidden objects block
+        # every triangle: emitters and camera-hidden objects block
+        attrs = triangle_attributes(self.scene, probe_capture.SPEC)
         mesh = be.mesh(be.program(probe_capture.SPEC), attrs, "triangles") if attrs is not None else None
         tri = self.scene.positions_m
         needed = grid.read_by(tri.min(axis=1), tri.max(axis=1), cfg.normal_bias * grid.spacing_m) \
