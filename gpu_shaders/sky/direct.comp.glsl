@@ -1,6 +1,7 @@
 // The sky's direct diffuse light at every G-buffer pixel in one pass: a loop over the sky directions
 // (world.py's regions of the world map, each along its vector irradiance), each shadowed by its tile of
-// the sky atlas. Added to `direct`, in Cycles' Diffuse Direct unit: irradiance / pi.
+// the sky atlas. Added to `direct` (or, with accumulate = 0, replacing it), in Cycles' Diffuse Direct unit:
+// irradiance / pi.
 //
 // sky_table, one row per direction: texels 0-3 the rows of its orthographic view-projection, texel 4
 // (axis the light travels along, texel size in m), texel 5 (irradiance normal to it, W/m^2 per colour;
@@ -102,6 +103,6 @@ void main() {
         }
         sum += light_texel.rgb * (cos_n * lit);
     }
-    vec4 acc = imageLoad(direct, px);
+    vec4 acc = accumulate != 0 ? imageLoad(direct, px) : vec4(0.0);
     imageStore(direct, px, acc + vec4(sum / PI, 0.0));
 }

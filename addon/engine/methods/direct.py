@@ -107,6 +107,9 @@ class DirectMethod:
               "gather": (sky_light.DIRECT_DECL, direct_light.DECL)}
     # Products of a stochastic gather, filtered after it when GIConfig.denoise (passes/denoise.py).
     NOISY: tuple[str, ...] = ()
+    # Whether the world's bounce comes from its suns' RSMs (light_views): a method that shades its own
+    # surfaces with the sky pass instead (probes) draws none.
+    WORLD_SUN_RSMS = True
 
     def __init_subclass__(cls, **kwargs):
         # A method's name, products and bounce limit are its registry entry's: declared once.
@@ -160,8 +163,8 @@ class DirectMethod:
         self._sun_shadows: dict[int, tuple[dict, object]] = {}  # slot -> a sun's own shadow map (made on use)
         self._emitter_rows = None  # the emitter table on the GPU (light_views)
         self._world_key, self._world_suns = None, []
-        self._world_map, self._sky_suns_key, self._sky_suns = None, None, []  # sky_suns()
-        self._sky_key, self._sky = None, None  # the sky directions' table and atlas (sky())
+        self._world_map = None
+        self._skies: dict[int, sky_light.SkyShadows] = {}  # sky(): per most directions asked for
         self.vpl_shares: dict[int, float] = {}
         self._solved_for = None  # lights_key of the light field on the GPU; None: none is
         self.solves = 0          # how many updates solved (bakes report it)
@@ -227,39 +230,31 @@ class DirectMethod:
             self._world_suns = world.world_suns(world_map, count) if count and world_map is not None else []
         return self._world_suns
 
-    def sky_suns(self) -> list:
-        """The sky's directions (world.py's regions split by power x width), as many as the world's
-        share of the scene's light asks (world.sky_direction_count), remade when that count or the
-        world changes."""
+    def sky(self, most: int | None = None) -> sky_light.SkyShadows | None:
+        """The sky's directions (world.py's regions split by power x width) on the GPU, as many as the
+        world's share of the scene's light asks (world.sky_direction_count) and at most `most`
+        (RsmConfig.sky_directions by default); None without a world. Remade when the world or that
+        count changes (the bounds change only with set_scene, which resets them)."""
         suns = self.world_suns()
-        lo, hi = self.bounds_m
-        count = world.sky_direction_count(suns, [*self.source.lights, *self.emissive], self.rsm_config.sky_directions,
-                                          min(SKY_DIRECTIONS_LEAST, self.rsm_config.sky_directions),
-                                          0.5 * float(np.linalg.norm(hi - lo)))
-        if (self._world_key, count) != self._sky_suns_key:
-            self._sky_suns_key = (self._world_key, count)
-            self._sky_suns = world.world_suns(self._world_map, count, by_width=True) if count else []
-        return self._sky_suns
-
-    def sky(self) -> tuple[sky_light.SkyLayout, object, list] | None:
-        """The sky's directions (sky_suns) as the sky pass needs them: (layout, table texture, shadow
-        draws); None without a world. Remade when they change (the bounds change only with set_scene,
-        which resets them). The atlas (about 20 MB at 256 directions of 64^2 texels) is outside the
-        RSM_KEEP_BYTES budget."""
-        suns = self.sky_suns()
         if not suns:
             return None
-        if self._sky_key != self._sky_suns_key:
-            layout = sky_light.SkyLayout.of(len(suns), self.rsm_config.sky_texels)
-            rows, draws = sky_light.table(suns, self.bounds_m, layout.tile_texels)
-            be = self.backend
-            if self._sky is None or self._sky[0] != layout:
-                self.sky_atlas = be.texture(layout.size)
-                self.sky_bounds = be.texture(layout.blocks)
-                self._sky_target = be.target([self.sky_atlas], be.depth_texture(layout.size))
-            self._sky = (layout, be.texture((rows.shape[1], rows.shape[0]), data=rows), draws)
-            self._sky_key = self._sky_suns_key
-        return self._sky
+        most = self.rsm_config.sky_directions if most is None else most
+        lo, hi = self.bounds_m
+        count = world.sky_direction_count(suns, [*self.source.lights, *self.emissive], most,
+                                          min(SKY_DIRECTIONS_LEAST, most), 0.5 * float(np.linalg.norm(hi - lo)))
+        key = (self._world_key, count)
+        shadows = next((s for s in self._skies.values() if s.key == key), None)  # another `most`'s: drawn once
+        if shadows is None:
+            shadows = self._skies.setdefault(most, sky_light.SkyShadows())
+            shadows.update(self.backend, key, world.world_suns(self._world_map, count, by_width=True), self.bounds_m,
+                           self.rsm_config.sky_texels)
+        return shadows if shadows.layout is not None else None
+
+    def skies(self) -> list[sky_light.SkyShadows]:
+        """Every set of sky directions an update shades with (the solve draws their shadow maps): the
+        camera's."""
+        sky = self.sky()
+        return [sky] if sky is not None else []
 
     def light_key(self) -> tuple:
         """What a light field is solved for: the lights and the world."""
@@ -324,7 +319,7 @@ class DirectMethod:
         # gather of vpl_samples per face of each of 32 suns made rsm ten times slower on Sponza. Their
         # RSMs are the world's bounce only (its direct light is the sky pass's, `sky`): a method without
         # indirect light draws none.
-        suns = self.world_suns() if "indirect" in self.products else []
+        suns = self.world_suns() if "indirect" in self.products and self.WORLD_SUN_RSMS else []
         powers = np.array([s.sun_strength * float(s.color @ world.LUMA) for s in suns])
         self.vpl_shares = {len(lights) + i: p / powers.sum() for i, p in enumerate(powers)} if suns else {}
         lights += suns
@@ -427,23 +422,31 @@ class DirectMethod:
         self.finish_solve(timings)
 
     def _draw_sky(self, timings: dict[str, float]) -> None:
-        """Every sky direction's shadow map into the sky atlas (solve half); nothing without a world."""
-        sky = self.sky()
-        if sky is not None:
+        """Every sky direction's shadow map into its sky atlas (solve half); nothing without a world."""
+        for sky in self.skies():
             with self.step(timings, sky_light.SHADOW_DECL):
-                sky_light.shadow(self.backend, self._sky_target, self._meshes[sky_light.SHADOW_SPEC.name], sky[0],
-                                 sky[2])
+                sky_light.shadow(self.backend, sky.target, self._meshes[sky_light.SHADOW_SPEC.name], sky.layout,
+                                 sky.draws)
             with self.step(timings, sky_light.BOUNDS_DECL):
-                sky_light.bounds(self.backend, self.sky_atlas, self.sky_bounds, sky[0])
+                sky_light.bounds(self.backend, sky.atlas, sky.bounds, sky.layout)
 
     def _sky_direct(self, timings: dict[str, float]) -> None:
         """The sky's direct light of every direction, in one pass, into `direct` (gather half)."""
-        sky = self.sky()
-        if sky is not None:
-            with self.step(timings, sky_light.DIRECT_DECL):
-                diagonal_m = float(np.linalg.norm(self.bounds_m[1] - self.bounds_m[0]))
-                sky_light.direct(self.backend, self.gbuf["position"], self.gbuf["normal"], self.sky_atlas,
-                                 self.sky_bounds, sky[1], self.direct, sky[0], diagonal_m)
+        self.shade_sky(timings, sky_light.DIRECT_DECL, self.gbuf["position"], self.gbuf["normal"], self.direct)
+
+    def shade_sky(self, timings: dict[str, float], decl, position, normal, out, accumulate: bool = True,
+                  most: int | None = None) -> bool:
+        """The sky's direct light (`sky(most)`) at the surfaces `position` / `normal` hold, into `out`
+        (added, or replacing at those that hold one), timed as `decl`; False (nothing written) without a
+        world."""
+        sky = self.sky(most)
+        if sky is None:
+            return False
+        with self.step(timings, decl):
+            diagonal_m = float(np.linalg.norm(self.bounds_m[1] - self.bounds_m[0]))
+            sky_light.direct(self.backend, position, normal, sky.atlas, sky.bounds, sky.table, out, sky.layout,
+                             diagonal_m, accumulate)
+        return True
 
     def _gather(self, views: list[LightView], timings: dict[str, float], slots, first: bool = True) -> None:
         self._bind_gather_targets()

@@ -2,8 +2,8 @@
 Szirmay-Kalos, "Robust diffuse final gathering on the GPU", seeds 001). docs/GATHER.md.
 
 The probes' grid is the paper's set of reference points: setup is the probes' (their atlas G-buffer of
-every probe's six faces, the distance moments), and so is the solve's shading (the direct pass on the
-atlas per light face). The solve then turns every probe face into M x M quad lights (gather_texels,
+every probe's six faces, the distance moments), and so is the solve's shading (the sky pass and the
+direct pass per light face on the atlas). The solve then turns every probe face into M x M quad lights (gather_texels,
 gather_quads: GatherConfig.face_quads), and the gather sums, at every pixel or lightmap texel, each
 quad's radiance times its form factor there, over the probes around it weighted as `probes` weighs
 them (gather_form_factor). Bounces 2..N: the probes' own bounces (their SH field, docs/PROBES.md)

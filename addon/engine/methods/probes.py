@@ -6,7 +6,8 @@ ProbesConfig.probes_per_side); probe_capture rasterizes every probe's six faces 
 (position, normal, albedo); with ProbesConfig.relocate, probe_relocate moves probes out of solids and
 off near surfaces and the moved ones are captured again (probe_grid.RELOCATE_ROUNDS times); then the
 distance moments of each atlas texel and which probes sit inside geometry. Solve (per light change):
-per light face probe_direct (the direct pass on the atlas), then probe_project (albedo x direct -> L2
+with a world, probe_sky (the sky pass on the atlas, ProbesConfig.atlas_sky_directions), then per light
+face probe_direct (the direct pass on the atlas), then probe_project (albedo x direct -> L2
 SH per probe); each further bounce reads the field back at the atlas (probe_lookup.bounce) and
 re-projects with it (GIConfig.bounces = N: N projections). Gather (per camera move, per lightmap): the
 direct pass on the G-buffer, then probe_lookup -> `indirect` (Cycles' Diffuse Indirect units). The light
@@ -28,10 +29,11 @@ from .direct import OneBounceMethod, triangle_attributes
 
 class ProbesMethod(OneBounceMethod):
     spec = registry.get("probes")
+    WORLD_SUN_RSMS = False
     PASSES = declare.extend(
         OneBounceMethod.PASSES, setup=(probe_capture.CAPTURE_DECL, probe_relocate.DECL, probe_capture.MOMENTS_DECL),
         # The SH encoding's passes, then the irradiance encoding's (ProbesConfig.encoding picks one).
-        solve=(probe_project.SHADE_DECL, probe_project.PROJECT_DECL, probe_lookup.BOUNCE_DECL,
+        solve=(probe_project.SKY_DECL, probe_project.SHADE_DECL, probe_project.PROJECT_DECL, probe_lookup.BOUNCE_DECL,
                probe_project.REPROJECT_DECL, probe_project.CONVOLVE_DECL, probe_lookup.IRRADIANCE_BOUNCE_DECL,
                probe_project.RECONVOLVE_DECL),
         gather=(probe_lookup.DECL, probe_lookup.IRRADIANCE_DECL))
@@ -109,8 +111,18 @@ class ProbesMethod(OneBounceMethod):
 
     def begin_solve(self, timings: dict[str, float]) -> None:
         # No zeroing pass over the atlas (1.57 M texels on cornell, ~27 ms on llvmpipe): the first face
-        # replaces the last solve's light.
-        self._faces_shaded = 0
+        # replaces the last solve's light; the sky, when there is one, is that first face.
+        self._faces_shaded = int(self.shade_sky(timings, probe_project.SKY_DECL, self.atlas["position"],
+                                                self.atlas["normal"], self.atlas_direct, accumulate=False,
+                                                most=self.probes_config.atlas_sky_directions))
+
+    def skies(self) -> list:
+        """The camera's sky directions and the atlas's (ProbesConfig.atlas_sky_directions)."""
+        skies = super().skies()
+        atlas_sky = self.sky(self.probes_config.atlas_sky_directions)
+        if atlas_sky is not None and not any(atlas_sky is sky for sky in skies):  # the same directions: one draw
+            skies.append(atlas_sky)
+        return skies
 
     def solve_view(self, view: LightView, timings: dict[str, float]) -> None:
         with self.step(timings, probe_project.SHADE_DECL):

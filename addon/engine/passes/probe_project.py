@@ -21,6 +21,7 @@ from . import direct_light
 from .declare import EMITTERS, LIGHT_VIEWS, RSM_NORMAL, RSM_POSITION, PassDecl, Port
 from .light_views import LightView
 from .probe_capture import ATLAS_ALBEDO, ATLAS_NORMAL, ATLAS_POSITION, ATLAS_UNIFORMS, grid_uniforms
+from .sky_light import SKY_BOUNDS, SKY_DEPTH, SKY_TABLE
 
 ATLAS_DIRECT = Port("probes", "direct", "RGBA32F", "probe_atlas", "irradiance / pi at the surface a texel sees")
 ATLAS_INDIRECT = Port("probes", "indirect", "RGBA32F", "probe_atlas",
@@ -34,6 +35,8 @@ IRRADIANCE_TEXELS = 4  # m: each face of a probe's irradiance cube map is m x m 
 SHADE_DECL = PassDecl("probe_direct", "solve", (ATLAS_POSITION, ATLAS_NORMAL, RSM_POSITION, RSM_NORMAL, LIGHT_VIEWS,
                                                 EMITTERS),
                       (ATLAS_DIRECT,), "one light face's shadow-mapped direct light on the probe atlas, added")
+SKY_DECL = PassDecl("probe_sky", "solve", (ATLAS_POSITION, ATLAS_NORMAL, SKY_DEPTH, SKY_BOUNDS, SKY_TABLE),
+                    (ATLAS_DIRECT,), "the sky's shadowed direct light on the probe atlas (sky_light.direct), first")
 PROJECT_DECL = PassDecl("probe_project", "solve", (ATLAS_ALBEDO, ATLAS_DIRECT), (SH,),
                         "the atlas shaded and projected to L2 SH per probe (first bounce)")
 REPROJECT_DECL = PassDecl("probe_reproject", "solve", (ATLAS_ALBEDO, ATLAS_DIRECT, ATLAS_INDIRECT), (SH,),

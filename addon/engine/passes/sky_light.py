@@ -13,7 +13,8 @@ along the direction's axis (m), w = 1 where geometry.
 bounds (solve half): per block of BLOCK_TEXELS^2 texels, the least and greatest depth of the 3 x 3
 blocks around it: a receiver in front of all of them is lit, behind all of them shadowed, in one fetch.
 direct (gather half): per G-buffer pixel, sum over directions of E_k max(0, n . l_k) x the bilinear
-percentage-closer visibility of its tile, / pi, added to `direct`.
+percentage-closer visibility of its tile, / pi, added to `direct`. The probes run it in their solve
+on their atlas G-buffer (probe_project.SKY_DECL), with a set of directions of its own (SkyShadows).
 The table (one row per direction, `TABLE_TEXELS` RGBA32F texels): the view-projection's rows, the axis
 with the texel size (m), the irradiance normal to the axis (W/m^2 per colour).
 """
@@ -65,7 +66,7 @@ DIRECT_SPEC = ShaderSpec(
               Sampler("sky_bounds", "2D"), Sampler("sky_table", "2D")),
     images=(Image("direct", "2D", "RGBA32F", "read_write"),),
     uniforms=(Var("sky_count", "int"), Var("tiles_x", "int"), Var("tile_texels", "int"),
-              Var("scene_diagonal_m", "float")),
+              Var("scene_diagonal_m", "float"), Var("accumulate", "int")),
 )
 
 SKY_TABLE = Port("scene", "sky_table", "RGBA32F", "table",
@@ -114,6 +115,33 @@ class SkyLayout:
         return (k % self.tiles_x) * n, (k // self.tiles_x) * n, n, n
 
 
+class SkyShadows:
+    """One set of sky directions on the GPU, as the passes need them: the table, the shadow atlas and its
+    bounds, and each direction's draw. Remade only when the directions change (`update`); the atlas
+    (about 20 MB at 256 directions of 64^2 texels, outside the methods' RSM_KEEP_BYTES budget) only when
+    their layout does."""
+
+    def __init__(self):
+        self.key = None  # what the directions were made from (the world and their count)
+        self.layout: SkyLayout | None = None
+
+    def update(self, backend: Backend, key, suns: list[Light], bounds: tuple[np.ndarray, np.ndarray],
+               texels: int) -> None:
+        """Make the table and draws of `suns` (their tiles `texels` a side), remembered as `key`; no suns
+        (a world whose regions all carry no light): no layout, nothing to draw."""
+        if not suns:
+            self.layout, self.key = None, key
+            return
+        layout = SkyLayout.of(len(suns), texels)
+        rows, self.draws = table(suns, bounds, layout.tile_texels)
+        if layout != self.layout:
+            self.atlas = backend.texture(layout.size)
+            self.bounds = backend.texture(layout.blocks)
+            self.target = backend.target([self.atlas], backend.depth_texture(layout.size))
+        self.table = backend.texture((rows.shape[1], rows.shape[0]), data=rows)
+        self.layout, self.key = layout, key
+
+
 def table(suns: list[Light], bounds: tuple[np.ndarray, np.ndarray], tile_texels: int) -> tuple[np.ndarray, list]:
     """The sky table (rows, TABLE_TEXELS, 4) float32 and each direction's (view_projection, axis) for its
     shadow draw; the views are those of a sun's RSM (light_views._sun_view) at the tile's size."""
@@ -147,12 +175,14 @@ def bounds(backend: Backend, atlas, out, layout: SkyLayout) -> None:
 
 
 def direct(backend: Backend, gbuf_position, gbuf_normal, atlas, sky_bounds, sky_table, out, layout: SkyLayout,
-           scene_diagonal_m: float) -> None:
+           scene_diagonal_m: float, accumulate: bool = True) -> None:
     """`scene_diagonal_m`: the bounds' diagonal, the farthest a blocker can be from its receiver (it
-    sizes the blocker search: the widest penumbra)."""
+    sizes the blocker search: the widest penumbra). accumulate: add to `out`; False: replace its pixels
+    that see geometry (those that see none are not written)."""
     backend.dispatch(backend.program(DIRECT_SPEC), group_count(out.size, DIRECT_SPEC.local_size),
                      uniforms={"sky_count": layout.count, "tiles_x": layout.tiles_x,
-                               "tile_texels": layout.tile_texels, "scene_diagonal_m": scene_diagonal_m},
+                               "tile_texels": layout.tile_texels, "scene_diagonal_m": scene_diagonal_m,
+                               "accumulate": int(accumulate)},
                      samplers={"gbuf_position": gbuf_position, "gbuf_normal": gbuf_normal,
                                "sky_depth_atlas": atlas, "sky_bounds": sky_bounds, "sky_table": sky_table},
                      images={"direct": out})
