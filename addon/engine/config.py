@@ -76,9 +76,11 @@ class RsmConfig(_Validated):
     # (area_light.py, docs/DIRECT.md).
     area_patches: int = _num(2, 1, 8, "patches per side an area light is split into, each with its own soft shadows")
     # The world's bounce: this many suns, each a region of the sky with its exact vector irradiance
-    # (world.py) and its own RSM face (the VPLs every indirect method reads): 16 kept Sponza's update
-    # near 0.7 s on llvmpipe (32: 1.4 s); 0 leaves the world out (no direct light from it either).
-    world_suns: int = _num(16, 0, 256, "suns the world's bounce is split into (0: the world does not light)")
+    # (world.py) and its own RSM face (the VPLs of rsm, lpv and diffusion; vct and probes take the sky
+    # pass's directions instead): 16 kept Sponza's update near 0.7 s on llvmpipe (32: 1.4 s); 0 leaves
+    # the world out (no direct light from it either).
+    world_suns: int = _num(16, 0, 256, "suns the world's bounce is split into for rsm, lpv and diffusion (0: the "
+                           "world lights no method)")
     # A sun's RSM spans the whole scene, so at `resolution` its texels are coarse where the camera looks
     # closely: a window's sunlit patch came out a camera pixel off along one edge (window-room, direct
     # rel_rmse_8 0.298 at 256 texels). Its direct light reads a shadow map of its own at this size

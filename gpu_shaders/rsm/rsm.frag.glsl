@@ -1,7 +1,8 @@
 // Each RSM texel is a VPL: position, normal (facing the light; w = the surfel's area in m^2) and
 // reflected flux (W). Flux = albedo * I(w) * texel solid angle (perspective: texel_scale * cos^3 of
 // the angle to the face axis, no 1/r^2) or albedo * E * texel area (sun: texel_scale = area in m^2).
-// Surfel area = the texel's footprint on the surface: solid angle * r^2 / cos, or area / cos for a sun.
+// Surfel area = the texel's footprint on the surface: solid angle * r^2 / cos, or area / cos for a sun,
+// times area_weight (1; a sky RSM tile's share of the sky's power, passes/sky_light.table).
 #include "common/light.glsl"
 
 void main() {
@@ -42,6 +43,6 @@ void main() {
         }
     }
     out_position = vec4(v_pos_ws, 1.0);
-    out_normal = vec4(n, area_m2);
+    out_normal = vec4(n, area_m2 * area_weight);
     out_flux = vec4(flux, 0.0);
 }

@@ -311,22 +311,6 @@ def test_the_capture_keeps_positions_on_their_triangles_plane(gl):
     assert np.abs(pos[seen][:, 2] - z).max() <= 2 * np.spacing(z)
 
 
-def _room_with_a_roof_opening(hole_m):
-    """A closed 2 x 2 x 1.5 m room (zero-thickness faces) whose roof has a square opening of side
-    `hole_m` at its centre: the four roof strips around it, and the opening's outline."""
-    from hard_scenes import parts, rect
-
-    a, h = 0.5 * hole_m, 1.5
-    roof = [rect([-1, -1, h], [2, 0, 0], [0, 1 - a, 0]), rect([-1, a, h], [2, 0, 0], [0, 1 - a, 0]),
-            rect([-1, -a, h], [1 - a, 0, 0], [0, 2 * a, 0]), rect([a, -a, h], [1 - a, 0, 0], [0, 2 * a, 0])]
-    walls = [rect([-1, -1, 0], [0, 2, 0], [2, 0, 0]), rect([-1, -1, 0], [2, 0, 0], [0, 0, h]),
-             rect([-1, 1, 0], [0, 0, h], [2, 0, 0]), rect([-1, -1, 0], [0, 0, h], [0, 2, 0]),
-             rect([1, -1, 0], [0, 2, 0], [0, 0, h])]
-    geometry = parts(*[(t, n, 0.5) for t, n in roof + walls])
-    outline = np.array([[-a, -a, h], [a, -a, h], [a, a, h], [-a, a, h]])
-    return geometry, outline
-
-
 def test_the_probes_see_the_skys_light_through_an_opening(gl):
     # A uniform sky of radiance L over a closed room whose roof has a 0.6 m opening: a floor point gets
     # E / pi = L x (the opening's cosine-weighted solid angle) / pi (area_light.polygon_irradiance,
@@ -341,7 +325,7 @@ def test_the_probes_see_the_skys_light_through_an_opening(gl):
     from pathlib import Path
 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "hard"))
-    from hard_scenes import camera
+    from hard_scenes import camera, room_with_a_roof_opening
     from hard_scenes import scene as make_scene
 
     from addon.engine import methods
@@ -350,7 +334,7 @@ def test_the_probes_see_the_skys_light_through_an_opening(gl):
     from addon.engine.world import constant_map
 
     radiance = 2.0
-    geometry, outline = _room_with_a_roof_opening(0.6)
+    geometry, outline = room_with_a_roof_opening(0.6)
     sc = replace(make_scene(geometry, [], camera([0, -0.9, 1.0], [0, 1, -0.5], size=16)),
                  world_map=constant_map(np.full(3, radiance, np.float32)))
     method = methods.create(gl, {"gi": GIConfig(method="probes"), "rsm": RsmConfig(resolution=64),

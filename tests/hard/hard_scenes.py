@@ -150,6 +150,20 @@ def products(images):
     return {k: v for k, v in images.items() if k in ("direct", "indirect")}
 
 
+def room_with_a_roof_opening(hole_m):
+    """A closed 2 x 2 x 1.5 m room (zero-thickness faces) whose roof has a square opening of side
+    `hole_m` at its centre: the four roof strips around it, and the opening's outline."""
+    a, h = 0.5 * hole_m, 1.5
+    roof = [rect([-1, -1, h], [2, 0, 0], [0, 1 - a, 0]), rect([-1, a, h], [2, 0, 0], [0, 1 - a, 0]),
+            rect([-1, -a, h], [1 - a, 0, 0], [0, 2 * a, 0]), rect([a, -a, h], [1 - a, 0, 0], [0, 2 * a, 0])]
+    walls = [rect([-1, -1, 0], [0, 2, 0], [2, 0, 0]), rect([-1, -1, 0], [2, 0, 0], [0, 0, h]),
+             rect([-1, 1, 0], [0, 0, h], [2, 0, 0]), rect([-1, -1, 0], [0, 0, h], [0, 2, 0]),
+             rect([1, -1, 0], [0, 2, 0], [0, 0, h])]
+    geometry = parts(*[(t, n, 0.5) for t, n in roof + walls])
+    outline = np.array([[-a, -a, h], [a, -a, h], [a, a, h], [-a, a, h]])
+    return geometry, outline
+
+
 def room(s=1.0, offset=(0.0, 0.0, 0.0), albedo=0.7):
     """An open-top room [-1, 1]^2 x [0, 2] (x s, + offset) with a block [-.3, .3]^2 x [0, .5] on its floor
     casting shadows, walls tinted so the bounce carries colour."""

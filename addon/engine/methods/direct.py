@@ -426,7 +426,7 @@ class DirectMethod:
         for sky in self.skies():
             with self.step(timings, sky_light.SHADOW_DECL):
                 sky_light.shadow(self.backend, sky.target, self._meshes[sky_light.SHADOW_SPEC.name], sky.layout,
-                                 sky.draws)
+                                 sky.views)
             with self.step(timings, sky_light.BOUNDS_DECL):
                 sky_light.bounds(self.backend, sky.atlas, sky.bounds, sky.layout)
 

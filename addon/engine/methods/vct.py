@@ -19,7 +19,19 @@ from __future__ import annotations
 from .. import registry
 from ..config import VctConfig
 from ..grid import Grid
-from ..passes import accumulate, atlas, declare, denoise, vct_gather, vct_inject, vct_pyramid, voxelize, zero
+from ..passes import (
+    accumulate,
+    atlas,
+    declare,
+    denoise,
+    rsm,
+    sky_light,
+    vct_gather,
+    vct_inject,
+    vct_pyramid,
+    voxelize,
+    zero,
+)
 from ..passes.atlas import Atlas
 from ..passes.light_views import LightView
 from ..passes.vct_inject import DIRECTIONS
@@ -30,9 +42,13 @@ from .direct import OneBounceMethod
 class VctMethod(OneBounceMethod):
     spec = registry.get("vct")
     PASSES = declare.extend(OneBounceMethod.PASSES, setup=(voxelize.DECL,),
-                            solve=(vct_inject.DECL, vct_pyramid.DECL, vct_gather.BOUNCE_DECL, vct_pyramid.DECL),
+                            solve=(vct_inject.DECL, sky_light.RSM_DECL, vct_inject.SKY_DECL, vct_pyramid.DECL,
+                                   vct_gather.BOUNCE_DECL, vct_pyramid.DECL),
                             gather=(vct_gather.PIXELS_DECL, vct_gather.GLOSSY_DECL, accumulate.DECL, denoise.DECL))
     NOISY = ("indirect", "ao", "glossy")
+    # The world's bounce: the camera's sky directions, each an RSM tile of the sky atlas, injected at
+    # once (inject_sky), not RsmConfig.world_suns suns one RSM and injection each (docs/VCT.md).
+    WORLD_SUN_RSMS = False
 
     def __init__(self, backend, gi, rsm_config, vct_config: VctConfig | None = None):
         super().__init__(backend, gi, rsm_config)
@@ -61,6 +77,7 @@ class VctMethod(OneBounceMethod):
         self.light_flux = vct_pyramid.direction_textures(be, self.atlas.size)
         self._light_target = be.target([self.light_flux[d] for d in DIRECTIONS])
         self._pending_light: int | None = None
+        self._sky_points = None  # (size, point mesh) of the sky's RSM tiles (inject_sky)
         filtered = cfg.filtered_injection
         self._points = atlas.texel_points(be, self.rsm_config.resolution, vct_inject.spec(filtered),
                                           vct_inject.points_per_texel(filtered))
@@ -131,7 +148,29 @@ class VctMethod(OneBounceMethod):
         if self._pending_light is not None:
             with self.step(timings, vct_inject.DECL):
                 self._flush_light()
+        self.inject_sky(timings)
         self.bounce_light(timings)
+
+    def inject_sky(self, timings: dict[str, float]) -> None:
+        """The world's VPLs: every sky direction's RSM into its tile (sky_rsm), all tiles splatted and
+        capped as one light (each tile's surfel areas weighted by its share of the sky's power,
+        sky_light.table, so a surface every direction lights counts its area once); nothing without a
+        world."""
+        sky = self.sky()
+        if sky is None:
+            return
+        textures, target = sky.rsm_target(self.backend)
+        with self.step(timings, sky_light.RSM_DECL):
+            sky_light.rsm_tiles(self.backend, target, self._meshes[rsm.SPEC.name], sky.layout, sky.views)
+        with self.step(timings, vct_inject.SKY_DECL):
+            filtered = self.vct_config.filtered_injection
+            size = sky.layout.size
+            if self._sky_points is None or self._sky_points[0] != size:
+                self._sky_points = (size, atlas.texel_points(self.backend, size, vct_inject.spec(filtered),
+                                                             vct_inject.points_per_texel(filtered)))
+            vct_inject.run(self.backend, self._light_target, self._sky_points[1], textures, self.grid, self.atlas,
+                           self.voxels["vox_projected"] if filtered else None)
+            self._flush_light()
 
     def gather_pixels(self, timings: dict[str, float]) -> None:
         with self.step(timings, vct_gather.PIXELS_DECL):

@@ -49,11 +49,12 @@ def splat_spec(name: str, vertex: str, fragment: str, varyings: tuple, outputs: 
     )
 
 
-def texel_points(backend: Backend, resolution: int, spec: ShaderSpec, copies: int = 1):
+def texel_points(backend: Backend, resolution: int | tuple[int, int], spec: ShaderSpec, copies: int = 1):
     """The point mesh: `copies` consecutive vertices per RSM texel (its integer coordinates, attribute
-    `texel`; a program tells the copies apart by gl_VertexID % copies), made once per RSM size for the
-    splatting program `spec`."""
-    j, i = np.mgrid[0:resolution, 0:resolution]
+    `texel`; a program tells the copies apart by gl_VertexID % copies), made once per RSM size (square,
+    or (width, height)) for the splatting program `spec`."""
+    width, height = (resolution, resolution) if isinstance(resolution, int) else resolution
+    j, i = np.mgrid[0:height, 0:width]
     texels = np.stack([i.ravel(), j.ravel()], axis=1).astype(np.float32)
     texels = np.repeat(texels, copies, axis=0)
     return backend.mesh(backend.program(spec), {"texel": texels}, "points")

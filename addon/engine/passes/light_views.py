@@ -192,6 +192,8 @@ def _common_uniforms(light: Light, emit_axis: np.ndarray, texel_scale: float) ->
         # A light with a shape: the disc it looks like, its shadows' penumbra (direct_light's soft shadows).
         "emitter_radius_m": emitter_radius_m(light.emitter, closed=light.kind != "AREA")
         if light.emitter is not None else 0.0,
+        # The RSM's surfel areas are scaled by it: 1 but in the sky's RSM tiles (sky_light.table).
+        "area_weight": 1.0,
     }
 
 

@@ -25,7 +25,7 @@ SPEC = ShaderSpec(
         Var("face_axis", "vec3"), Var("light_kind", "int"),
         Var("emit_axis", "vec3"), Var("spot_cos_half", "float"),
         Var("light_color_intensity", "vec3"), Var("spot_blend", "float"),
-        Var("occluder_radius", "float"),
+        Var("occluder_radius", "float"), Var("area_weight", "float"),
     ),
     attributes=(Var("pos_ws", "vec3"), Var("normal_ws", "vec3"), Var("albedo", "vec3")),
     varyings=(Var("v_pos_ws", "vec3"), Var("v_normal_ws", "vec3"), Var("v_albedo", "vec3")),

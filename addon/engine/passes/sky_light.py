@@ -28,6 +28,8 @@ import numpy as np
 
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..scene import Light
+from ..world import LUMA
+from . import rsm
 from .declare import DIRECT, GBUF_NORMAL, GBUF_POSITION, TRIANGLES, PassDecl, Port
 from .light_views import views_for
 
@@ -77,10 +79,17 @@ SKY_DEPTH = Port("sky", "depth", "RGBA32F", "sky_atlas",
 SKY_BOUNDS = Port("sky", "bounds", "RGBA32F", "sky_blocks",
                   "per block of BLOCK_TEXELS^2 atlas texels: least, greatest depth (m) over its 3 x 3 blocks")
 
+SKY_RSM = (Port("sky", "rsm_position", "RGBA32F", "sky_atlas", "world position (m), w = 1 where geometry"),
+           Port("sky", "rsm_normal", "RGBA32F", "sky_atlas",
+                "world normal, facing the direction; w = surfel area (m^2) x the direction's power share"),
+           Port("sky", "rsm_flux", "RGBA32F", "sky_atlas", "W reflected by the texel's surfel"))
+
 SHADOW_DECL = PassDecl("sky_shadow", "solve", (TRIANGLES, SKY_TABLE), (SKY_DEPTH,),
                        "every sky direction's small shadow map, into its tile of one atlas")
 BOUNDS_DECL = PassDecl("sky_bounds", "solve", (SKY_DEPTH,), (SKY_BOUNDS,),
                        "the atlas's depth bounds per block: most directions settled in one fetch")
+RSM_DECL = PassDecl("sky_rsm", "solve", (TRIANGLES, SKY_TABLE), SKY_RSM,
+                    "every sky direction's RSM into its tile: the world's VPLs (vct)")
 DIRECT_DECL = PassDecl("sky_direct", "gather", (GBUF_POSITION, GBUF_NORMAL, SKY_DEPTH, SKY_BOUNDS, SKY_TABLE),
                        (DIRECT,), "the sky's shadowed direct light of every direction, in one pass, added")
 
@@ -117,13 +126,14 @@ class SkyLayout:
 
 class SkyShadows:
     """One set of sky directions on the GPU, as the passes need them: the table, the shadow atlas and its
-    bounds, and each direction's draw. Remade only when the directions change (`update`); the atlas
+    bounds, and each direction's view. Remade only when the directions change (`update`); the atlas
     (about 20 MB at 256 directions of 64^2 texels, outside the methods' RSM_KEEP_BYTES budget) only when
     their layout does."""
 
     def __init__(self):
         self.key = None  # what the directions were made from (the world and their count)
         self.layout: SkyLayout | None = None
+        self.rsm = None  # (textures, target) of the directions' RSM tiles, rsm_target()
 
     def update(self, backend: Backend, key, suns: list[Light], bounds: tuple[np.ndarray, np.ndarray],
                texels: int) -> None:
@@ -133,37 +143,68 @@ class SkyShadows:
             self.layout, self.key = None, key
             return
         layout = SkyLayout.of(len(suns), texels)
-        rows, self.draws = table(suns, bounds, layout.tile_texels)
+        rows, self.views = table(suns, bounds, layout.tile_texels)
         if layout != self.layout:
             self.atlas = backend.texture(layout.size)
             self.bounds = backend.texture(layout.blocks)
             self.target = backend.target([self.atlas], backend.depth_texture(layout.size))
+            self.rsm = None  # rsm_target() makes them again at the new size
         self.table = backend.texture((rows.shape[1], rows.shape[0]), data=rows)
         self.layout, self.key = layout, key
 
+    def rsm_target(self, backend: Backend) -> tuple[dict, object]:
+        """The RSM tiles' textures (position, normal, flux; SKY_RSM) and their target, made on first use:
+        only a method that injects the world's VPLs from them (vct) pays for them."""
+        if self.rsm is None:
+            size = self.layout.size
+            textures = {k: backend.texture(size) for k in ("position", "normal", "flux")}
+            self.rsm = (textures, backend.target(list(textures.values()), backend.depth_texture(size)))
+        return self.rsm
+
 
 def table(suns: list[Light], bounds: tuple[np.ndarray, np.ndarray], tile_texels: int) -> tuple[np.ndarray, list]:
-    """The sky table (rows, TABLE_TEXELS, 4) float32 and each direction's (view_projection, axis) for its
-    shadow draw; the views are those of a sun's RSM (light_views._sun_view) at the tile's size."""
+    """The sky table (rows, TABLE_TEXELS, 4) float32 and each direction's LightView: a sun's RSM view
+    (light_views._sun_view) at the tile's size, what its shadow draw (and its RSM tile) use."""
     rows = np.zeros((len(suns), TABLE_TEXELS, 4), np.float32)
-    draws = []
+    views = []
+    # A tile's RSM (rsm_tiles) weighs its surfels' areas by its share of the sky's power: vct caps all the
+    # tiles' VPLs as one light, against their lit cross-section, which a surface every direction lights
+    # then counts once; a dominant sun's tile keeps the cap a lamp gets.
+    powers = np.array([sun.sun_strength * float(sun.color @ LUMA) for sun in suns])
+    shares = powers / powers.sum() if powers.sum() > 0 else np.full(len(suns), 1.0 / max(len(suns), 1))
     for k, sun in enumerate(suns):
         (view,) = views_for(sun, k, bounds, tile_texels)
+        view.uniforms["area_weight"] = float(shares[k])
         rows[k, :4] = view.view_projection
         rows[k, 4] = (*view.face_axis, math.sqrt(view.texel_scale))
         rows[k, 5] = (*(sun.color * sun.sun_strength), math.tan(sun.sun_angle_rad / 2.0))
-        draws.append((view.view_projection, view.face_axis))
-    return rows, draws
+        views.append(view)
+    return rows, views
 
 
-def shadow(backend: Backend, target, mesh, layout: SkyLayout, draws: list) -> None:
+def shadow(backend: Backend, target, mesh, layout: SkyLayout, views: list) -> None:
     """Every direction's shadow map into its tile; texels no geometry covers keep w = 0 (lit)."""
     backend.clear(target, color=(0, 0, 0, 0), depth=1.0)
     if mesh is None:
         return
     program = backend.program(SHADOW_SPEC)
-    for k, (view_projection, axis) in enumerate(draws):
-        backend.draw(program, target, mesh, uniforms={"light_view_projection": view_projection, "emit_axis": axis},
+    for k, view in enumerate(views):
+        backend.draw(program, target, mesh, uniforms={"light_view_projection": view.view_projection,
+                                                      "emit_axis": view.face_axis},
+                     depth_test=True, viewport=layout.viewport(k))
+
+
+def rsm_tiles(backend: Backend, target, mesh, layout: SkyLayout, views: list) -> None:
+    """Every direction's RSM (passes/rsm.py, a sun's view at the tile's size) into its tile of the
+    textures behind `target` (position, normal, flux): the world's VPLs, one tile per region of the sky,
+    for a method that injects them all at once (vct)."""
+    backend.clear(target, color=(0, 0, 0, 0), depth=1.0)
+    if mesh is None:
+        return
+    program = backend.program(rsm.SPEC)
+    names = {u.name for u in rsm.SPEC.uniforms}
+    for k, view in enumerate(views):
+        backend.draw(program, target, mesh, uniforms={n: v for n, v in view.uniforms.items() if n in names},
                      depth_test=True, viewport=layout.viewport(k))
 
 

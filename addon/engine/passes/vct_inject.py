@@ -29,6 +29,7 @@ from ..grid import Grid
 from .atlas import Atlas, splat, splat_spec
 from .declare import RSM, VCT_FLUX, VOX_PROJECTED, PassDecl
 from .lpv_inject import emitter_class
+from .sky_light import SKY_RSM
 
 DIRECTIONS = ("px", "nx", "py", "ny", "pz", "nz")  # travel along +x, -x, +y, -y, +z, -z
 
@@ -43,6 +44,8 @@ FILTER_CORNERS = 4  # points per RSM texel when filtered: atlas.texel_points(cop
 
 DECL = PassDecl("vct_inject", "solve", (*RSM, VOX_PROJECTED), (VCT_FLUX,),
                 "each face's VPLs splatted per travel direction; each light capped by the geometry")
+SKY_DECL = PassDecl("vct_inject_sky", "solve", (*SKY_RSM, VOX_PROJECTED), (VCT_FLUX,),
+                    "the sky's RSM tiles' VPLs splatted and capped as one light: the world's bounce")
 
 
 def spec(filtered: bool) -> ShaderSpec:
