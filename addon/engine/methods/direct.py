@@ -107,8 +107,8 @@ class DirectMethod:
               "gather": (sky_light.DIRECT_DECL, direct_light.DECL)}
     # Products of a stochastic gather, filtered after it when GIConfig.denoise (passes/denoise.py).
     NOISY: tuple[str, ...] = ()
-    # Whether the world's bounce comes from its suns' RSMs (light_views): a method that shades its own
-    # surfaces with the sky pass instead (probes) draws none.
+    # Whether the world's bounce comes from its suns' RSMs (light_views): a method that takes the world's
+    # light from the sky pass's directions instead (probes, gather, vct) draws none.
     WORLD_SUN_RSMS = True
 
     def __init_subclass__(cls, **kwargs):
