@@ -7,19 +7,23 @@ const int POLYGON_MAX_VERTICES = 4;
 
 // E / L (sr) at p with unit normal n from the polygon v[0..count), the part above p's horizon (clipped
 // by Sutherland-Hodgman), whichever way it winds: Lambert's formula, (1/2) |sum theta_i n.g_i|.
+// A convex polygon clipped by one plane gains at most one corner; corners that fp32 rounding adds
+// beyond that (signs alternating along a polygon nearly in the horizon plane) are dropped rather than
+// written past the array, which is undefined.
 float polygon_irradiance(vec3 p, vec3 n, vec3 v[POLYGON_MAX_VERTICES], int count) {
-    vec3 c[POLYGON_MAX_VERTICES + 1];
+    const int CLIPPED_MAX = POLYGON_MAX_VERTICES + 1;
+    vec3 c[CLIPPED_MAX];
     int m = 0;
     for (int i = 0; i < count; ++i) {
         vec3 a = v[i] - p;
         vec3 b = v[(i + 1) % count] - p;
         float da = dot(n, a);
         float db = dot(n, b);
-        if (da > 0.0) {
+        if (da > 0.0 && m < CLIPPED_MAX) {
             c[m] = a;
             m += 1;
         }
-        if ((da > 0.0) != (db > 0.0)) {
+        if ((da > 0.0) != (db > 0.0) && m < CLIPPED_MAX) {
             c[m] = a + (b - a) * (da / (da - db));
             m += 1;
         }

@@ -47,10 +47,11 @@ float form_factor(vec3 v0, vec3 v1, vec3 v2, vec3 v3, vec3 n) {
         vec3 b = quad[(i + 1) % 4];
         float da = dot(n, a);
         float db = dot(n, b);
-        if (da >= 0.0) {
+        // At most 5 corners exactly; one more from fp32 rounding is dropped, not written past v.
+        if (da >= 0.0 && count < 5) {
             v[count++] = a;
         }
-        if ((da >= 0.0) != (db >= 0.0)) {
+        if ((da >= 0.0) != (db >= 0.0) && count < 5) {
             v[count++] = mix(a, b, da / (da - db));
         }
     }

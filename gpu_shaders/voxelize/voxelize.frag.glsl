@@ -10,11 +10,15 @@
 // triangles would count every edge twice and more.
 
 // Area (pixel units) of triangle (p0, p1, p2) inside the square [lo, lo + 1]^2: Sutherland-Hodgman
-// against the four sides (at most 7 corners), then the shoelace formula.
+// against the four sides, then the shoelace formula. Exactly, each side adds at most one corner (7 in
+// all); in fp32 a clipped polygon can come out slightly non-convex, and a side then adds more. Corners
+// past CLIP_CORNERS are dropped (a sliver's worth of area): a write past a GLSL array is undefined.
+const int CLIP_CORNERS = 8;
+
 float area_in_pixel(vec2 p0, vec2 p1, vec2 p2, vec2 lo) {
     vec2 hi = lo + 1.0;
-    vec2 poly[8];
-    vec2 next[8];
+    vec2 poly[CLIP_CORNERS];
+    vec2 next[CLIP_CORNERS];
     poly[0] = p0;
     poly[1] = p1;
     poly[2] = p2;
@@ -26,11 +30,11 @@ float area_in_pixel(vec2 p0, vec2 p1, vec2 p2, vec2 lo) {
             vec2 b = poly[i + 1 < n ? i + 1 : 0];
             float da = side == 0 ? a.x - lo.x : (side == 1 ? hi.x - a.x : (side == 2 ? a.y - lo.y : hi.y - a.y));
             float db = side == 0 ? b.x - lo.x : (side == 1 ? hi.x - b.x : (side == 2 ? b.y - lo.y : hi.y - b.y));
-            if (da >= 0.0) {
+            if (da >= 0.0 && m < CLIP_CORNERS) {
                 next[m] = a;
                 m++;
             }
-            if ((da >= 0.0) != (db >= 0.0)) {
+            if ((da >= 0.0) != (db >= 0.0) && m < CLIP_CORNERS) {
                 next[m] = a + (b - a) * (da / (da - db));
                 m++;
             }
