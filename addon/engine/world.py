@@ -125,6 +125,18 @@ def world_suns(world_map: np.ndarray, count: int, by_width: bool = False) -> lis
 AXES = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], np.float64)
 
 
+def sun_strengths(suns: list[Light]) -> np.ndarray:
+    """Each sun's strength in luminance (W/m^2 normal to it, colours weighed by LUMA)."""
+    return np.array([s.sun_strength * float(s.color @ LUMA) for s in suns])
+
+
+def power_shares(suns: list[Light]) -> np.ndarray:
+    """Each sun's share of the suns' summed strength (sun_strengths); equal shares when all are dark."""
+    strengths = sun_strengths(suns)
+    total = strengths.sum()
+    return strengths / total if total > 0 else np.full(len(suns), 1.0 / max(len(suns), 1))
+
+
 def sky_direction_count(world_lights: list[Light], lamps: list[Light], most: int, least: int,
                         scene_radius_m: float) -> int:
     """How many directions the sky's direct light gets: `most` times the world's share of the scene's
@@ -137,8 +149,7 @@ def sky_direction_count(world_lights: list[Light], lamps: list[Light], most: int
     if not world_lights:
         return 0
     toward = np.array([-s.direction for s in world_lights])
-    luma = np.array([s.sun_strength * float(s.color @ LUMA) for s in world_lights])
-    world_e = float(np.max(np.maximum(AXES @ toward.T, 0.0) @ luma))
+    world_e = float(np.max(np.maximum(AXES @ toward.T, 0.0) @ sun_strengths(world_lights)))
     lamps_e = 0.0
     for lamp in lamps:
         if lamp.kind == "SUN":

@@ -81,3 +81,17 @@ def test_sky_direction_count_follows_the_worlds_share():
     dim = world_suns(constant_map([1e-3] * 3), 16)
     assert sky_direction_count(dim, [sun], 256, 16, 5.0) == 16  # never fewer than `least`
     assert sky_direction_count([], [sun], 256, 16, 5.0) == 0  # no world, no directions
+
+
+def test_power_shares_split_by_luminance_and_never_divide_by_zero():
+    from addon.engine.scene import Light
+    from addon.engine.world import power_shares
+
+    def sun(strength, color):
+        return Light("SUN", [0, 0, 10], [0, 0, -1], color, sun_strength=strength)
+
+    # Luminance weights (Rec.709): pure green 0.7152, pure blue 0.0722, so green at strength 1 against
+    # blue at strength 2 share 0.7152 : 0.1444.
+    shares = power_shares([sun(1.0, [0, 1, 0]), sun(2.0, [0, 0, 1])])
+    np.testing.assert_allclose(shares, np.array([0.7152, 0.1444]) / 0.8596, rtol=1e-12)
+    np.testing.assert_array_equal(power_shares([sun(0.0, [1, 1, 1])] * 4), [0.25] * 4)  # all dark: equal

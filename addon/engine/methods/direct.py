@@ -320,8 +320,7 @@ class DirectMethod:
         # RSMs are the world's bounce only (its direct light is the sky pass's, `sky`): a method without
         # indirect light draws none.
         suns = self.world_suns() if "indirect" in self.products and self.WORLD_SUN_RSMS else []
-        powers = np.array([s.sun_strength * float(s.color @ world.LUMA) for s in suns])
-        self.vpl_shares = {len(lights) + i: p / powers.sum() for i, p in enumerate(powers)} if suns else {}
+        self.vpl_shares = {len(lights) + i: float(p) for i, p in enumerate(world.power_shares(suns))}
         lights += suns
         table, ranges = emitter_table(lights)
         self._upload_emitters(table)

@@ -37,8 +37,16 @@ DECL = PassDecl("rsm", "solve", (TRIANGLES, LIGHT_VIEWS), RSM, "the scene seen f
 
 
 def run(backend: Backend, target, mesh, view: LightView) -> None:
+    """The RSM of `view` into `target`, cleared first."""
     backend.clear(target, color=(0, 0, 0, 0), depth=1.0)
+    draw(backend, target, mesh, view)
+
+
+def draw(backend: Backend, target, mesh, view: LightView, viewport=None) -> None:
+    """The RSM of `view` over what `target` holds, into `viewport` (x, y, w, h; None: all of it), e.g. a
+    tile of an atlas of several views (sky_light.rsm_tiles)."""
     if mesh is not None:
         names = {u.name for u in SPEC.uniforms}
         backend.draw(backend.program(SPEC), target, mesh,
-                     uniforms={k: v for k, v in view.uniforms.items() if k in names}, depth_test=True)
+                     uniforms={k: v for k, v in view.uniforms.items() if k in names}, depth_test=True,
+                     viewport=viewport)

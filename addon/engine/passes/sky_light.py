@@ -28,7 +28,7 @@ import numpy as np
 
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..scene import Light
-from ..world import LUMA
+from ..world import power_shares
 from . import rsm
 from .declare import DIRECT, GBUF_NORMAL, GBUF_POSITION, TRIANGLES, PassDecl, Port
 from .light_views import views_for
@@ -170,8 +170,7 @@ def table(suns: list[Light], bounds: tuple[np.ndarray, np.ndarray], tile_texels:
     # A tile's RSM (rsm_tiles) weighs its surfels' areas by its share of the sky's power: vct caps all the
     # tiles' VPLs as one light, against their lit cross-section, which a surface every direction lights
     # then counts once; a dominant sun's tile keeps the cap a lamp gets.
-    powers = np.array([sun.sun_strength * float(sun.color @ LUMA) for sun in suns])
-    shares = powers / powers.sum() if powers.sum() > 0 else np.full(len(suns), 1.0 / max(len(suns), 1))
+    shares = power_shares(suns)
     for k, sun in enumerate(suns):
         (view,) = views_for(sun, k, bounds, tile_texels)
         view.uniforms["area_weight"] = float(shares[k])
@@ -199,13 +198,8 @@ def rsm_tiles(backend: Backend, target, mesh, layout: SkyLayout, views: list) ->
     textures behind `target` (position, normal, flux): the world's VPLs, one tile per region of the sky,
     for a method that injects them all at once (vct)."""
     backend.clear(target, color=(0, 0, 0, 0), depth=1.0)
-    if mesh is None:
-        return
-    program = backend.program(rsm.SPEC)
-    names = {u.name for u in rsm.SPEC.uniforms}
     for k, view in enumerate(views):
-        backend.draw(program, target, mesh, uniforms={n: v for n, v in view.uniforms.items() if n in names},
-                     depth_test=True, viewport=layout.viewport(k))
+        rsm.draw(backend, target, mesh, view, viewport=layout.viewport(k))
 
 
 def bounds(backend: Backend, atlas, out, layout: SkyLayout) -> None:
