@@ -134,6 +134,10 @@ class BOUNCE_PG_settings(bpy.types.PropertyGroup):
                                         get=lambda _self: _live_state().STATE.last_update_ms, precision=1),
         "status": StringProperty(name="Status", description="What the overlay did last, or why it stopped",
                                  get=lambda _self: _live_state().status()),
+        "world_averaged": BoolProperty(
+            name="World Averaged", description="The world varies with direction but the overlay lights with its "
+            "average colour: Capture World Light renders its map",
+            get=lambda _self: _live_state().STATE.world_averaged),
     }
 
 

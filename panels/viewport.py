@@ -25,6 +25,10 @@ def draw_settings(layout, settings) -> None:
         box.label(text="Lights")
         for ob in lamps:
             box.prop(ob.data, "bounce_include", text=ob.name)
+    if settings.world_averaged:  # a sky or node-tree world: the overlay never renders it from its timer
+        row = layout.row()
+        row.label(text="World lit as its average colour", icon="WORLD")
+        row.operator("bounce.capture_world", text="Capture", icon="RENDER_STILL")
     status = settings.status
     layout.label(text=status, icon="ERROR" if status.startswith("Error") else "INFO")
 

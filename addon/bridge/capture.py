@@ -400,11 +400,12 @@ class SceneCache:
     image averages are cached until an Image update). `geometry_reads` counts re-triangulated meshes.
     """
 
-    def __init__(self, world_maps: bool = True):
-        """world_maps: render a world that varies with direction into a map (world_capture.py, about
-        1.5 s per change); without, such a world lights as its average colour (the interactive
-        viewport, where a Cycles render from a timer would stall the UI)."""
-        self.world_maps = world_maps
+    def __init__(self, render_world: bool = True):
+        """render_world: a world that varies with direction becomes a map, rendered by Cycles where
+        Bounce cannot read it (world_capture.py, about 1.5 s per change); without, only a map that needs
+        no render (an HDRI, or one already rendered for that node tree) and otherwise the world's average
+        colour: the interactive viewport, where a Cycles render from a timer would stall the UI."""
+        self.render_world = render_world
         self.blocks: dict[tuple, _Block] = {}
         self.images: dict[str, np.ndarray | None] = {}
         self.geometry_reads = 0
@@ -424,11 +425,13 @@ class SceneCache:
 
     def _capture_world(self, world, out: Scene) -> None:
         """The world's light into out.world_color (constant) or out.world_map (a map, with its mean as
-        world_color): a world that varies with direction is rendered by Cycles unless world_maps is off."""
-        if self.world_maps and world_capture.needs_map(world):
-            out.world_map = world_capture.world_map(world)
-            _, omega = world_directions(*out.world_map.shape[:2])
-            out.world_color = (np.tensordot(omega, out.world_map, axes=2) / omega.sum()).astype(np.float32)
+        world_color): a world that varies with direction is rendered by Cycles unless render_world is
+        off and no map is at hand (then its average colour, with a warning)."""
+        world_map = world_capture.world_map(world, self.render_world) if world_capture.needs_map(world) else None
+        if world_map is not None:
+            out.world_map = world_map
+            _, omega = world_directions(*world_map.shape[:2])
+            out.world_color = (np.tensordot(omega, world_map, axes=2) / omega.sum()).astype(np.float32)
         else:
             out.world_color = world_color(world, out.warnings).astype(np.float32)
 

@@ -17,6 +17,10 @@ Why it is shaped like this:
   says "full" and stops.
 - Nothing here writes to Blender data: writing from a draw callback is refused, and every write would
   send another depsgraph update. The panel reads `STATE` through read-only properties.
+- The world: an HDRI lights by direction (read in milliseconds); a world Bounce cannot read (a Sky
+  Texture, any node tree) is never rendered from the timer and lights as its average until the
+  Capture World Light operator renders its map (`world_averaged` says so to the panel); the map is
+  part of the lights' comparison, so turning the sky's sun is a lights change.
 """
 
 from __future__ import annotations
@@ -31,6 +35,7 @@ import bpy
 import numpy as np
 
 from ..engine.scene import Scene
+from . import world_capture
 from .capture import SceneCache
 
 log = logging.getLogger(__name__)
@@ -43,8 +48,8 @@ _versions = itertools.count(1)  # never reset, so an overlay can never mistake a
 
 @dataclasses.dataclass
 class LiveState:
-    # No Cycles render of the world from the UI's timer: a textured world lights as its average here.
-    cache: SceneCache = dataclasses.field(default_factory=lambda: SceneCache(world_maps=False))
+    # No Cycles render of the world from the UI's timer (module docstring, "The world").
+    cache: SceneCache = dataclasses.field(default_factory=lambda: SceneCache(render_world=False))
     scene_name: str | None = None
     scene: Scene | None = None      # the last capture (its camera is replaced by each region's)
     geometry_version: int = 0
@@ -53,6 +58,7 @@ class LiveState:
     last_event_s: float = -math.inf
     captures: int = 0
     changed: tuple[str, ...] = ()   # what the last capture changed: "geometry", "lights"
+    world_averaged: bool = False    # the world varies with direction but lights as its average (no map yet)
     # Written by the viewport overlay, read by the panel.
     last_update_ms: float = 0.0
     info: str = ""
@@ -98,13 +104,14 @@ def _geometry(scene: Scene) -> tuple:
 def _lights(scene: Scene) -> list:
     rows = [[np.asarray(v).tolist() if isinstance(v, np.ndarray) else v for v in dataclasses.astuple(light)]
             for light in scene.lights]
-    return [rows, scene.world_color.tolist()]
+    world = None if scene.world_map is None else scene.world_map.tobytes()
+    return [rows, scene.world_color.tolist(), world]
 
 
 def capture(depsgraph) -> tuple[str, ...]:
     """Capture the depsgraph's scene; bump the versions of what differs from the last capture."""
     if depsgraph.scene.name != STATE.scene_name:
-        STATE.cache, STATE.scene, STATE.scene_name = SceneCache(world_maps=False), None, depsgraph.scene.name
+        STATE.cache, STATE.scene, STATE.scene_name = SceneCache(render_world=False), None, depsgraph.scene.name
     previous = STATE.scene
     # 1 x 1: the scene camera is not what the viewport shows; each region builds its own camera.
     scene = STATE.cache.update(depsgraph, 1, 1)
@@ -117,6 +124,7 @@ def capture(depsgraph) -> tuple[str, ...]:
         STATE.lights_version = next(_versions)
         changed.append("lights")
     STATE.scene, STATE.changed = scene, tuple(changed)
+    STATE.world_averaged = scene.world_map is None and world_capture.needs_map(depsgraph.scene.world)
     return STATE.changed
 
 

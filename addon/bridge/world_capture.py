@@ -11,6 +11,12 @@ which is narrowed). That costs about 1.5 s on this project's 2-core CPU machine 
 scene sync), so the map is cached by a fingerprint of the world's node tree and made again only when
 that changes. A constant background (no link into its Color) needs no map: capture.world_color gives it.
 
+The interactive viewport never renders from its timer (a second's stall per edit of the sky): it asks
+`world_map(world, render=False)`, which reads an HDRI (each image's binning cached apart from the
+Background's strength, so dragging the strength re-reads nothing) and otherwise returns only a map
+already rendered for this exact node tree: by the Capture World Light operator, a bake or a render
+in the same session.
+
 Cycles' equirectangular camera, rotated to look along +x with +z up, puts longitude increasing to the
 left: its columns are read reversed to match world.py's layout (tests/blender/test_world_capture.py
 renders a world whose colour is the view direction and checks every texel).
@@ -29,6 +35,7 @@ from . import compat
 
 MAP_ROWS, MAP_COLS = 32, 64
 _cache: dict[str, np.ndarray] = {}
+_binned_images: dict[tuple, np.ndarray] = {}  # an HDRI's map at strength 1, by (name, filepath, size)
 
 
 def _background(world):
@@ -54,13 +61,21 @@ LINEAR_SPACES = {"Linear Rec.709", "Linear", "Non-Color", "Linear CIE-XYZ E", "L
 
 
 def _binned(image, strength: float) -> np.ndarray:
+    """The HDRI's map at `strength` (its binning at strength 1 cached per image: `_bin`)."""
+    key = (image.name, image.filepath, tuple(image.size))
+    if key not in _binned_images:
+        _binned_images[key] = _bin(image)
+    return (_binned_images[key] * np.float32(strength)).astype(np.float32)
+
+
+def _bin(image) -> np.ndarray:
     """The HDRI's pixels binned into the map by direction (Cycles' equirectangular mapping: u = 0.5 -
     atan2(y, x) / 2 pi, v = 0.5 + atan2(z, hypot(x, y)) / pi, row 0 = bottom), each weighted by its
     solid angle: the map texel's radiance is the mean over the image pixels it holds."""
     w, h = image.size
     px = np.empty(w * h * 4, np.float32)
     image.pixels.foreach_get(px)
-    rgb = px.reshape(h, w, 4)[..., :3].astype(np.float64) * strength
+    rgb = px.reshape(h, w, 4)[..., :3].astype(np.float64)
     v = (np.arange(h) + 0.5) / h                              # row 0 = bottom
     lat = (v - 0.5) * np.pi
     u = (np.arange(w) + 0.5) / w
@@ -115,17 +130,22 @@ def fingerprint(world) -> str:
 
 
 def forget() -> None:
-    """Drop the cached map: an image was edited in place (capture.SceneCache.note calls this on an
+    """Drop the cached maps: an image was edited in place (capture.SceneCache.note calls this on an
     Image update, which the fingerprint cannot see)."""
     _cache.clear()
+    _binned_images.clear()
 
 
-def world_map(world) -> np.ndarray:
-    """The world's radiance map (MAP_ROWS, MAP_COLS, 3) float32 W/m^2/sr, cached by fingerprint."""
+def world_map(world, render: bool = True) -> np.ndarray | None:
+    """The world's radiance map (MAP_ROWS, MAP_COLS, 3) float32 W/m^2/sr, cached by fingerprint. With
+    `render` False only what needs no Cycles render: an HDRI read directly, or a map already made for
+    this node tree; None otherwise (the caller lights with the world's average)."""
     key = fingerprint(world)
     if key not in _cache:
-        _cache.clear()  # one world at a time: a new fingerprint replaces the old map
         hdri = _direct_hdri(world)
+        if hdri is None and not render:
+            return None
+        _cache.clear()  # one world at a time: a new fingerprint replaces the old map
         _cache[key] = _binned(*hdri) if hdri is not None else _render(world)
     return _cache[key]
 
@@ -151,6 +171,8 @@ def _render(world) -> np.ndarray:
         scene.cycles.device = "CPU"
         r.image_settings.file_format = "OPEN_EXR"
         r.image_settings.color_depth = "32"
+        # The active Render Result slot shows the render of the scene it is looked at from: the user's
+        # last render of their own scene stays what that slot shows (tests/blender/test_world_capture.py).
         bpy.ops.render.render(scene=scene.name)
         bpy.data.images["Render Result"].save_render(path, scene=scene)
         image = bpy.data.images.load(path)

@@ -92,13 +92,19 @@ class _RecordingLayout:
     """Stands in for UILayout (no UI in background mode): records props and labels."""
 
     def __init__(self):
-        self.drawn, self.labels = [], []
+        self.drawn, self.labels, self.operators = [], [], []
 
     def box(self, **_kwargs):
         return self
 
     def column(self, **_kwargs):
         return self
+
+    def row(self, **_kwargs):
+        return self
+
+    def operator(self, idname, **_kwargs):
+        self.operators.append(idname)
 
     def prop(self, data, name, **_kwargs):
         assert name in data.bl_rna.properties, name
@@ -144,6 +150,56 @@ def test_broken_method_logs_once_stops_and_panel_shows_why(live_cornell, monkeyp
     settings.enabled = False
     settings.enabled = True
     assert live.STATE.error is None and not settings.status.startswith("Error")
+
+
+def test_a_sky_lights_as_its_average_until_captured_then_by_direction(live_cornell):
+    # The overlay never renders the world from its timer: a node-tree world lights as its average and the
+    # panel offers Capture World Light. The operator renders its map; the next capture lights by direction
+    # (a lights change: the light passes run again, no mesh re-read) and the panel's row goes away.
+    from bounce.addon.bridge import live, viewport, world_capture
+    from bounce.panels.viewport import draw_settings
+    from test_world_capture import _direction_world
+
+    world_capture.forget()
+    bpy.context.scene.world = _direction_world()
+    bpy.context.view_layer.update()
+    captured(live)
+    settings = bpy.context.scene.bounce
+    assert live.STATE.scene.world_map is None and settings.world_averaged
+    layout = _RecordingLayout()
+    draw_settings(layout, settings)
+    assert layout.operators == ["bounce.capture_world"]
+    draw_offscreen(viewport, live_cornell, 64, 48)
+    reads, solves = live.STATE.cache.geometry_reads, viewport.overlay_for(1, "full").method.solves
+
+    assert bpy.ops.bounce.capture_world() == {"FINISHED"}
+    captured(live)
+    draw_offscreen(viewport, live_cornell, 64, 48)
+    assert live.STATE.changed == ("lights",) and not settings.world_averaged
+    method = viewport.overlay_for(1, "full").method
+    assert method.source.world_map is live.STATE.scene.world_map is not None
+    assert method.solves == solves + 1 and live.STATE.cache.geometry_reads == reads
+    layout = _RecordingLayout()
+    draw_settings(layout, settings)
+    assert layout.operators == []
+
+
+def test_the_worlds_map_is_part_of_the_lights(bounce):
+    # Turning a sky's sun keeps the world's average colour: the map itself must be compared, or the
+    # overlay would keep the old light.
+    from bounce.addon.bridge import live
+    from bounce.addon.engine.scene import Scene
+
+    def scene(world_map):
+        tri = np.zeros((1, 3, 3), np.float32)
+        return Scene(tri, tri.copy(), np.ones((1, 3), np.float32), np.zeros((1, 3), np.float32),
+                     world_color=np.full(3, 0.5, np.float32), world_map=world_map)
+
+    sky = np.zeros((32, 64, 3), np.float32)
+    sky[:16] = 1.0
+    assert live._lights(scene(sky)) != live._lights(scene(sky[::-1].copy()))
+    assert live._lights(scene(sky)) == live._lights(scene(sky.copy()))
+    assert live._lights(scene(sky)) != live._lights(scene(None))
 
 
 def test_quality_preset_sets_rsm_settings(bounce, fresh_blend):

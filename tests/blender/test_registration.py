@@ -47,11 +47,11 @@ def test_register_unregister_twice_leaves_nothing_behind(bounce, fresh_blend):
     before = _handler_counts()
     assert "load_post" in before and "depsgraph_update_post" in before
     classes = _all_classes(bounce)
-    # a property group per settings group (config.GROUPS) and one for them all, 3 operators
-    # (report_renderer, bake, choose), 3 panels (main, its viewport sub-panel, the sidebar tab)
+    # a property group per settings group (config.GROUPS) and one for them all, 4 operators
+    # (report_renderer, bake, choose, capture_world), 3 panels (main, its viewport sub-panel, the sidebar tab)
     from addon.engine import config
 
-    assert len(classes) == len(config.GROUPS) + 1 + 3 + 3
+    assert len(classes) == len(config.GROUPS) + 1 + 4 + 3
     for _ in range(2):
         bounce.register()
         try:

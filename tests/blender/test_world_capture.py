@@ -52,8 +52,17 @@ def test_capture_keeps_a_constant_world_constant(fresh_blend):
     bpy.context.scene.world = _direction_world()
     scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 8, 8)
     assert scene.world_map is not None and scene.world_map.shape[2] == 3
-    # Without maps (the interactive viewport) the world lights as its constant part.
-    assert SceneCache(world_maps=False).update(bpy.context.evaluated_depsgraph_get(), 8, 8).world_map is None
+    # Without renders (the interactive viewport) a node tree whose map is not made yet lights as its
+    # average, with a warning; once a map was rendered for that node tree, it lights by direction.
+    from addon.bridge import world_capture
+
+    world_capture.forget()
+    viewport = SceneCache(render_world=False).update(bpy.context.evaluated_depsgraph_get(), 8, 8)
+    assert viewport.world_map is None
+    assert any("average" in w for w in viewport.warnings)
+    rendered = world_capture.world_map(bpy.context.scene.world)
+    viewport = SceneCache(render_world=False).update(bpy.context.evaluated_depsgraph_get(), 8, 8)
+    assert viewport.world_map is rendered
 
 
 def _hdri_world(hot_pixel=None, name="HDRI"):
@@ -110,3 +119,56 @@ def test_hdri_sun_keeps_its_energy(fresh_blend):
     band = 2 * np.pi * (np.sin(lat + np.pi / (2 * h)) - np.sin(lat - np.pi / (2 * h))) / w
     expected = np.einsum("ijc,i->c", image, band)
     np.testing.assert_allclose(np.einsum("ijc,ij->c", m, omega), expected, rtol=2e-3)
+
+
+def test_viewport_reads_an_hdri_without_rendering_and_rebins_nothing_for_its_strength(fresh_blend, monkeypatch):
+    # The viewport (render_world False) lights an HDRI by direction: read directly, never rendered. Its
+    # binning is kept per image, so a new Background strength only scales the map (exactly: the same
+    # float32 binning times each strength).
+    from addon.bridge import world_capture
+    from addon.bridge.capture import SceneCache
+
+    world_capture.forget()
+    bins = []
+    real_bin = world_capture._bin
+    monkeypatch.setattr(world_capture, "_bin", lambda image: bins.append(image.name) or real_bin(image))
+    monkeypatch.setattr(world_capture, "_render", lambda world: pytest.fail("the viewport rendered the world"))
+    world, image = _hdri_world()
+    bpy.context.scene.world = world
+    first = SceneCache(render_world=False).update(bpy.context.evaluated_depsgraph_get(), 8, 8).world_map
+    assert first is not None and bins == ["HDRI"]
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 3.0
+    again = SceneCache(render_world=False).update(bpy.context.evaluated_depsgraph_get(), 8, 8).world_map
+    assert bins == ["HDRI"]  # no second binning
+    np.testing.assert_allclose(again, first * 2.0, rtol=1e-6)  # strength 1.5 -> 3.0
+
+
+def test_rendering_the_world_keeps_the_users_render_result(fresh_blend):
+    # The world is rendered from a scene of its own: the Render Result's active slot, seen from the
+    # user's scene, still holds the user's last render afterwards. That render here: a red world seen by
+    # a camera, so every pixel is (1, 0, 0) up to Cycles' single sample (atol 0.1).
+    import tempfile
+    from pathlib import Path
+
+    from addon.bridge import compat, world_capture
+
+    scene = bpy.context.scene
+    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+    red = bpy.data.worlds.new("Red")
+    compat.node_tree(red).nodes["Background"].inputs["Color"].default_value = (1, 0, 0, 1)
+    scene.world = red
+    scene.render.engine = "CYCLES"
+    scene.cycles.samples = 1
+    scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 8, 8, 100
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    bpy.ops.render.render()
+    world_capture.forget()
+    world_capture.world_map(_direction_world())
+    path = Path(tempfile.mkdtemp()) / "user.exr"
+    bpy.data.images["Render Result"].save_render(str(path), scene=scene)
+    image = bpy.data.images.load(str(path))
+    px = np.empty(8 * 8 * 4, np.float32)
+    image.pixels.foreach_get(px)
+    np.testing.assert_allclose(px.reshape(-1, 4)[:, :3].mean(axis=0), [1.0, 0.0, 0.0], atol=0.1)

@@ -116,6 +116,25 @@ def steps():
     yield from until_updated(live, viewport, runs)
     result["area_light"] = {"shot": shot("area_light"), "status": live.status(), "error": live.STATE.error,
                             "gpu_runs": viewport.gpu_runs - runs}
+    # A sky (Blender's Sky Texture: no map Bounce reads itself) instead of the lamps: the overlay lights
+    # it as its average until Capture World Light renders its map, then by direction.
+    area.hide_viewport = area.hide_render = True
+    world = bpy.data.worlds.new("Sky")
+    world.use_nodes = True
+    sky = world.node_tree.nodes.new("ShaderNodeTexSky")
+    world.node_tree.links.new(sky.outputs["Color"], world.node_tree.nodes["Background"].inputs["Color"])
+    bpy.context.scene.world = world
+    runs = viewport.gpu_runs
+    yield from until_updated(live, viewport, runs)
+    entry = result["sky"] = {}
+    entry["averaged"] = {"shot": shot("sky_averaged"), "world_averaged": settings.world_averaged,
+                         "error": live.STATE.error, "gpu_runs": viewport.gpu_runs - runs}
+    runs = viewport.gpu_runs
+    entry["operator"] = sorted(bpy.ops.bounce.capture_world())
+    yield from until_updated(live, viewport, runs)
+    entry["captured"] = {"shot": shot("sky_captured"), "world_averaged": settings.world_averaged,
+                         "error": live.STATE.error, "gpu_runs": viewport.gpu_runs - runs,
+                         "map": live.STATE.scene.world_map is not None}
 
 
 _steps = steps()
