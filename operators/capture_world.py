@@ -12,13 +12,15 @@ from ..addon.bridge import live, world_capture
 
 class BOUNCE_OT_capture_world(bpy.types.Operator):
     """Render the world's light by direction with Cycles (about a second) for the viewport overlay, which
-    otherwise lights a sky or node-tree world as its average colour; needed again after the world changes"""
+    otherwise lights a sky or node-tree world as its average colour; kept in the world (saved with the
+    file) until the world changes"""
 
     bl_idname = "bounce.capture_world"
     bl_label = "Capture World Light"
-    # No UNDO: it writes no Blender data (the map lives in world_capture's cache; the render is of a
-    # temporary scene, so the Render Result still shows the user's last render of theirs).
-    bl_options = {"REGISTER"}
+    # It writes the map into the world's custom properties (world_capture.store: saved with the .blend),
+    # so undo takes it back. The render is of a temporary scene: the Render Result still shows the
+    # user's last render of theirs.
+    bl_options = {"REGISTER", "UNDO"}
 
     @classmethod
     def poll(cls, context):
@@ -28,7 +30,7 @@ class BOUNCE_OT_capture_world(bpy.types.Operator):
         world = context.scene.world
         start = time.perf_counter()
         try:
-            world_capture.world_map(world)
+            world_capture.store(world, world_capture.world_map(world))
         except RuntimeError as exc:  # Cycles refused to render (no Cycles in this build, say)
             self.report({"ERROR"}, f"Bounce: cannot render the world {world.name!r}: {exc}")
             return {"CANCELLED"}

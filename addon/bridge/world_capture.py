@@ -14,8 +14,9 @@ that changes. A constant background (no link into its Color) needs no map: captu
 The interactive viewport never renders from its timer (a second's stall per edit of the sky): it asks
 `world_map(world, render=False)`, which reads an HDRI (each image's binning cached apart from the
 Background's strength, so dragging the strength re-reads nothing) and otherwise returns only a map
-already rendered for this exact node tree: by the Capture World Light operator, a bake or a render
-in the same session.
+already made for this exact node tree: kept in the world by the Capture World Light operator (`store`:
+saved with the .blend, keyed by the node tree and Blender's version), or rendered by a bake or a
+render in the same session.
 
 Cycles' equirectangular camera, rotated to look along +x with +z up, puts longitude increasing to the
 left: its columns are read reversed to match world.py's layout (tests/blender/test_world_capture.py
@@ -24,6 +25,7 @@ renders a world whose colour is the view direction and checks every texel).
 
 from __future__ import annotations
 
+import hashlib
 import math
 import os
 import tempfile
@@ -101,10 +103,11 @@ def needs_map(world) -> bool:
     return node is not None and (node.type != "BACKGROUND" or node.inputs["Color"].is_linked)
 
 
-def fingerprint(world) -> str:
+def fingerprint(world, with_file: bool = True) -> str:
     """Changes whenever anything in the world's node tree that can change its light changes: node
-    types, input values, properties (a Sky Texture's sun is a node property), links, image names."""
-    parts = [bpy.data.filepath, world.name]
+    types, input values, properties (a Sky Texture's sun is a node property), links, image names; and,
+    `with_file`, the .blend's path (the session's cache spans files, whose images may share names)."""
+    parts = [bpy.data.filepath if with_file else "", world.name]
     tree = world.node_tree
     for node in sorted(tree.nodes, key=lambda n: n.name):
         parts.append(f"{node.name}:{node.bl_idname}")
@@ -138,16 +141,48 @@ def forget() -> None:
 
 def world_map(world, render: bool = True) -> np.ndarray | None:
     """The world's radiance map (MAP_ROWS, MAP_COLS, 3) float32 W/m^2/sr, cached by fingerprint. With
-    `render` False only what needs no Cycles render: an HDRI read directly, or a map already made for
-    this node tree; None otherwise (the caller lights with the world's average)."""
+    `render` False only what needs no Cycles render: an HDRI read directly, a map stored in the world
+    for this node tree (`store`), or one already made for it; None otherwise (the caller lights with the
+    world's average)."""
     key = fingerprint(world)
     if key not in _cache:
         hdri = _direct_hdri(world)
-        if hdri is None and not render:
+        stored = stored_map(world) if hdri is None else None
+        if hdri is None and stored is None and not render:
             return None
         _cache.clear()  # one world at a time: a new fingerprint replaces the old map
-        _cache[key] = _binned(*hdri) if hdri is not None else _render(world)
+        if hdri is not None:
+            _cache[key] = _binned(*hdri)
+        else:
+            _cache[key] = stored if stored is not None else _render(world)
     return _cache[key]
+
+
+# The map kept in the world datablock (so in the .blend) by the Capture World Light operator, with the
+# key of what it was rendered from: the node tree's fingerprint without the file's path (a saved copy
+# keeps it) and Blender's version (another version may model the sky otherwise).
+STORED_MAP, STORED_KEY = "bounce_world_map", "bounce_world_key"
+
+
+def _stored_key(world) -> str:
+    text = f"{bpy.app.version_string}|{fingerprint(world, with_file=False)}"
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def store(world, world_map: np.ndarray) -> None:
+    """Keep `world_map` in the world's custom properties (saved with the .blend, undone with undo)."""
+    world[STORED_MAP] = np.asarray(world_map, np.float64).ravel().tolist()
+    world[STORED_KEY] = _stored_key(world)
+
+
+def stored_map(world) -> np.ndarray | None:
+    """The map `store` kept in the world, if it was made from the world as it is now; else None."""
+    if world.get(STORED_KEY) != _stored_key(world) or STORED_MAP not in world:
+        return None
+    values = np.asarray(world[STORED_MAP], np.float32)
+    if values.size != MAP_ROWS * MAP_COLS * 3:
+        return None
+    return np.maximum(values.reshape(MAP_ROWS, MAP_COLS, 3), 0.0)
 
 
 def _render(world) -> np.ndarray:

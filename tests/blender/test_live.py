@@ -173,6 +173,7 @@ def test_a_sky_lights_as_its_average_until_captured_then_by_direction(live_corne
     reads, solves = live.STATE.cache.geometry_reads, viewport.overlay_for(1, "full").method.solves
 
     assert bpy.ops.bounce.capture_world() == {"FINISHED"}
+    assert world_capture.STORED_KEY in bpy.context.scene.world  # kept in the world: saved with the file
     captured(live)
     draw_offscreen(viewport, live_cornell, 64, 48)
     assert live.STATE.changed == ("lights",) and not settings.world_averaged

@@ -172,3 +172,26 @@ def test_rendering_the_world_keeps_the_users_render_result(fresh_blend):
     px = np.empty(8 * 8 * 4, np.float32)
     image.pixels.foreach_get(px)
     np.testing.assert_allclose(px.reshape(-1, 4)[:, :3].mean(axis=0), [1.0, 0.0, 0.0], atol=0.1)
+
+
+def test_a_stored_map_is_saved_with_the_blend_until_the_world_changes(fresh_blend, tmp_path, monkeypatch):
+    # Capture World Light keeps the map in the world's custom properties: after saving and opening the
+    # file the viewport (no renders) lights by it, to the bit (float32 through float64 and back); an edit
+    # of the world makes it stale, and the world lights as its average again.
+    from addon.bridge import world_capture
+    from addon.bridge.capture import SceneCache
+
+    world = _direction_world()
+    bpy.context.scene.world = world
+    made = world_capture.world_map(world)
+    world_capture.store(world, made)
+    path = tmp_path / "sky.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    world_capture.forget()
+    monkeypatch.setattr(world_capture, "_render", lambda world: pytest.fail("rendered a stored world"))
+    scene = SceneCache(render_world=False).update(bpy.context.evaluated_depsgraph_get(), 8, 8)
+    np.testing.assert_array_equal(scene.world_map, made)
+    bpy.context.scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 2.0
+    assert SceneCache(render_world=False).update(bpy.context.evaluated_depsgraph_get(), 8, 8).world_map is None
