@@ -30,7 +30,7 @@ class BOUNCE_OT_capture_world(bpy.types.Operator):
         world = context.scene.world
         start = time.perf_counter()
         try:
-            world_capture.store(world, world_capture.world_map(world))
+            world_capture.store(world, world_capture.capture(world))
         except RuntimeError as exc:  # Cycles refused to render (no Cycles in this build, say)
             self.report({"ERROR"}, f"Bounce: cannot render the world {world.name!r}: {exc}")
             return {"CANCELLED"}

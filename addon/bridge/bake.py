@@ -272,16 +272,10 @@ def attribute_name(pass_name: str) -> str:
 
 # ------------------------------------------------------------------------------------- nothing baked
 
-def _emits(light) -> bool:
-    strength = light.sun_strength if light.kind == "SUN" else light.power_w
-    return strength > 0 and bool(np.any(np.asarray(light.color) > 0))
-
-
 def empty_light_warning(scene) -> str | None:
     """Why every value baked from the captured engine Scene would be zero, or None: no light with
     power > 0, no emissive triangle and a black world."""
-    world_lit = np.any(scene.world_color > 0) or (scene.world_map is not None and np.any(scene.world_map > 0))
-    if any(_emits(light) for light in scene.lights) or bool(np.any(scene.emission > 0)) or world_lit:
+    if scene.has_light_source():
         return None
     return ("the scene has no light sources (no light with power > 0, no emissive surface, a black world): "
             "every baked value is zero")

@@ -427,11 +427,13 @@ class SceneCache:
         """The world's light into out.world_color (constant) or out.world_map (a map, with its mean as
         world_color): a world that varies with direction is rendered by Cycles unless render_world is
         off and no map is at hand (then its average colour, with a warning)."""
-        world_map = world_capture.world_map(world, self.render_world) if world_capture.needs_map(world) else None
-        if world_map is not None:
-            out.world_map = world_map
-            _, omega = world_directions(*world_map.shape[:2])
-            out.world_color = (np.tensordot(omega, world_map, axes=2) / omega.sum()).astype(np.float32)
+        captured = world_capture.capture(world, self.render_world) if world_capture.needs_map(world) else None
+        if captured is not None:
+            out.world_map = captured.map
+            _, omega = world_directions(*captured.map.shape[:2])
+            out.world_color = (np.tensordot(omega, captured.map, axes=2) / omega.sum()).astype(np.float32)
+            out.lights = [*out.lights, *captured.suns]  # a Sky Texture's sun disc: a sun, not in the map
+            out.warnings.extend(world_capture.disc_warnings(world))
         else:
             out.world_color = world_color(world, out.warnings).astype(np.float32)
 

@@ -178,7 +178,7 @@ def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
     notes = list(captured.warnings)
     if captured.triangle_count == 0:
         notes.append("the scene has no geometry: all light is zero")
-    if not captured.lights and not captured.emission.any():
+    if not captured.has_light_source():
         notes.append("the scene has no light sources: all light is zero")
     stats = {
         "method": gi.method,

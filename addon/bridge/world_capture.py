@@ -18,6 +18,14 @@ already made for this exact node tree: kept in the world by the Capture World Li
 saved with the .blend, keyed by the node tree and Blender's version), or rendered by a bake or a
 render in the same session.
 
+A Sky Texture's sun disc (on by default; half a degree wide) falls between the map's point-sampled
+texels, 5.6 degrees apart, and would be lost with most of a clear day's light: each disc Bounce can
+place (its Vector input unlinked) becomes a SUN light along the node's sun direction, its irradiance
+measured by a second render, a pinhole view three disc diameters wide around it (the pixels' excess
+over the sky at the view's border times their solid angles), and the map is rendered from a copy of
+the world with those discs off, so nothing is counted twice (`Captured.suns`). A disc turned by a
+linked Vector is left out with a warning.
+
 Cycles' equirectangular camera, rotated to look along +x with +z up, puts longitude increasing to the
 left: its columns are read reversed to match world.py's layout (tests/blender/test_world_capture.py
 renders a world whose colour is the view direction and checks every texel).
@@ -29,14 +37,17 @@ import hashlib
 import math
 import os
 import tempfile
+from typing import NamedTuple
 
 import bpy
 import numpy as np
+from mathutils import Vector
 
+from ..engine.scene import Light
 from . import compat
 
 MAP_ROWS, MAP_COLS = 32, 64
-_cache: dict[str, np.ndarray] = {}
+_cache: dict[str, Captured] = {}
 _binned_images: dict[tuple, np.ndarray] = {}  # an HDRI's map at strength 1, by (name, filepath, size)
 
 
@@ -139,29 +150,45 @@ def forget() -> None:
     _binned_images.clear()
 
 
-def world_map(world, render: bool = True) -> np.ndarray | None:
-    """The world's radiance map (MAP_ROWS, MAP_COLS, 3) float32 W/m^2/sr, cached by fingerprint. With
-    `render` False only what needs no Cycles render: an HDRI read directly, a map stored in the world
-    for this node tree (`store`), or one already made for it; None otherwise (the caller lights with the
-    world's average)."""
+class Captured(NamedTuple):
+    """A world as Bounce lights with it: its radiance map (MAP_ROWS, MAP_COLS, 3) float32 W/m^2/sr, and
+    the sun discs of its Sky Textures as SUN lights (Light, their light left out of the map: a disc of
+    half a degree falls between the map's point-sampled texels, which are 5.6 degrees apart)."""
+
+    map: np.ndarray
+    suns: tuple = ()
+
+
+def capture(world, render: bool = True) -> Captured | None:
+    """The world's light, cached by fingerprint. With `render` False only what needs no Cycles render:
+    an HDRI read directly, what the world stores for this node tree (`store`), or what was already made
+    for it; None otherwise (the caller lights with the world's average)."""
     key = fingerprint(world)
     if key not in _cache:
         hdri = _direct_hdri(world)
-        stored = stored_map(world) if hdri is None else None
+        stored = stored_capture(world) if hdri is None else None
         if hdri is None and stored is None and not render:
             return None
         _cache.clear()  # one world at a time: a new fingerprint replaces the old map
         if hdri is not None:
-            _cache[key] = _binned(*hdri)
+            _cache[key] = Captured(_binned(*hdri))
         else:
             _cache[key] = stored if stored is not None else _render(world)
     return _cache[key]
 
 
-# The map kept in the world datablock (so in the .blend) by the Capture World Light operator, with the
-# key of what it was rendered from: the node tree's fingerprint without the file's path (a saved copy
-# keeps it) and Blender's version (another version may model the sky otherwise).
-STORED_MAP, STORED_KEY = "bounce_world_map", "bounce_world_key"
+def world_map(world, render: bool = True) -> np.ndarray | None:
+    """capture's map alone (None where capture gives None)."""
+    captured = capture(world, render)
+    return None if captured is None else captured.map
+
+
+# What the Capture World Light operator keeps in the world datablock (so in the .blend): the map, its
+# suns (7 floats each: the direction the light travels, its irradiance per colour, its angular
+# diameter) and the key of what they were rendered from: the node tree's fingerprint without the
+# file's path (a saved copy keeps it) and Blender's version (another version may model the sky
+# otherwise).
+STORED_MAP, STORED_SUNS, STORED_KEY = "bounce_world_map", "bounce_world_suns", "bounce_world_key"
 
 
 def _stored_key(world) -> str:
@@ -169,23 +196,132 @@ def _stored_key(world) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def store(world, world_map: np.ndarray) -> None:
-    """Keep `world_map` in the world's custom properties (saved with the .blend, undone with undo)."""
-    world[STORED_MAP] = np.asarray(world_map, np.float64).ravel().tolist()
+def store(world, captured: Captured) -> None:
+    """Keep `captured` in the world's custom properties (saved with the .blend, undone with undo)."""
+    world[STORED_MAP] = np.asarray(captured.map, np.float64).ravel().tolist()
+    world[STORED_SUNS] = [float(v) for sun in captured.suns
+                          for v in (*sun.direction, *(sun.color * sun.sun_strength), sun.sun_angle_rad)]
     world[STORED_KEY] = _stored_key(world)
 
 
-def stored_map(world) -> np.ndarray | None:
-    """The map `store` kept in the world, if it was made from the world as it is now; else None."""
+def stored_capture(world) -> Captured | None:
+    """What `store` kept in the world, if it was made from the world as it is now; else None."""
     if world.get(STORED_KEY) != _stored_key(world) or STORED_MAP not in world:
         return None
     values = np.asarray(world[STORED_MAP], np.float32)
-    if values.size != MAP_ROWS * MAP_COLS * 3:
+    suns = np.asarray(world.get(STORED_SUNS, []), np.float64)
+    if values.size != MAP_ROWS * MAP_COLS * 3 or suns.size % 7:
         return None
-    return np.maximum(values.reshape(MAP_ROWS, MAP_COLS, 3), 0.0)
+    return Captured(np.maximum(values.reshape(MAP_ROWS, MAP_COLS, 3), 0.0),
+                    tuple(_sun_light(world, row[:3], row[3:6], row[6]) for row in suns.reshape(-1, 7)))
 
 
-def _render(world) -> np.ndarray:
+def _sun_light(world, direction, irradiance, angle_rad: float) -> Light:
+    """A SUN light travelling along `direction` with `irradiance` (W/m^2 per colour) facing it."""
+    irradiance = np.maximum(np.asarray(irradiance, np.float64), 0.0)
+    strength = float(irradiance.max())
+    color = irradiance / strength if strength > 0 else np.ones(3)
+    return Light("SUN", np.zeros(3), direction, color, sun_strength=strength, sun_angle_rad=float(angle_rad),
+                 name=f"{world.name}: sun disc")
+
+
+# Sky models that draw a sun disc (Blender 4.x names it NISHITA; 5.0 splits it in two).
+DISC_SKIES = {"NISHITA", "SINGLE_SCATTERING", "MULTIPLE_SCATTERING"}
+
+
+def sun_discs(world) -> list:
+    """The world's Sky Texture nodes that draw a sun disc."""
+    if world is None or world.node_tree is None:
+        return []
+    return [n for n in world.node_tree.nodes
+            if n.type == "TEX_SKY" and n.sky_type in DISC_SKIES and getattr(n, "sun_disc", False)]
+
+
+def disc_warnings(world) -> list[str]:
+    """The sun discs Bounce cannot place: a Sky Texture whose Vector input is linked (a mapping turns
+    its sky, so the node's own sun direction is not where the sun is)."""
+    return [f"world {world.name!r}: the sun disc of {n.name!r} is turned by its linked Vector input and "
+            "is left out (unlink it, or turn the disc off and add a Sun lamp)"
+            for n in sun_discs(world) if _vector_linked(n)]
+
+
+def _vector_linked(node) -> bool:
+    """Whether the node's Vector input is in use and linked (5.0's scattering skies disable the socket,
+    and a name lookup does not see a disabled socket)."""
+    return any(s.identifier == "Vector" and getattr(s, "enabled", True) and s.is_linked for s in node.inputs)
+
+
+def _render(world) -> Captured:
+    """The map rendered by Cycles; each sun disc Bounce can place becomes a SUN light, measured by a
+    render of a narrow view around it, and is left out of the map (rendered from a copy of the world
+    with those discs off)."""
+    discs = [n for n in sun_discs(world) if not _vector_linked(n)]
+    if not discs:
+        return Captured(_render_map(world))
+    suns = tuple(sun for sun in (_measure_sun(world, node) for node in discs) if sun is not None)
+    sky_only = world.copy()
+    try:
+        for node in discs:
+            sky_only.node_tree.nodes[node.name].sun_disc = False
+        return Captured(_render_map(sky_only), suns)
+    finally:
+        bpy.data.worlds.remove(sky_only)
+
+
+def sun_direction(node) -> np.ndarray:
+    """Unit vector towards a Sky Texture's sun: elevation above the horizon, rotation about +z from +y
+    towards +x (checked against Cycles: the disc lies at the centre of a view along it)."""
+    e, r = node.sun_elevation, node.sun_rotation
+    return np.array([math.cos(e) * math.sin(r), math.cos(e) * math.cos(r), math.sin(e)])
+
+
+SUN_VIEW_TEXELS = 64  # a side of the narrow view: the disc covers ~1/9 of it, ~350 point samples
+# How much brighter than the brightest sky around it a pixel must be to be the disc: a sun's radiance
+# is 10^4-10^5 times the sky's even at sunset (46 W/m^2 from 7e-5 sr against ~10 W/m^2/sr), a smooth
+# sky's excess over its mean across 1.5 degrees a few per cent of it.
+DISC_CONTRAST = 100.0
+
+
+def _measure_sun(world, node) -> Light | None:
+    """The sun disc of `node` as a SUN light: a pinhole view 3 disc diameters wide centred on the sun,
+    each pixel's radiance above the sky around the disc (the mean of the view's border) times its solid
+    angle, summed: the disc's irradiance facing it. None below the horizon (no disc in view)."""
+    toward = sun_direction(node)
+    half = 1.5 * node.sun_size
+    n = SUN_VIEW_TEXELS
+
+    def aim(cam_data, cam):
+        cam_data.sensor_fit = "HORIZONTAL"
+        cam_data.angle = 2.0 * half
+        cam.rotation_euler = Vector(toward).to_track_quat("-Z", "Y").to_euler()
+
+    radiance = _render_view(world, n, n, aim)
+    border = np.concatenate([radiance[0], radiance[-1], radiance[1:-1, 0], radiance[1:-1, -1]])
+    excess = np.maximum(radiance - border.mean(axis=0), 0.0)
+    if excess.max() <= DISC_CONTRAST * max(float(border.max()), 1e-30):
+        return None  # no disc in view, only the sky's own gradient across it
+    t = math.tan(half)
+    u = ((np.arange(n) + 0.5) / n * 2.0 - 1.0) * t
+    x, y = np.meshgrid(u, u)
+    solid_angle = (2.0 * t / n) ** 2 / (1.0 + x * x + y * y) ** 1.5  # a pinhole's pixels, image plane at 1
+    return _sun_light(world, -toward, np.einsum("ijc,ij->c", excess, solid_angle), node.sun_size)
+
+
+def _render_map(world) -> np.ndarray:
+    """The world rendered from a panoramic equirectangular camera at the origin, MAP_ROWS x MAP_COLS."""
+
+    def equirectangular(cam_data, cam):
+        cam_data.type = "PANO"
+        cam_data.panorama_type = "EQUIRECTANGULAR"
+        cam.rotation_euler = (math.pi / 2, 0.0, -math.pi / 2)  # looking along +x, +z up
+
+    rgb = _render_view(world, MAP_COLS, MAP_ROWS, equirectangular)
+    return np.ascontiguousarray(np.maximum(rgb[:, ::-1], 0.0), np.float32)  # columns mirrored (module doc)
+
+
+def _render_view(world, width: int, height: int, setup) -> np.ndarray:
+    """The world alone rendered by Cycles from a camera at the origin that `setup(camera data, camera
+    object)` points: (height, width, 3) float64 radiance, row 0 = top, one sample at each pixel centre."""
     scene = bpy.data.scenes.new("bounce_world_capture")
     cam_data = bpy.data.cameras.new("bounce_world_capture")
     cam = bpy.data.objects.new("bounce_world_capture", cam_data)
@@ -194,12 +330,10 @@ def _render(world) -> np.ndarray:
     try:
         scene.collection.objects.link(cam)
         scene.camera, scene.world = cam, world
-        cam_data.type = "PANO"
-        cam_data.panorama_type = "EQUIRECTANGULAR"
-        cam.rotation_euler = (math.pi / 2, 0.0, -math.pi / 2)  # looking along +x, +z up
+        setup(cam_data, cam)
         r = scene.render
         r.engine = "CYCLES"
-        r.resolution_x, r.resolution_y, r.resolution_percentage = MAP_COLS, MAP_ROWS, 100
+        r.resolution_x, r.resolution_y, r.resolution_percentage = width, height, 100
         scene.cycles.samples = 1
         scene.cycles.use_denoising = False
         scene.cycles.filter_width = 0.01  # each pixel its centre's direction, as world.py assumes
@@ -212,7 +346,7 @@ def _render(world) -> np.ndarray:
         bpy.data.images["Render Result"].save_render(path, scene=scene)
         image = bpy.data.images.load(path)
         image.colorspace_settings.is_data = True  # the EXR holds linear radiance: read it as stored
-        px = np.empty(MAP_ROWS * MAP_COLS * 4, np.float32)
+        px = np.empty(width * height * 4, np.float32)
         image.pixels.foreach_get(px)
     finally:
         if image is not None:
@@ -223,5 +357,4 @@ def _render(world) -> np.ndarray:
         if os.path.exists(path):
             os.remove(path)
             os.rmdir(os.path.dirname(path))
-    rgb = px.reshape(MAP_ROWS, MAP_COLS, 4)[::-1, ::-1, :3]  # Blender rows bottom-up; columns mirrored
-    return np.ascontiguousarray(np.maximum(rgb, 0.0), np.float32)
+    return px.reshape(height, width, 4)[::-1, :, :3].astype(np.float64)  # Blender's rows are bottom-up

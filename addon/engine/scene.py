@@ -135,6 +135,16 @@ class Scene:
             return np.ones(self.triangle_count, bool)
         return np.asarray(self.camera_visible, bool)
 
+    def has_light_source(self) -> bool:
+        """Whether anything lights the scene: a light with power (or a sun with strength) and a colour, an
+        emissive triangle, or a world that is not black."""
+        def emits(light: Light) -> bool:
+            strength = light.sun_strength if light.kind == "SUN" else light.power_w
+            return strength > 0 and bool(np.any(np.asarray(light.color) > 0))
+
+        world_lit = np.any(self.world_color > 0) or (self.world_map is not None and np.any(self.world_map > 0))
+        return any(emits(light) for light in self.lights) or bool(np.any(self.emission > 0)) or bool(world_lit)
+
     @property
     def triangle_count(self) -> int:
         return int(self.positions_m.shape[0])

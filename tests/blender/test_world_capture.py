@@ -1,6 +1,8 @@
 """A world that varies with direction, rendered by Cycles into world.py's map layout
 (bridge/world_capture.py), and the capture's choice between a constant and a map."""
 
+import math
+
 import numpy as np
 import pytest
 
@@ -65,6 +67,49 @@ def test_capture_keeps_a_constant_world_constant(fresh_blend):
     assert viewport.world_map is rendered
 
 
+def _sky_world(elevation=0.45, rotation=0.7):
+    """Blender's Sky Texture at its defaults (its sun disc on) with the sun at `elevation` above the
+    horizon, turned `rotation` about +z."""
+    from addon.bridge import compat
+
+    world = bpy.data.worlds.new("Sky")
+    tree = compat.node_tree(world)
+    node = tree.nodes.new("ShaderNodeTexSky")
+    node.sun_elevation, node.sun_rotation = elevation, rotation
+    tree.links.new(node.outputs["Color"], tree.nodes["Background"].inputs["Color"])
+    return world, node
+
+
+def test_a_sky_textures_sun_disc_becomes_a_sun_light(fresh_blend):
+    # The disc is half a degree wide: the map's point-sampled texels, 5.6 degrees apart, miss it (a map
+    # rendered with the disc equals one without). The capture renders the map without it and measures
+    # the disc as a SUN light along the node's sun direction (the irradiance against Cycles:
+    # tests/e2e/test_direct_vs_cycles.py, the sky case); a sun below the horizon gives none.
+    from addon.bridge import world_capture
+
+    world, node = _sky_world()
+    assert node.sun_disc and node.sky_type in world_capture.DISC_SKIES
+    captured = world_capture.capture(world)
+    (sun,) = captured.suns
+    np.testing.assert_allclose(sun.direction, -world_capture.sun_direction(node), atol=1e-12)
+    assert sun.sun_angle_rad == pytest.approx(node.sun_size)
+    with_disc = world_capture._render_map(world)
+    node.sun_disc = False
+    np.testing.assert_array_equal(world_capture._render_map(world), captured.map)
+    np.testing.assert_array_equal(with_disc, captured.map)  # what the disc would have added: nothing
+    # The disc's light against the whole sky's on a floor, in luminance: at 26 degrees a clear day's sun
+    # is most of it (4.9x the sky's in this model; the bound 3x only says it is no detail).
+    from addon.engine.world import LUMA, directions
+
+    d, omega = directions(*captured.map.shape[:2])
+    sky_floor = np.einsum("ijc,ij->c", captured.map * np.maximum(d[..., 2:3], 0.0), omega)
+    sun_floor = sun.sun_strength * sun.color * math.sin(node.sun_elevation)
+    assert sun_floor @ LUMA > 3.0 * (sky_floor @ LUMA), (sun_floor, sky_floor)
+    node.sun_disc = True
+    node.sun_elevation = -0.2
+    assert world_capture.capture(world).suns == ()
+
+
 def _hdri_world(hot_pixel=None, name="HDRI"):
     """An Environment Texture of a 256 x 128 float image (linear): a sky gradient from dark below to bright
     above (rows are bottom-up in Blender), and optionally one hot pixel (a sun)."""
@@ -100,7 +145,7 @@ def test_hdri_is_read_directly_and_agrees_with_cycles(fresh_blend):
     t0 = time.perf_counter()
     read = world_capture.world_map(world)
     read_s = time.perf_counter() - t0
-    rendered = world_capture._render(world)
+    rendered = world_capture._render_map(world)
     np.testing.assert_allclose(read, rendered, rtol=0.02)
     assert read_s < 0.5, read_s  # a read, not a render (~1.5 s)
 
@@ -181,9 +226,10 @@ def test_a_stored_map_is_saved_with_the_blend_until_the_world_changes(fresh_blen
     from addon.bridge import world_capture
     from addon.bridge.capture import SceneCache
 
-    world = _direction_world()
+    world, node = _sky_world()
     bpy.context.scene.world = world
-    made = world_capture.world_map(world)
+    made = world_capture.capture(world)
+    assert len(made.suns) == 1
     world_capture.store(world, made)
     path = tmp_path / "sky.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
@@ -192,6 +238,9 @@ def test_a_stored_map_is_saved_with_the_blend_until_the_world_changes(fresh_blen
     world_capture.forget()
     monkeypatch.setattr(world_capture, "_render", lambda world: pytest.fail("rendered a stored world"))
     scene = SceneCache(render_world=False).update(bpy.context.evaluated_depsgraph_get(), 8, 8)
-    np.testing.assert_array_equal(scene.world_map, made)
+    np.testing.assert_array_equal(scene.world_map, made.map)
+    (sun,) = [light for light in scene.lights if light.kind == "SUN"]
+    np.testing.assert_allclose(sun.direction, made.suns[0].direction, atol=1e-12)
+    np.testing.assert_allclose(sun.color * sun.sun_strength, made.suns[0].color * made.suns[0].sun_strength, rtol=1e-12)
     bpy.context.scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 2.0
     assert SceneCache(render_world=False).update(bpy.context.evaluated_depsgraph_get(), 8, 8).world_map is None
