@@ -97,14 +97,15 @@ def test_an_area_light_draws_in_a_real_window(shots):
 
 def test_a_sky_lights_by_direction_once_captured(shots):
     # A Sky Texture world: the overlay lights it as its average (the panel's row says so) until the
-    # Capture World Light operator renders its map in the real binary; then the light comes by direction,
-    # and the image changes visibly.
+    # Capture World Light operator renders its map and measures its sun disc in the real binary; then
+    # the light comes by direction, the disc as one sun, and the image changes visibly.
     result, crop = shots
     entry = result["sky"]
     assert entry["averaged"]["error"] is None and entry["averaged"]["world_averaged"], entry
     assert entry["operator"] == ["FINISHED"]
     captured = entry["captured"]
     assert captured["error"] is None and captured["map"] and not captured["world_averaged"], entry
+    assert captured["sun_discs"] == ["Sky: sun disc"], entry
     assert captured["gpu_runs"] >= 1
     change = np.abs(crop(captured["shot"]) - crop(entry["averaged"]["shot"]))
     assert (change.max(axis=2) > 4 / 255).mean() > 0.01

@@ -116,8 +116,9 @@ def steps():
     yield from until_updated(live, viewport, runs)
     result["area_light"] = {"shot": shot("area_light"), "status": live.status(), "error": live.STATE.error,
                             "gpu_runs": viewport.gpu_runs - runs}
-    # A sky (Blender's Sky Texture: no map Bounce reads itself) instead of the lamps: the overlay lights
-    # it as its average until Capture World Light renders its map, then by direction.
+    # A sky (Blender's Sky Texture, its sun disc on: no map Bounce reads itself) instead of the lamps: the
+    # overlay lights it as its average until Capture World Light renders its map and its sun, then by
+    # direction.
     area.hide_viewport = area.hide_render = True
     world = bpy.data.worlds.new("Sky")
     world.use_nodes = True
@@ -134,7 +135,8 @@ def steps():
     yield from until_updated(live, viewport, runs)
     entry["captured"] = {"shot": shot("sky_captured"), "world_averaged": settings.world_averaged,
                          "error": live.STATE.error, "gpu_runs": viewport.gpu_runs - runs,
-                         "map": live.STATE.scene.world_map is not None}
+                         "map": live.STATE.scene.world_map is not None,
+                         "sun_discs": [light.name for light in live.STATE.scene.lights if light.kind == "SUN"]}
 
 
 _steps = steps()
