@@ -24,7 +24,9 @@ place (its Vector input unlinked) becomes a SUN light along the node's sun direc
 measured by a second render, a pinhole view three disc diameters wide around it (the pixels' excess
 over the sky at the view's border times their solid angles), and the map is rendered from a copy of
 the world with those discs off, so nothing is counted twice (`Captured.suns`). A disc turned by a
-linked Vector is left out with a warning.
+linked Vector is left out with a warning. An HDRI's sun is taken out of its pixels the same way
+(`_take_sun`) before they are binned: a sun texel of the map would light through the sky pass's coarse
+shadow tiles from a direction up to 2.8 degrees off.
 
 Cycles' equirectangular camera, rotated to look along +x with +z up, puts longitude increasing to the
 left: its columns are read reversed to match world.py's layout (tests/blender/test_world_capture.py
@@ -44,11 +46,12 @@ import numpy as np
 from mathutils import Vector
 
 from ..engine.scene import Light
+from ..engine.world import LUMA
 from . import compat
 
 MAP_ROWS, MAP_COLS = 32, 64
 _cache: dict[str, Captured] = {}
-_binned_images: dict[tuple, np.ndarray] = {}  # an HDRI's map at strength 1, by (name, filepath, size)
+_binned_images: dict[tuple, tuple] = {}  # an HDRI's (map, suns) at strength 1, by (name, filepath, size)
 
 
 def _background(world):
@@ -73,18 +76,32 @@ def _direct_hdri(world):
 LINEAR_SPACES = {"Linear Rec.709", "Linear", "Non-Color", "Linear CIE-XYZ E", "Linear Rec.2020"}
 
 
-def _binned(image, strength: float) -> np.ndarray:
-    """The HDRI's map at `strength` (its binning at strength 1 cached per image: `_bin`)."""
+def _binned(world, image, strength: float) -> Captured:
+    """The HDRI's map and sun at `strength` (read at strength 1 and cached per image: `_read_hdri`)."""
     key = (image.name, image.filepath, tuple(image.size))
     if key not in _binned_images:
-        _binned_images[key] = _bin(image)
-    return (_binned_images[key] * np.float32(strength)).astype(np.float32)
+        _binned_images[key] = _read_hdri(image)
+    world_map, suns = _binned_images[key]
+    return Captured((world_map * np.float32(strength)).astype(np.float32),
+                    tuple(_sun_light(world, -toward, irradiance * strength, angle)
+                          for toward, irradiance, angle in suns))
 
 
-def _bin(image) -> np.ndarray:
+# An HDRI's sun: its pixels brighter than SUN_CONTRAST x the image's median luminance within
+# SUN_RADIUS_RAD of its brightest pixel (a photographed sun is 10^4-10^6 times the sky, blown out over
+# a degree or two). Left in the 5.6-degree map it would light through a shadow map of the sky pass's
+# tiles (64 texels across the scene: blurred shadows) from a texel centre up to 2.8 degrees off.
+SUN_CONTRAST = 100.0
+SUN_RADIUS_RAD = math.radians(5.0)
+
+
+def _read_hdri(image) -> tuple[np.ndarray, list]:
     """The HDRI's pixels binned into the map by direction (Cycles' equirectangular mapping: u = 0.5 -
     atan2(y, x) / 2 pi, v = 0.5 + atan2(z, hypot(x, y)) / pi, row 0 = bottom), each weighted by its
-    solid angle: the map texel's radiance is the mean over the image pixels it holds."""
+    solid angle: the map texel's radiance is the mean over the image pixels it holds. Its sun (if any,
+    SUN_CONTRAST) is taken out first: its pixels keep SUN_CONTRAST x the median, and what they had above
+    that becomes one sun, (direction towards it, irradiance facing it per colour, angular diameter of a
+    disc of its pixels' solid angle), so the map and the sun together hold the image's int L dw."""
     w, h = image.size
     px = np.empty(w * h * 4, np.float32)
     image.pixels.foreach_get(px)
@@ -94,6 +111,7 @@ def _bin(image) -> np.ndarray:
     u = (np.arange(w) + 0.5) / w
     lon = (0.5 - u) * 2 * np.pi                                 # atan2(y, x) of each column
     weight = np.repeat(np.cos(lat)[:, None], w, axis=1)         # solid angle per pixel, up to a constant
+    rgb, suns = _take_sun(rgb, lat, lon, weight * (np.pi / h) * (2 * np.pi / w))
     # world.py's layout: row 0 = up, column c at longitude 2 pi (c + 0.5) / MAP_COLS - pi
     rows = np.clip(((np.pi / 2 - lat) / np.pi * MAP_ROWS).astype(int), 0, MAP_ROWS - 1)
     cols = np.clip(((lon + np.pi) / (2 * np.pi) * MAP_COLS).astype(int) % MAP_COLS, 0, MAP_COLS - 1)
@@ -103,7 +121,27 @@ def _bin(image) -> np.ndarray:
         total[:, c] = np.bincount(index, weights=(rgb[..., c] * weight).ravel(), minlength=MAP_ROWS * MAP_COLS)
     norm = np.bincount(index, weights=weight.ravel(), minlength=MAP_ROWS * MAP_COLS)
     out = total / np.maximum(norm, 1e-300)[:, None]
-    return np.maximum(out, 0.0).reshape(MAP_ROWS, MAP_COLS, 3).astype(np.float32)
+    return np.maximum(out, 0.0).reshape(MAP_ROWS, MAP_COLS, 3).astype(np.float32), suns
+
+
+def _take_sun(rgb: np.ndarray, lat: np.ndarray, lon: np.ndarray, solid_angle: np.ndarray) -> tuple:
+    """(rgb with its sun's excess removed, [the sun] or []) for an equirectangular image: rows at
+    latitudes `lat`, columns at longitudes `lon`, pixels of `solid_angle` sr (module's SUN_CONTRAST)."""
+    luma = np.maximum(rgb @ LUMA, 0.0)
+    level = SUN_CONTRAST * float(np.median(luma))
+    peak = np.unravel_index(np.argmax(luma), luma.shape)
+    if luma[peak] <= level or level <= 0.0:
+        return rgb, []
+    cos_lat = np.cos(lat)[:, None]
+    dirs = np.stack(np.broadcast_arrays(cos_lat * np.cos(lon)[None, :], cos_lat * np.sin(lon)[None, :],
+                                        np.sin(lat)[:, None]), axis=-1)
+    hot = (luma > level) & (dirs @ dirs[peak] > math.cos(SUN_RADIUS_RAD))
+    keep = np.where(hot, level / np.maximum(luma, 1e-300), 1.0)[..., None]  # hot pixels down to `level`
+    excess = rgb * (1.0 - keep)
+    irradiance = np.einsum("ijc,ij->c", excess, solid_angle)
+    toward = np.einsum("ij,ijk->k", (excess @ LUMA) * solid_angle, dirs)
+    angle = 2.0 * math.sqrt(float(solid_angle[hot].sum()) / math.pi)
+    return rgb * keep, [(toward / np.linalg.norm(toward), irradiance, angle)]
 
 
 def needs_map(world) -> bool:
@@ -171,7 +209,7 @@ def capture(world, render: bool = True) -> Captured | None:
             return None
         _cache.clear()  # one world at a time: a new fingerprint replaces the old map
         if hdri is not None:
-            _cache[key] = Captured(_binned(*hdri))
+            _cache[key] = _binned(world, *hdri)
         else:
             _cache[key] = stored if stored is not None else _render(world)
     return _cache[key]

@@ -150,20 +150,28 @@ def test_hdri_is_read_directly_and_agrees_with_cycles(fresh_blend):
     assert read_s < 0.5, read_s  # a read, not a render (~1.5 s)
 
 
-def test_hdri_sun_keeps_its_energy(fresh_blend):
-    # One pixel 2000 times the sky: a point-sampled map would miss it; the read bins it into one texel
-    # with its solid angle, so the map's total power int L dw equals the image's (to float rounding).
+def test_hdri_sun_becomes_a_sun_and_keeps_its_energy(fresh_blend):
+    # One pixel 2000 times the sky: the read takes it out as a sun along that pixel's direction (the
+    # pixel kept at 100x the image's median luminance) and bins the rest into the map with each pixel's
+    # solid angle, so the map's int L dw plus the sun's irradiance equal the image's (to 2e-3: the read
+    # weighs pixels by cos(latitude), the test by the exact band areas).
     from addon.bridge import world_capture
     from addon.engine.world import directions
 
     world, image = _hdri_world(hot_pixel=(90, 100), name="HDRI with a sun")
-    m = world_capture.world_map(world)
-    _, omega = directions(*m.shape[:2])
+    captured = world_capture.capture(world)
+    (sun,) = captured.suns
+    _, omega = directions(*captured.map.shape[:2])
     h, w = image.shape[:2]
     lat = ((np.arange(h) + 0.5) / h - 0.5) * np.pi  # image rows bottom-up
     band = 2 * np.pi * (np.sin(lat + np.pi / (2 * h)) - np.sin(lat - np.pi / (2 * h))) / w
     expected = np.einsum("ijc,i->c", image, band)
-    np.testing.assert_allclose(np.einsum("ijc,ij->c", m, omega), expected, rtol=2e-3)
+    total = np.einsum("ijc,ij->c", captured.map, omega) + sun.sun_strength * sun.color
+    np.testing.assert_allclose(total, expected, rtol=2e-3)
+    assert sun.sun_strength > 0.9 * float((image[90, 100] * band[90]).max())  # nearly all of it is the sun
+    sun_lat, sun_lon = lat[90], (0.5 - (100 + 0.5) / w) * 2 * np.pi  # that pixel's centre
+    toward = [np.cos(sun_lat) * np.cos(sun_lon), np.cos(sun_lat) * np.sin(sun_lon), np.sin(sun_lat)]
+    np.testing.assert_allclose(-sun.direction, toward, atol=1e-9)
 
 
 def test_viewport_reads_an_hdri_without_rendering_and_rebins_nothing_for_its_strength(fresh_blend, monkeypatch):
@@ -175,8 +183,8 @@ def test_viewport_reads_an_hdri_without_rendering_and_rebins_nothing_for_its_str
 
     world_capture.forget()
     bins = []
-    real_bin = world_capture._bin
-    monkeypatch.setattr(world_capture, "_bin", lambda image: bins.append(image.name) or real_bin(image))
+    real_read = world_capture._read_hdri
+    monkeypatch.setattr(world_capture, "_read_hdri", lambda image: bins.append(image.name) or real_read(image))
     monkeypatch.setattr(world_capture, "_render", lambda world: pytest.fail("the viewport rendered the world"))
     world, image = _hdri_world()
     bpy.context.scene.world = world

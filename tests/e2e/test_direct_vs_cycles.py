@@ -82,14 +82,53 @@ def test_direct_matches_cycles_diffuse_direct(scene_name, tmp_path):
     assert lo <= err["bias"] <= hi, err
 
 
-def _save_sky_scene(path) -> None:
-    """A 10 m floor and a 1 m box under Blender's default Sky Texture (its sun disc on, the sun 26
-    degrees up): no lamp at all, the sun is the world's. A camera looks down at the box and its shadow."""
-    import math
-
+def _sky_world():
+    """Blender's default Sky Texture (its sun disc on) with the sun 26 degrees up."""
     import bpy
 
     from addon.bridge import compat
+
+    world = bpy.data.worlds.new("Sky")
+    tree = compat.node_tree(world)
+    sky = tree.nodes.new("ShaderNodeTexSky")
+    sky.sun_elevation, sky.sun_rotation = 0.45, 0.7
+    tree.links.new(sky.outputs["Color"], tree.nodes["Background"].inputs["Color"])
+    return world
+
+
+def _hdri_world():
+    """An HDRI (a packed 512 x 256 float image): a sky from 0.3 at the horizon to 1 at the zenith, and a
+    sun of 3 x 3 pixels (2.1 degrees) at 40 degrees up, 2e4 times the sky's zenith."""
+    import bpy
+    import numpy as np
+
+    from addon.bridge import compat
+
+    w, h = 512, 256
+    lat = ((np.arange(h) + 0.5) / h - 0.5) * np.pi  # rows bottom-up
+    sky = 0.3 + 0.7 * np.maximum(np.sin(lat), 0.0)
+    px = np.ones((h, w, 4))
+    px[..., :3] = sky[:, None, None] * np.array([0.6, 0.8, 1.0])
+    row = int((np.radians(40.0) / np.pi + 0.5) * h)
+    px[row - 1:row + 2, 60:63, :3] = 2e4 * np.array([1.0, 0.9, 0.8])
+    image = bpy.data.images.new("Sun sky", w, h, float_buffer=True)
+    image.colorspace_settings.name = "Linear Rec.709"
+    image.pixels.foreach_set(px.astype(np.float32).ravel())
+    image.pack()
+    world = bpy.data.worlds.new("HDRI")
+    tree = compat.node_tree(world)
+    env = tree.nodes.new("ShaderNodeTexEnvironment")
+    env.image = image
+    tree.links.new(env.outputs["Color"], tree.nodes["Background"].inputs["Color"])
+    return world
+
+
+def _save_sky_scene(path, world) -> None:
+    """A 10 m floor and a 1 m box under `world` (a function making it) and no lamp at all: its sun is
+    the world's. A camera looks down at the box and its shadow."""
+    import math
+
+    import bpy
 
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
@@ -99,32 +138,29 @@ def _save_sky_scene(path) -> None:
     scene.collection.objects.link(cam)
     scene.camera = cam
     cam.location, cam.rotation_euler = (0.0, -6.0, 4.0), (math.radians(58.0), 0.0, 0.0)
-    world = bpy.data.worlds.new("Sky")
-    tree = compat.node_tree(world)
-    sky = tree.nodes.new("ShaderNodeTexSky")
-    sky.sun_elevation, sky.sun_rotation = 0.45, 0.7
-    tree.links.new(sky.outputs["Color"], tree.nodes["Background"].inputs["Color"])
-    scene.world = world
+    scene.world = world()
     scene.render.resolution_x, scene.render.resolution_y = 128, 96
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
 
 
-def test_a_sky_with_its_sun_disc_lights_as_in_cycles(tmp_path):
-    # The world's sun disc is a SUN light of the measured irradiance (bridge/world_capture.py); the rest of
-    # the sky, the sky pass. Same bound as the lamps'. Measured at 128 px against 256 spp: rel_rmse_8
-    # 0.017, bias 1.006; before the disc was a light, 0.874 / 0.224 (the sun lost).
+@pytest.mark.parametrize("world", ["sky", "hdri"])
+def test_a_worlds_sun_lights_as_in_cycles(world, tmp_path):
+    # A world's sun is a SUN light (bridge/world_capture.py): the Sky Texture's disc of the measured
+    # irradiance, an HDRI's brightest pixels taken out of its map; the rest of the world, the sky pass.
+    # Same bound as the lamps'. The sky measured at 128 px against 256 spp: rel_rmse_8 0.017, bias
+    # 1.006; before the disc was a light, 0.874 / 0.224 (the sun lost).
     from addon.bridge import images
     from addon.bridge.pipeline import render_file
     from addon.bridge.reference import render_reference
     from addon.engine import metrics
     from addon.engine.config import GIConfig, RsmConfig
 
-    blend = tmp_path / "sky.blend"
-    _save_sky_scene(blend)
+    blend = tmp_path / f"{world}.blend"
+    _save_sky_scene(blend, {"sky": _sky_world, "hdri": _hdri_world}[world])
     (tmp_path / "ours").mkdir()
     stats = render_file(blend, tmp_path / "ours", {"gi": GIConfig(method="direct", resolution=RES),
                                                    "rsm": RsmConfig(resolution=512)}, repeat=1)
-    assert stats["lights"] == 1  # the disc
+    assert stats["lights"] == 1  # the world's sun
     for s in (0, 1):
         render_reference(blend, tmp_path / f"ref{s}", spp=SKY_SPP, bounces=1, res=RES, seed=s)
     ours = images.read_exr(tmp_path / "ours" / "direct.exr")
@@ -134,7 +170,7 @@ def test_a_sky_with_its_sun_disc_lights_as_in_cycles(tmp_path):
     assert mask.sum() >= MIN_PIXELS
     noise = metrics.compare(ref1[..., :3], ref0[..., :3], mask)
     err = metrics.compare(ours[..., :3], ref0[..., :3], mask)
-    print(f"sky with its sun disc: ours vs Cycles {err}; noise floor {noise}")
+    print(f"{world} with its sun: ours vs Cycles {err}; noise floor {noise}")
     assert noise["rel_rmse"] < BOUND_REL_RMSE / 2, f"reference too noisy for the bound: {noise}"
     assert err["rel_rmse"] <= BOUND_REL_RMSE, err
     assert BOUND_BIAS[0] <= err["bias"] <= BOUND_BIAS[1], err
