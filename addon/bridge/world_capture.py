@@ -87,7 +87,7 @@ def _binned(world, image, strength: float) -> Captured:
                           for toward, irradiance, angle in suns))
 
 
-# An HDRI's sun: its pixels brighter than SUN_CONTRAST x the image's median luminance within
+# An HDRI's sun: its pixels brighter than SUN_CONTRAST x the median luminance of its lit pixels within
 # SUN_RADIUS_RAD of its brightest pixel (a photographed sun is 10^4-10^6 times the sky, blown out over
 # a degree or two). Left in the 5.6-degree map it would light through a shadow map of the sky pass's
 # tiles (64 texels across the scene: blurred shadows) from a texel centre up to 2.8 degrees off.
@@ -128,9 +128,12 @@ def _take_sun(rgb: np.ndarray, lat: np.ndarray, lon: np.ndarray, solid_angle: np
     """(rgb with its sun's excess removed, [the sun] or []) for an equirectangular image: rows at
     latitudes `lat`, columns at longitudes `lon`, pixels of `solid_angle` sr (module's SUN_CONTRAST)."""
     luma = np.maximum(rgb @ LUMA, 0.0)
-    level = SUN_CONTRAST * float(np.median(luma))
+    lit = luma[luma > 0.0]  # a sky dome's black lower half would put the median at 0
+    if lit.size == 0:
+        return rgb, []
+    level = SUN_CONTRAST * float(np.median(lit))
     peak = np.unravel_index(np.argmax(luma), luma.shape)
-    if luma[peak] <= level or level <= 0.0:
+    if luma[peak] <= level:
         return rgb, []
     cos_lat = np.cos(lat)[:, None]
     dirs = np.stack(np.broadcast_arrays(cos_lat * np.cos(lon)[None, :], cos_lat * np.sin(lon)[None, :],

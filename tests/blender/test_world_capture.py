@@ -172,6 +172,16 @@ def test_hdri_sun_becomes_a_sun_and_keeps_its_energy(fresh_blend):
     sun_lat, sun_lon = lat[90], (0.5 - (100 + 0.5) / w) * 2 * np.pi  # that pixel's centre
     toward = [np.cos(sun_lat) * np.cos(sun_lon), np.cos(sun_lat) * np.sin(sun_lon), np.sin(sun_lat)]
     np.testing.assert_allclose(-sun.direction, toward, atol=1e-9)
+    # A sky dome whose lower half is black still finds its sun (the level is the lit pixels' median),
+    # and an image with no pixel 100x that level has none.
+    from addon.bridge.world_capture import _take_sun
+
+    dome = image.copy()
+    dome[: h // 2] = 0.0
+    solid = np.repeat(band[:, None], w, axis=1)
+    lon = (0.5 - (np.arange(w) + 0.5) / w) * 2 * np.pi
+    assert len(_take_sun(dome, lat, lon, solid)[1]) == 1
+    assert _take_sun(np.where(dome > 100, 1.0, dome), lat, lon, solid)[1] == []
 
 
 def test_viewport_reads_an_hdri_without_rendering_and_rebins_nothing_for_its_strength(fresh_blend, monkeypatch):
