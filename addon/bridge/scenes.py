@@ -305,9 +305,10 @@ def build_cornell_large_area() -> None:
     _light("Area", "AREA", (0.0, 0.0, 1.98), 200.0, shape="SQUARE", size=1.0, spread=math.pi)
 
 
-def _world(color=(0.0, 0.0, 0.0), strength: float = 1.0, sky: bool = False) -> None:
-    """The scene's world: a constant colour x strength, or (sky) a Sky Texture without its sun disc
-    (the scene's own SUN lamp is the sun) x strength."""
+def _world(color=(0.0, 0.0, 0.0), strength: float = 1.0, sky: bool = False, sun_disc: bool = False) -> None:
+    """The scene's world: a constant colour x strength, or (sky) a Sky Texture x strength, without its
+    sun disc (the scene's own SUN lamp is the sun; the sky's own sun where the node puts it by default)
+    or, `sun_disc`, with it, the sky's sun along WINDOW_SUN_DIR."""
     world = bpy.context.scene.world
     tree = compat.node_tree(world)
     background = tree.nodes["Background"]
@@ -315,7 +316,12 @@ def _world(color=(0.0, 0.0, 0.0), strength: float = 1.0, sky: bool = False) -> N
     background.inputs["Strength"].default_value = strength
     if sky:
         tex = tree.nodes.new("ShaderNodeTexSky")
-        tex.sun_disc = False
+        tex.sun_disc = sun_disc
+        if sun_disc:
+            toward = -np.asarray(WINDOW_SUN_DIR, float) / np.linalg.norm(WINDOW_SUN_DIR)
+            # world_capture.sun_direction: elevation, then rotation about +z from +y towards +x
+            tex.sun_elevation = float(np.arcsin(toward[2]))
+            tex.sun_rotation = float(np.arctan2(toward[0], toward[1]))
         tree.links.new(tex.outputs["Color"], background.inputs["Color"])
 
 
@@ -332,6 +338,15 @@ def build_window_sky() -> None:
     build_window_room()
     bpy.context.scene["bounce_scene"] = "window-sky"
     _world(strength=1.0, sky=True)
+
+
+def build_window_sky_sun() -> None:
+    """window-room lit by Blender's Sky Texture alone, as artists light with it: its sun disc is the
+    sun (along window-room's sun, through the window), no lamp."""
+    build_window_room()
+    bpy.data.objects.remove(bpy.data.objects["Sun"])
+    bpy.context.scene["bounce_scene"] = "window-sky-sun"
+    _world(strength=1.0, sky=True, sun_disc=True)
 
 
 def build_textured() -> None:
@@ -392,6 +407,7 @@ SCENES = {
     "cornell-large-area": build_cornell_large_area,
     "cornell-grey-world": build_cornell_grey_world,
     "window-sky": build_window_sky,
+    "window-sky-sun": build_window_sky_sun,
     "cornell-glossy": build_cornell_glossy,
     "textured": build_textured,
     "window-room": build_window_room,
