@@ -12,7 +12,7 @@ scene sync), so the map is cached by a fingerprint of the world's node tree and 
 that changes. A constant background (no link into its Color) needs no map: capture.world_color gives it.
 
 The interactive viewport never renders from its timer (a second's stall per edit of the sky): it asks
-`world_map(world, render=False)`, which reads an HDRI (each image's binning cached apart from the
+`capture(world, render=False)`, which reads an HDRI (each image's binning cached apart from the
 Background's strength, so dragging the strength re-reads nothing) and otherwise returns only a map
 already made for this exact node tree: kept in the world by the Capture World Light operator (`store`:
 saved with the .blend, keyed by the node tree and Blender's version), or rendered by a bake or a
@@ -193,8 +193,8 @@ def forget() -> None:
 
 class Captured(NamedTuple):
     """A world as Bounce lights with it: its radiance map (MAP_ROWS, MAP_COLS, 3) float32 W/m^2/sr, and
-    the sun discs of its Sky Textures as SUN lights (Light, their light left out of the map: a disc of
-    half a degree falls between the map's point-sampled texels, which are 5.6 degrees apart)."""
+    its suns as SUN lights (Light), their light left out of the map: its Sky Textures' discs (half a
+    degree, between the map's point-sampled texels 5.6 degrees apart) or an HDRI's sun (`_take_sun`)."""
 
     map: np.ndarray
     suns: tuple = ()
@@ -263,7 +263,7 @@ def _sun_light(world, direction, irradiance, angle_rad: float) -> Light:
     strength = float(irradiance.max())
     color = irradiance / strength if strength > 0 else np.ones(3)
     return Light("SUN", np.zeros(3), direction, color, sun_strength=strength, sun_angle_rad=float(angle_rad),
-                 name=f"{world.name}: sun disc")
+                 name=f"{world.name}: sun")
 
 
 # Sky models that draw a sun disc (Blender 4.x names it NISHITA; 5.0 splits it in two).

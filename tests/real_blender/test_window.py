@@ -105,7 +105,7 @@ def test_a_sky_lights_by_direction_once_captured(shots):
     assert entry["operator"] == ["FINISHED"]
     captured = entry["captured"]
     assert captured["error"] is None and captured["map"] and not captured["world_averaged"], entry
-    assert captured["sun_discs"] == ["Sky: sun disc"], entry
+    assert captured["sun_discs"] == ["Sky: sun"], entry
     assert captured["gpu_runs"] >= 1
     change = np.abs(crop(captured["shot"]) - crop(entry["averaged"]["shot"]))
     assert (change.max(axis=2) > 4 / 255).mean() > 0.01
