@@ -432,7 +432,7 @@ class SceneCache:
             out.world_map = captured.map
             _, omega = world_directions(*captured.map.shape[:2])
             out.world_color = (np.tensordot(omega, captured.map, axes=2) / omega.sum()).astype(np.float32)
-            out.lights = [*out.lights, *captured.suns]  # a Sky Texture's sun disc: a sun, not in the map
+            out.lights = [*out.lights, *captured.suns]  # its suns (a sky's disc, an HDRI's sun): not in the map
             out.warnings.extend(world_capture.disc_warnings(world))
         else:
             out.world_color = world_color(world, out.warnings).astype(np.float32)
