@@ -184,7 +184,9 @@ class ProbesConfig(_Validated):
     # Cornell at 128 px against Cycles (docs/PROBES.md), rel_rmse_8: 4 probes a side 0.35, 8 0.20,
     # 12 0.16, 16 0.124 at 8^2 texels a face; at 16 a side 4^2 faces 0.22, 6^2 0.17 (the visibility
     # moments' resolution). Cost: 6 draws of the scene per probe per geometry change, 6 face_texels^2
-    # texels per probe re-shaded per light change.
+    # texels per probe re-shaded per light change. Other face sizes do not converge: each texel is shaded
+    # at its centre, so a bright feature seen at a grazing angle is hit or missed by where the rows fall
+    # (docs/PROBES.md, "The capture aliases bright light seen at a grazing angle").
     probes_per_side: int = _num(16, 2, 64, "probes along the bounds' longest side (spacing = that side / n)")
     face_texels: int = _num(8, 4, 64, "texels per side of each of a probe's six captured faces")
     normal_bias: float = _num(0.25, 0.0, 1.0, "lookup point moved off its surface along the normal, x spacing")
