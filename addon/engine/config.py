@@ -189,6 +189,11 @@ class ProbesConfig(_Validated):
     # (docs/PROBES.md, "The capture aliases bright light seen at a grazing angle").
     probes_per_side: int = _num(16, 2, 64, "probes along the bounds' longest side (spacing = that side / n)")
     face_texels: int = _num(8, 4, 64, "texels per side of each of a probe's six captured faces")
+    # A face texel that sees its surface at a grazing angle (|n . w| < 0.25) is shaded at this many
+    # points along its footprint instead of its centre alone (direct/shade.comp.glsl, texel_area_light):
+    # the capture's aliasing of bright light seen edge-on. 1: the centre only.
+    area_samples: int = _num(1, 1, 16, "points a grazing probe texel is shaded at along its footprint (1: its "
+                             "centre)")
     normal_bias: float = _num(0.25, 0.0, 1.0, "lookup point moved off its surface along the normal, x spacing")
     # sh: the paper's nine coefficients per colour; irradiance: a cube map of exact clamped-cosine
     # irradiance per probe (DDGI's irradiance map, in the capture's cube layout), no SH ringing: Cornell

@@ -200,11 +200,9 @@ bool in_front_of_texel(vec3 p, vec3 q, ivec2 size, float texel_m) {
 }
 #endif
 
-// This face's direct light (irradiance / pi) at G-buffer pixel px, which sees geometry: 0 where
-// another face shades it, where the light does not reach it, or in its shadow.
-vec3 face_light(ivec2 px, vec4 pos) {
-    vec3 p = pos.xyz;
-    vec3 n = texelFetch(gbuf_normal, px, 0).xyz;
+// This face's direct light (irradiance / pi) at surface point p of normal n: 0 where another face shades
+// it, where the light does not reach it, or in its shadow.
+vec3 face_light(vec3 p, vec3 n) {
     vec3 irradiance;
     vec3 to_light;
     float dist = 0.0;
@@ -274,6 +272,53 @@ vec3 face_light(ivec2 px, vec4 pos) {
     return irradiance * (lit / PI);
 }
 
+#ifdef AREA_SAMPLES
+// A probe atlas texel stands for its whole solid angle, but the G-buffer holds only the surface at its
+// centre. Where that surface is seen at a grazing angle its footprint is long, and a bright feature
+// thinner than the texel (a sun patch seen from just above the floor) is hit or missed by the centre
+// (docs/PROBES.md, "The capture aliases bright light seen at a grazing angle"). There the light is
+// the mean over AREA_SAMPLES rays spread across the texel along its footprint
+// (probes/footprint.comp.glsl). A ray meets the centre's plane within the distances the texel's two
+// neighbours along the footprint see; beyond them it meets what that neighbour sees instead (a wall
+// behind the floor), shaded at the neighbour's point; where the neighbour bounds nothing, the
+// centre's point. Used on the probe atlas only (passes/probe_project.py, ProbesConfig.area_samples).
+vec3 texel_area_light(ivec2 px, vec3 p, vec3 n) {
+    vec4 origin = texelFetch(footprint_origin, px, 0);
+    vec4 step = texelFetch(footprint_step, px, 0);
+    ivec4 neighbours = ivec4(texelFetch(footprint_neighbours, px, 0));
+    vec3 o = origin.xyz;
+    int samples = any(notEqual(step.xyz, vec3(0.0))) ? AREA_SAMPLES : 1;
+    vec3 w = p - o;
+    vec3 a = abs(w);
+    vec3 centre = w / max(max(a.x, a.y), a.z);  // forward + s right + t up: its face-axis component is +-1
+    float along = dot(w, n);  // the plane's signed distance from the probe, along n
+    // One call of face_light (one inlined copy of the shading): the texel that does not graze shades
+    // its centre's surface point once.
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < AREA_SAMPLES; ++i) {
+        if (i >= samples) {
+            break;
+        }
+        vec3 q = p;
+        vec3 nq = n;
+        if (samples > 1) {
+            vec3 d = normalize(centre + step.xyz * ((float(i) + 0.5) / float(samples) - 0.5));
+            float cos_plane = dot(d, n);
+            float t = cos_plane * along > 0.0 ? along / cos_plane : 1e30;  // parallel or away: far
+            ivec2 beyond = t < origin.w ? neighbours.xy : (t > step.w ? neighbours.zw : ivec2(0));
+            if (t >= origin.w && t <= step.w) {
+                q = o + d * t;
+            } else if (any(notEqual(beyond, ivec2(0)))) {
+                q = texelFetch(gbuf_position, px + beyond, 0).xyz;
+                nq = texelFetch(gbuf_normal, px + beyond, 0).xyz;
+            }
+        }
+        sum += face_light(q, nq);
+    }
+    return sum / float(samples);
+}
+#endif
+
 // Adds this face's light to `direct`, or with accumulate = 0 (a solve's first face on the probe atlas)
 // puts it in place of what `direct` holds, so that the atlas needs no zeroing pass before each solve
 // (texels that see no geometry are never written: 0 since set-up). One store, after the shading: a
@@ -287,7 +332,12 @@ void main() {
     if (pos.w == 0.0) {
         return;
     }
-    vec3 light = face_light(px, pos);
+    vec3 n = texelFetch(gbuf_normal, px, 0).xyz;
+#ifdef AREA_SAMPLES
+    vec3 light = texel_area_light(px, pos.xyz, n);
+#else
+    vec3 light = face_light(pos.xyz, n);
+#endif
     if (accumulate != 0 && all(equal(light, vec3(0.0)))) {
         return;
     }

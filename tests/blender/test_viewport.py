@@ -200,7 +200,7 @@ def test_navigating_gives_preview_then_full_quality(cornell):
 @pytest.mark.parametrize("name", ["direct", "direct-world", "direct-area", "direct-emissive", "rsm", "lpv",
                                   "lpv-far-field", "lpv-emitter-classes",
                                   "lpv-octree", "lpv-octree-index", "vct", "vct-filtered", "diffusion", "probes",
-                                  "probes-irradiance", "probes-relocate", "gather", "gather-point"])
+                                  "probes-irradiance", "probes-relocate", "probes-area", "gather", "gather-point"])
 def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, name):
     # lpv at 16 cells runs one grid; "lpv-far-field" at 32 cells adds the far field's passes;
     # "lpv-emitter-classes" (16 cells) the classes' injection, unpacks and own-light lookups;
@@ -211,7 +211,9 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
     # "direct-area" and "direct-emissive" the direct pass of lights with a shape (its POLYGONS program,
     # which reads fewer uniforms than a point's: the compiler drops the rest);
     # "gather-point" the gather's point-to-point form factor; "probes-relocate" the relocation step,
-    # the moved probes' tiles cleared and drawn again, and every probe shader at the moved positions.
+    # the moved probes' tiles cleared and drawn again, and every probe shader at the moved positions;
+    # "probes-area" the grazing texels' footprints and the atlas's area-sampled direct pass of a light
+    # with a shape (the program with the most samplers).
     from addon.bridge import scenes
     from addon.bridge.capture import SceneCache
     from addon.engine import methods
@@ -226,8 +228,9 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
     )
 
     # vct: its glossy product too; direct-world: Blender's default grey world besides the spot.
-    scenes.build({"direct-world": "cornell-grey-world", "direct-area": "cornell-large-area",
-                  "direct-emissive": "emissive"}.get(name, "cornell-glossy" if name.startswith("vct") else "cornell"))
+    scene_of = {"direct-world": "cornell-grey-world", "direct-area": "cornell-large-area",
+                "direct-emissive": "emissive", "probes-area": "cornell-large-area"}
+    scenes.build(scene_of.get(name, "cornell-glossy" if name.startswith("vct") else "cornell"))
     scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 64, 48)
     method_name, grid_cells = ("lpv", 32) if name == "lpv-far-field" else (name.split("-")[0], 16)
     gi = GIConfig(method=method_name, resolution=64)
@@ -242,7 +245,8 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
                                      "diffusion": DiffusionConfig(grid_cells=16),
                                      "probes": ProbesConfig(probes_per_side=6, encoding="irradiance"
                                                             if name == "probes-irradiance" else "sh",
-                                                            relocate=name == "probes-relocate"),
+                                                            relocate=name == "probes-relocate",
+                                                            area_samples=4 if name == "probes-area" else 1),
                                      "gather": GatherConfig(form_factor="point" if name == "gather-point"
                                                             else "polygon")})
         method.set_scene(scene)

@@ -350,3 +350,73 @@ def test_the_probes_see_the_skys_light_through_an_opening(gl):
     assert floor.sum() > 1000 and np.isfinite(ours).all() and ours.min() >= 0.0
     assert np.sqrt(np.mean((ours - exact[:, None]) ** 2)) / exact.mean() < 0.2
     assert ours.mean() / exact.mean() == pytest.approx(1.0, abs=0.06)
+
+
+def _spot_lit_floor_probes(gl, area_samples):
+    """A closed 4 x 4 x 2 m room (albedo 0.5) lit only by a spot 1 m above the floor's centre pointing
+    down with a sharp 60-degree cone (a disc of radius tan(30 deg) m on the floor); probes 16 a side, so
+    the lowest layer is 0.125 m above the floor. Returns (the probes' positions (m, world), int L dw over each
+    probe's first-bounce capture: the SH table's c_0 x 2 sqrt(pi)), and the exact answer's inputs."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "hard"))
+    from hard_scenes import box, camera
+    from hard_scenes import scene as make_scene
+
+    from addon.engine import methods
+    from addon.engine.config import GIConfig, RsmConfig
+    from addon.engine.scene import Light
+
+    tris, normals = box([-2, -2, 0], [2, 2, 2])
+    geometry = (tris, normals, np.full((len(tris), 3), 0.5))
+    spot = Light("SPOT", [0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [1.0, 1.0, 1.0], power_w=100.0,
+                 spot_size_rad=math.radians(60.0), spot_blend=0.0)
+    sc = make_scene(geometry, [spot], camera([0, -1.9, 1.0], [0, 1, -0.3], size=16))
+    method = methods.create(gl, {"gi": GIConfig(method="probes"), "rsm": RsmConfig(resolution=256),
+                                 "probes": ProbesConfig(probes_per_side=16, area_samples=area_samples)})
+    method.set_scene(sc)
+    method.run()
+    grid = method.grid
+    table = gl.read(method.light)  # c_0 of probe p = ix + nx row at texel (ix, row)
+    c0 = table[:, :grid.dims[0], :3].reshape(-1, 3).mean(axis=-1)
+    return grid.positions_m() + method.origin_m, c0 * 2.0 * math.sqrt(math.pi)
+
+
+def _exact_spot_disc_radiance_integral(probe_m):
+    """int L dw over the lit disc seen from probe_m: L = albedo E / pi, E = I cos / d^2 with I = P / (4 pi)
+    (scene.Light), summed over 2 mm cells of the floor (the disc's edge cells split by their centres:
+    ~0.3 % of its area)."""
+    intensity, albedo, height = 100.0 / (4.0 * math.pi), 0.5, 1.0
+    radius = math.tan(math.radians(30.0))
+    cell = 0.002
+    x = np.arange(-radius, radius, cell) + cell / 2
+    gx, gy = np.meshgrid(x, x)
+    inside = gx ** 2 + gy ** 2 <= radius ** 2
+    gx, gy = gx[inside], gy[inside]
+    d2 = gx ** 2 + gy ** 2 + height ** 2
+    radiance = albedo * intensity * height / d2 ** 1.5 / math.pi
+    r2 = (gx - probe_m[0]) ** 2 + (gy - probe_m[1]) ** 2 + probe_m[2] ** 2
+    solid_angle = cell * cell * probe_m[2] / r2 ** 1.5  # the cell's area x its cosine towards the probe / r^2
+    return float(np.sum(radiance * solid_angle))
+
+
+def test_area_samples_integrate_a_lit_disc_seen_at_a_grazing_angle(gl):
+    # The probes of the lowest layer, 0.125 m above the floor and 1.1-1.9 m from the spot's axis, see its
+    # lit disc 2-13 degrees below their horizon, within the 14-degree texel row next to it of an 8^2 face.
+    # Shaded at texel centres, a probe's rows hit or miss it (docs/PROBES.md, "The capture aliases bright
+    # light seen at a grazing angle"): int L dw over the capture against the exact, rel_rmse over those
+    # 120 probes 1.74 (some read 0, others 3x). Shaded at 8 points along each grazing texel's footprint:
+    # 0.069, at 16 points 0.041 (what is left: the disc's sides fall between the face's columns, which
+    # are still shaded at their centres). Bounds: the centre-only error above 0.4, the area-sampled one
+    # below 0.15.
+    errors = {}
+    for samples in (1, 8):
+        positions, ours = _spot_lit_floor_probes(gl, samples)
+        rho = np.hypot(positions[:, 0], positions[:, 1])
+        chosen = (np.abs(positions[:, 2] - 0.125) < 1e-6) & (rho > 1.1) & (rho < 1.9)
+        exact = np.array([_exact_spot_disc_radiance_integral(p) for p in positions[chosen]])
+        assert chosen.sum() >= 20 and np.isfinite(ours).all() and ours.min() >= 0.0
+        errors[samples] = float(np.sqrt(np.mean((ours[chosen] - exact) ** 2)) / exact.mean())
+    assert errors[1] > 0.4, errors
+    assert errors[8] < 0.15, errors

@@ -31,7 +31,8 @@ class ProbesMethod(OneBounceMethod):
     spec = registry.get("probes")
     WORLD_SUN_RSMS = False
     PASSES = declare.extend(
-        OneBounceMethod.PASSES, setup=(probe_capture.CAPTURE_DECL, probe_relocate.DECL, probe_capture.MOMENTS_DECL),
+        OneBounceMethod.PASSES, setup=(probe_capture.CAPTURE_DECL, probe_relocate.DECL, probe_capture.MOMENTS_DECL,
+                                       probe_capture.FOOTPRINT_DECL),
         # The SH encoding's passes, then the irradiance encoding's (ProbesConfig.encoding picks one).
         solve=(probe_project.SKY_DECL, probe_project.SHADE_DECL, probe_project.PROJECT_DECL, probe_lookup.BOUNCE_DECL,
                probe_project.REPROJECT_DECL, probe_project.CONVOLVE_DECL, probe_lookup.IRRADIANCE_BOUNCE_DECL,
@@ -78,6 +79,10 @@ class ProbesMethod(OneBounceMethod):
         self.probes_moved = self.relocate(mesh, far) if cfg.relocate else 0
         probe_capture.moments(be, self.atlas, self.moments, self.state, grid, cfg.backface_share, self.offset,
                               needed)
+        self.footprint = None
+        if cfg.area_samples > 1:
+            self.footprint = declare.allocate(be, probe_capture.FOOTPRINT, size)
+            probe_capture.footprint(be, self.atlas, self.offset, self.footprint, grid)
 
     def relocate(self, mesh, far: float) -> int:
         """Move probes out of solids and off near surfaces (probe_relocate), capturing the moved ones
@@ -128,7 +133,8 @@ class ProbesMethod(OneBounceMethod):
         with self.step(timings, probe_project.SHADE_DECL):
             shadow, shadow_view = self.shadow_map(view)
             probe_project.shade(self.backend, self.atlas, self.atlas_direct, shadow, shadow_view,
-                                self.rsm_config.shadow_bias_texels, self.emitters, first=self._faces_shaded == 0)
+                                self.rsm_config.shadow_bias_texels, self.emitters, first=self._faces_shaded == 0,
+                                footprint=self.footprint, area_samples=self.probes_config.area_samples)
         self._faces_shaded += 1
 
     def finish_solve(self, timings: dict[str, float]) -> None:

@@ -12,6 +12,8 @@ each pixel is shaded by exactly one face.
 
 from __future__ import annotations
 
+import functools
+
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from .declare import (
     DIRECT,
@@ -26,18 +28,25 @@ from .declare import (
 from .light_views import KIND_CODE, LightView
 
 
-def _spec(polygons: bool, soft_sun: bool) -> ShaderSpec:
+@functools.cache  # one spec, hence one program, per kind
+def _spec(polygons: bool, soft_sun: bool, area_samples: int = 1) -> ShaderSpec:
     """The pass for one kind of light: with its polygons' irradiance (POLYGONS: the emitter table and
     its rows) or a point's, with a sun's soft shadows (SOFT_SUN: the sun's angle) or a hard shadow test.
     One program each, because llvmpipe runs the code of a branch no invocation takes: with both kinds in
-    one program a spot's shading of the probe atlas took 4.5 x as long (docs/PROBES.md)."""
+    one program a spot's shading of the probe atlas took 4.5 x as long (docs/PROBES.md).
+    area_samples > 1: the G-buffer is a probe atlas, and a texel that sees its surface at a grazing angle
+    is shaded at that many points along its footprint (AREA_SAMPLES; probe_capture.FOOTPRINT)."""
+    area = area_samples > 1
     return ShaderSpec(
-        name="direct_shade" + ("_polygons" if polygons else "") + ("_soft_sun" if soft_sun else ""),
+        name="direct_shade" + ("_polygons" if polygons else "") + ("_soft_sun" if soft_sun else "")
+        + (f"_area{area_samples}" if area else ""),
         compute="direct/shade.comp.glsl",
         local_size=(8, 8, 1),
         samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("rsm_position", "2D"),
                   Sampler("rsm_normal", "2D"))
-        + ((Sampler("emitters", "2D"),) if polygons else ()),
+        + ((Sampler("emitters", "2D"),) if polygons else ())
+        + ((Sampler("footprint_origin", "2D"), Sampler("footprint_step", "2D"), Sampler("footprint_neighbours", "2D"))
+           if area else ()),
         images=(Image("direct", "2D", "RGBA32F", "read_write"),),
         uniforms=(
             Var("light_view_projection", "mat4"),
@@ -49,7 +58,8 @@ def _spec(polygons: bool, soft_sun: bool) -> ShaderSpec:
         ) + ((Var("poly_first", "int"), Var("poly_count", "int"), Var("emitter_radius_m", "float"),
                Var("light_view_projection_inverse", "mat4")) if polygons else ())
         + ((Var("sun_tan_half", "float"),) if soft_sun else ()),
-        defines=((("POLYGONS", "1"),) if polygons else ()) + ((("SOFT_SUN", "1"),) if soft_sun else ()),
+        defines=((("POLYGONS", "1"),) if polygons else ()) + ((("SOFT_SUN", "1"),) if soft_sun else ())
+        + ((("AREA_SAMPLES", str(area_samples)),) if area else ()),
     )
 
 
@@ -62,20 +72,23 @@ DECL = PassDecl("direct_light", "gather", (GBUF_POSITION, GBUF_NORMAL, RSM_POSIT
 
 
 def run(backend: Backend, gbuf_position, gbuf_normal, shadow: dict, direct, view: LightView,
-        shadow_bias_texels: float, emitters, accumulate: bool = True) -> None:
+        shadow_bias_texels: float, emitters, accumulate: bool = True, footprint=None) -> None:
     """`shadow`: the shadow map's "position" and "normal" textures (the RSM's, or a sun's own map).
     `emitters`: the emitter table texture; the view's uniforms give its rows (poly_first, poly_count).
     accumulate: add to `direct`; False: replace its pixels that see geometry (those that see none are not
-    written: the caller keeps them 0)."""
+    written: the caller keeps them 0). footprint: where the G-buffer is a probe atlas to shade by its
+    texels' areas: (probe_capture.footprint's textures by name, samples)."""
     view_uniforms = view.uniforms
     soft_sun = view_uniforms["light_kind"] == KIND_CODE["SUN"] and view_uniforms["sun_tan_half"] > 0.0
-    spec = SPECS[(view_uniforms.get("poly_count", 0) > 0, soft_sun)]
+    area_samples = footprint[1] if footprint is not None else 1
+    spec = _spec(view_uniforms.get("poly_count", 0) > 0, soft_sun, area_samples)
     names = {u.name for u in spec.uniforms}
     uniforms = {k: v for k, v in view_uniforms.items() if k in names}
+    extra_samplers = footprint[0] if area_samples > 1 else {}
     uniforms["shadow_bias_texels"] = shadow_bias_texels
     uniforms["accumulate"] = int(accumulate)
     backend.dispatch(backend.program(spec), group_count(direct.size, spec.local_size), uniforms=uniforms,
                      samplers={"gbuf_position": gbuf_position, "gbuf_normal": gbuf_normal,
                                "rsm_position": shadow["position"], "rsm_normal": shadow["normal"],
-                               "emitters": emitters},
+                               "emitters": emitters, **extra_samplers},
                      images={"direct": direct})

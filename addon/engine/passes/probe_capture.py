@@ -63,6 +63,16 @@ CAPTURE_DECL = PassDecl("probe_capture", "setup", (TRIANGLES,), ATLAS,
                         "every probe's six faces rasterized into the atlas G-buffer")
 MOMENTS_DECL = PassDecl("probe_moments", "setup", (ATLAS_POSITION, ATLAS_NORMAL, OFFSET), (MOMENTS, STATE),
                         "distance moments per atlas texel; probes inside geometry switched off")
+# With ProbesConfig.area_samples > 1: what the direct pass needs to shade a grazing texel along its
+# footprint (probes/footprint.comp.glsl).
+FOOTPRINT = (_atlas("footprint_origin", "xyz: the texel's probe position (m); w: the least distance to follow "
+                    "its plane (m)"),
+             _atlas("footprint_step", "xyz: the ray direction's change across the texel (0: it does not graze); "
+                    "w: the greatest distance to follow its plane (m)"),
+             _atlas("footprint_neighbours", "xy, zw: atlas offsets of the neighbours seen nearer and farther along "
+                    "the footprint ((0, 0): none)"))
+FOOTPRINT_DECL = PassDecl("probe_footprint", "setup", (ATLAS_POSITION, ATLAS_NORMAL, OFFSET), FOOTPRINT,
+                          "per grazing atlas texel, its probe, footprint step and plane's distance range")
 
 SPEC = ShaderSpec(
     name="probe_capture",
@@ -82,6 +92,15 @@ MOMENTS_SPEC = ShaderSpec(
     samplers=(Sampler("atlas_position", "2D"), Sampler("probe_offset", "2D")),
     images=(Image("moments", "2D", "RGBA32F", "write"),),
     uniforms=(*GRID_UNIFORMS, Var("max_distance_m", "float"), Var("moment_radius", "int")),
+)
+
+FOOTPRINT_SPEC = ShaderSpec(
+    name="probe_footprint",
+    compute="probes/footprint.comp.glsl",
+    local_size=(8, 8, 1),
+    samplers=(Sampler("atlas_position", "2D"), Sampler("atlas_normal", "2D"), Sampler("probe_offset", "2D")),
+    images=tuple(Image(p.name, "2D", "RGBA32F", "write") for p in FOOTPRINT),
+    uniforms=GRID_UNIFORMS,
 )
 
 CLASSIFY_SPEC = ShaderSpec(
@@ -151,3 +170,13 @@ def moments(backend: Backend, atlas: dict, out_moments, out_state, grid: ProbeGr
         state = backend.read(out_state)
         state[..., 0] *= needed.reshape(state.shape[:2])
         backend.write(out_state, state)
+
+
+def footprint(backend: Backend, atlas: dict, offset, out: dict, grid: ProbeGrid) -> None:
+    """out (FOOTPRINT's textures by name) := each grazing texel's footprint, from the capture and the
+    probes' positions (grid + `offset`)."""
+    backend.dispatch(backend.program(FOOTPRINT_SPEC), group_count(grid.atlas_size, FOOTPRINT_SPEC.local_size),
+                     uniforms=grid_uniforms(FOOTPRINT_SPEC, grid),
+                     samplers={"atlas_position": atlas["position"], "atlas_normal": atlas["normal"],
+                               "probe_offset": offset},
+                     images=out)
