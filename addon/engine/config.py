@@ -191,7 +191,8 @@ class ProbesConfig(_Validated):
     face_texels: int = _num(8, 4, 64, "texels per side of each of a probe's six captured faces")
     # A face texel that sees its surface at a grazing angle (|n . w| < 0.25) is shaded at this many
     # points along its footprint instead of its centre alone (direct/shade.comp.glsl, texel_area_light):
-    # the capture's aliasing of bright light seen edge-on. 1: the centre only.
+    # the capture's aliasing of bright light seen edge-on. 1: the centre only. Off by default: at 4 the
+    # light update costs about lpv's on cornell (docs/PROBES.md, "Area sampling of grazing texels").
     area_samples: int = _num(1, 1, 16, "points a grazing probe texel is shaded at along its footprint (1: its "
                              "centre)")
     normal_bias: float = _num(0.25, 0.0, 1.0, "lookup point moved off its surface along the normal, x spacing")

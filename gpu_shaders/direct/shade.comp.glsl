@@ -281,41 +281,34 @@ vec3 face_light(vec3 p, vec3 n) {
 // (probes/footprint.comp.glsl). A ray meets the centre's plane within the distances the texel's two
 // neighbours along the footprint see; beyond them it meets what that neighbour sees instead (a wall
 // behind the floor), shaded at the neighbour's point; where the neighbour bounds nothing, the
-// centre's point. Used on the probe atlas only (passes/probe_project.py, ProbesConfig.area_samples).
+// centre's point. Only the probe atlas's grazing texels run this (the list `grazing_texels`,
+// passes/direct_light.py); the others are shaded at their centres by the ATLAS_CENTRES program.
 vec3 texel_area_light(ivec2 px, vec3 p, vec3 n) {
     vec4 origin = texelFetch(footprint_origin, px, 0);
     vec4 step = texelFetch(footprint_step, px, 0);
     ivec4 neighbours = ivec4(texelFetch(footprint_neighbours, px, 0));
     vec3 o = origin.xyz;
-    int samples = any(notEqual(step.xyz, vec3(0.0))) ? AREA_SAMPLES : 1;
     vec3 w = p - o;
     vec3 a = abs(w);
     vec3 centre = w / max(max(a.x, a.y), a.z);  // forward + s right + t up: its face-axis component is +-1
     float along = dot(w, n);  // the plane's signed distance from the probe, along n
-    // One call of face_light (one inlined copy of the shading): the texel that does not graze shades
-    // its centre's surface point once.
     vec3 sum = vec3(0.0);
     for (int i = 0; i < AREA_SAMPLES; ++i) {
-        if (i >= samples) {
-            break;
-        }
+        vec3 d = normalize(centre + step.xyz * ((float(i) + 0.5) / float(AREA_SAMPLES) - 0.5));
+        float cos_plane = dot(d, n);
+        float t = cos_plane * along > 0.0 ? along / cos_plane : 1e30;  // parallel or away: far
+        ivec2 beyond = t < origin.w ? neighbours.xy : (t > step.w ? neighbours.zw : ivec2(0));
         vec3 q = p;
         vec3 nq = n;
-        if (samples > 1) {
-            vec3 d = normalize(centre + step.xyz * ((float(i) + 0.5) / float(samples) - 0.5));
-            float cos_plane = dot(d, n);
-            float t = cos_plane * along > 0.0 ? along / cos_plane : 1e30;  // parallel or away: far
-            ivec2 beyond = t < origin.w ? neighbours.xy : (t > step.w ? neighbours.zw : ivec2(0));
-            if (t >= origin.w && t <= step.w) {
-                q = o + d * t;
-            } else if (any(notEqual(beyond, ivec2(0)))) {
-                q = texelFetch(gbuf_position, px + beyond, 0).xyz;
-                nq = texelFetch(gbuf_normal, px + beyond, 0).xyz;
-            }
+        if (t >= origin.w && t <= step.w) {
+            q = o + d * t;
+        } else if (any(notEqual(beyond, ivec2(0)))) {
+            q = texelFetch(gbuf_position, px + beyond, 0).xyz;
+            nq = texelFetch(gbuf_normal, px + beyond, 0).xyz;
         }
         sum += face_light(q, nq);
     }
-    return sum / float(samples);
+    return sum / float(AREA_SAMPLES);
 }
 #endif
 
@@ -324,14 +317,32 @@ vec3 texel_area_light(ivec2 px, vec3 p, vec3 n) {
 // (texels that see no geometry are never written: 0 since set-up). One store, after the shading: a
 // store on each of its early ways out cost llvmpipe a third more time.
 void main() {
+#ifdef AREA_SAMPLES
+    // One invocation per listed grazing texel (xy: its atlas texel, w: 1; the list's tail is 0).
+    ivec2 entry = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(entry, textureSize(grazing_texels, 0)))) {
+        return;
+    }
+    vec4 listed = texelFetch(grazing_texels, entry, 0);
+    if (listed.w == 0.0) {
+        return;
+    }
+    ivec2 px = ivec2(listed.xy);
+#else
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(px, textureSize(gbuf_position, 0)))) {
         return;
     }
+#endif
     vec4 pos = texelFetch(gbuf_position, px, 0);
     if (pos.w == 0.0) {
         return;
     }
+#ifdef ATLAS_CENTRES
+    if (any(notEqual(texelFetch(footprint_step, px, 0).xyz, vec3(0.0)))) {
+        return;  // a grazing texel: the AREA_SAMPLES program shades it
+    }
+#endif
     vec3 n = texelFetch(gbuf_normal, px, 0).xyz;
 #ifdef AREA_SAMPLES
     vec3 light = texel_area_light(px, pos.xyz, n);

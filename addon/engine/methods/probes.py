@@ -79,10 +79,7 @@ class ProbesMethod(OneBounceMethod):
         self.probes_moved = self.relocate(mesh, far) if cfg.relocate else 0
         probe_capture.moments(be, self.atlas, self.moments, self.state, grid, cfg.backface_share, self.offset,
                               needed)
-        self.footprint = None
-        if cfg.area_samples > 1:
-            self.footprint = declare.allocate(be, probe_capture.FOOTPRINT, size)
-            probe_capture.footprint(be, self.atlas, self.offset, self.footprint, grid)
+        self.footprint = probe_capture.footprint(be, self.atlas, self.offset, grid) if cfg.area_samples > 1 else None
 
     def relocate(self, mesh, far: float) -> int:
         """Move probes out of solids and off near surfaces (probe_relocate), capturing the moved ones

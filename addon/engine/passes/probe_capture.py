@@ -19,7 +19,7 @@ import numpy as np
 
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..probe_grid import ProbeGrid, face_view_projection
-from . import zero
+from . import declare, zero
 from .declare import TRIANGLES, PassDecl, Port
 
 # Texels each side of the moments' window. 0: each texel's own distance; the variance comes from the
@@ -71,8 +71,12 @@ FOOTPRINT = (_atlas("footprint_origin", "xyz: the texel's probe position (m); w:
                     "w: the greatest distance to follow its plane (m)"),
              _atlas("footprint_neighbours", "xy, zw: atlas offsets of the neighbours seen nearer and farther along "
                     "the footprint ((0, 0): none)"))
-FOOTPRINT_DECL = PassDecl("probe_footprint", "setup", (ATLAS_POSITION, ATLAS_NORMAL, OFFSET), FOOTPRINT,
-                          "per grazing atlas texel, its probe, footprint step and plane's distance range")
+GRAZING_TEXELS = Port("probes", "grazing_texels", "RGBA32F", "list",
+                      "xy: an atlas texel whose footprint_step is not 0; w: 1 (0 past the list's end)")
+GRAZING_LIST_WIDTH = 1024  # entries per row of the grazing texels' list
+FOOTPRINT_DECL = PassDecl("probe_footprint", "setup", (ATLAS_POSITION, ATLAS_NORMAL, OFFSET),
+                          (*FOOTPRINT, GRAZING_TEXELS),
+                          "per grazing atlas texel, its probe, footprint step and plane's distance range; their list")
 
 SPEC = ShaderSpec(
     name="probe_capture",
@@ -172,11 +176,21 @@ def moments(backend: Backend, atlas: dict, out_moments, out_state, grid: ProbeGr
         backend.write(out_state, state)
 
 
-def footprint(backend: Backend, atlas: dict, offset, out: dict, grid: ProbeGrid) -> None:
-    """out (FOOTPRINT's textures by name) := each grazing texel's footprint, from the capture and the
-    probes' positions (grid + `offset`)."""
+def footprint(backend: Backend, atlas: dict, offset, grid: ProbeGrid) -> dict:
+    """FOOTPRINT's textures by name (each grazing texel's footprint, from the capture and the probes'
+    positions: grid + `offset`) and GRAZING_TEXELS, the list of the grazing texels (read back: the
+    direct pass shades them apart, so that their loop runs only where they are)."""
+    out = declare.allocate(backend, FOOTPRINT, grid.atlas_size)
     backend.dispatch(backend.program(FOOTPRINT_SPEC), group_count(grid.atlas_size, FOOTPRINT_SPEC.local_size),
                      uniforms=grid_uniforms(FOOTPRINT_SPEC, grid),
                      samplers={"atlas_position": atlas["position"], "atlas_normal": atlas["normal"],
                                "probe_offset": offset},
                      images=out)
+    step = backend.read(out["footprint_step"])  # rows are texel rows y, from 0
+    y, x = np.nonzero(np.any(step[..., :3] != 0.0, axis=-1))
+    width = int(min(GRAZING_LIST_WIDTH, max(len(x), 1)))
+    table = np.zeros((-(-max(len(x), 1) // width) * width, 4), np.float32)
+    table[:len(x)] = np.stack([x, y, np.zeros_like(x), np.ones_like(x)], axis=-1)
+    out[GRAZING_TEXELS.name] = backend.texture((width, len(table) // width),
+                                               data=table.reshape(-1, width, 4))
+    return out

@@ -20,7 +20,15 @@ from ..probe_grid import ProbeGrid
 from . import direct_light
 from .declare import EMITTERS, LIGHT_VIEWS, RSM_NORMAL, RSM_POSITION, PassDecl, Port
 from .light_views import LightView
-from .probe_capture import ATLAS_ALBEDO, ATLAS_NORMAL, ATLAS_POSITION, ATLAS_UNIFORMS, grid_uniforms
+from .probe_capture import (
+    ATLAS_ALBEDO,
+    ATLAS_NORMAL,
+    ATLAS_POSITION,
+    ATLAS_UNIFORMS,
+    FOOTPRINT,
+    GRAZING_TEXELS,
+    grid_uniforms,
+)
 from .sky_light import SKY_BOUNDS, SKY_DEPTH, SKY_TABLE
 
 ATLAS_DIRECT = Port("probes", "direct", "RGBA32F", "probe_atlas", "irradiance / pi at the surface a texel sees")
@@ -33,7 +41,7 @@ IRRADIANCE = Port("probes", "irradiance", "RGBA32F", "probe_atlas",
 IRRADIANCE_TEXELS = 4  # m: each face of a probe's irradiance cube map is m x m normals
 
 SHADE_DECL = PassDecl("probe_direct", "solve", (ATLAS_POSITION, ATLAS_NORMAL, RSM_POSITION, RSM_NORMAL, LIGHT_VIEWS,
-                                                EMITTERS),
+                                                EMITTERS, *FOOTPRINT, GRAZING_TEXELS),
                       (ATLAS_DIRECT,), "one light face's shadow-mapped direct light on the probe atlas, added")
 SKY_DECL = PassDecl("probe_sky", "solve", (ATLAS_POSITION, ATLAS_NORMAL, SKY_DEPTH, SKY_BOUNDS, SKY_TABLE),
                     (ATLAS_DIRECT,), "the sky's shadowed direct light on the probe atlas (sky_light.direct), first")
@@ -77,11 +85,14 @@ SPECS = {(bounce, encoding): _spec(bounce, encoding) for bounce in (False, True)
 
 
 def shade(backend: Backend, atlas: dict, atlas_direct, shadow: dict, view: LightView, shadow_bias_texels: float,
-          emitters, first: bool) -> None:
+          emitters, first: bool, footprint: dict | None = None, area_samples: int = 1) -> None:
     """atlas_direct += one light face's direct light; the solve's first face (`first`) replaces the last
-    solve's light instead, at every texel that sees geometry (the others the caller keeps 0)."""
+    solve's light instead, at every texel that sees geometry (the others the caller keeps 0). With
+    area_samples > 1 (ProbesConfig.area_samples) a texel that sees its surface at a grazing angle is
+    shaded at that many points of its footprint (`footprint`: probe_capture.footprint's textures)."""
     direct_light.run(backend, atlas["position"], atlas["normal"], shadow, atlas_direct, view,
-                     shadow_bias_texels, emitters, accumulate=not first)
+                     shadow_bias_texels, emitters, accumulate=not first,
+                     footprint=(footprint, area_samples) if area_samples > 1 else None)
 
 
 def run(backend: Backend, atlas: dict, atlas_direct, sh, grid: ProbeGrid, atlas_indirect=None) -> None:
