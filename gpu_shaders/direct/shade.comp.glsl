@@ -5,6 +5,7 @@
 // a sun with an angle. llvmpipe pays for a branch's code even where no invocation takes it: a spot
 // shaded 1.1 M probe atlas texels in ~270 ms with both, ~60 ms without (docs/PROBES.md).
 #include "common/light.glsl"
+#include "common/texel_list.glsl"
 #include "common/polygon.glsl"
 
 const float PI = 3.14159265;
@@ -28,10 +29,23 @@ int cube_face(vec3 d) {
 // spiral (fixed: no per-pixel noise).
 const int SOFT_SAMPLES = 16;
 const float MAX_SOFT_TEXELS = 16.0;
+// A probe atlas texel shaded at AREA_SAMPLES points (texel_area_light) spends one point's taps over
+// them: point s takes the spiral's taps s, s + AREA_SAMPLES, ..., so together they cover the disc as the
+// centre's 16 do, and the grazing texels' pass costs about what as many centres do (4 points of
+// window-sky-sun's sun with 16 taps each: 68 ms, more than the 630 K other texels' 150 ms).
+#ifdef AREA_SAMPLES
+const int SOFT_STRIDE = AREA_SAMPLES;
+#else
+const int SOFT_STRIDE = 1;
+#endif
+const int SOFT_TAPS = SOFT_SAMPLES / SOFT_STRIDE;  // AREA_SAMPLES <= 16 (ProbesConfig): at least 1
+int soft_first = 0;  // the spiral's first tap for the point being shaded
 
+// Tap i of the point being shaded: the spiral's tap soft_first + SOFT_STRIDE i.
 vec2 vogel(int i) {
-    float r = sqrt((float(i) + 0.5) / float(SOFT_SAMPLES));
-    float a = float(i) * 2.39996323;
+    int j = soft_first + SOFT_STRIDE * i;
+    float r = sqrt((float(j) + 0.5) / float(SOFT_SAMPLES));
+    float a = float(j) * 2.39996323;
     return r * vec2(cos(a), sin(a));
 }
 #endif
@@ -71,7 +85,7 @@ float soft_sun_visibility(vec2 uv, ivec2 size, float receiver, float bias_m, flo
     float search = min(MAX_SOFT_TEXELS, sun_tan_half * float(size.x));
     float blockers = 0.0;
     float depth_sum = 0.0;
-    for (int i = 0; i < SOFT_SAMPLES; ++i) {
+    for (int i = 0; i < SOFT_TAPS; ++i) {
         vec2 offset = search * vogel(i);
         float d = sun_depth(uv + offset, size);
         if (d < receiver + dot(slope, offset) - bias_m) {
@@ -84,12 +98,12 @@ float soft_sun_visibility(vec2 uv, ivec2 size, float receiver, float bias_m, flo
     }
     float radius = clamp((receiver - depth_sum / blockers) * sun_tan_half / texel_m, 0.5, MAX_SOFT_TEXELS);
     float lit = 0.0;
-    for (int i = 0; i < SOFT_SAMPLES; ++i) {
+    for (int i = 0; i < SOFT_TAPS; ++i) {
         vec2 offset = radius * vogel(i);
         float d = sun_depth(uv + offset, size);
         lit += d >= 1e29 ? centre_lit : (d >= receiver + dot(slope, offset) - bias_m ? 1.0 : 0.0);
     }
-    return lit / float(SOFT_SAMPLES);
+    return lit / float(SOFT_TAPS);
 }
 #endif
 
@@ -148,7 +162,7 @@ float patch_visibility(vec2 uv, ivec2 size, vec3 p, vec3 p_test, vec3 n, float b
     float search = clamp(3.0 * emitter_radius_m / (receiver_m * texel_rad), 0.5, MAX_SOFT_TEXELS);
     float blockers = 0.0;
     float blocker_sum_m = 0.0;
-    for (int i = 0; i < SOFT_SAMPLES; ++i) {
+    for (int i = 0; i < SOFT_TAPS; ++i) {
         float d = patch_blocker_m(clamp(uv + search * vogel(i), lo, hi), size, p, p_test, n, receiver_m, bias_m,
                                   texel_m);
         if (d >= 0.0 && d < 1e29) {
@@ -163,7 +177,7 @@ float patch_visibility(vec2 uv, ivec2 size, vec3 p, vec3 p_test, vec3 n, float b
     float radius = clamp(emitter_radius_m * (1.0 / mean_blocker_m - 1.0 / receiver_m) / texel_rad, 0.5,
                          MAX_SOFT_TEXELS);
     float lit = 0.0;
-    for (int i = 0; i < SOFT_SAMPLES; ++i) {
+    for (int i = 0; i < SOFT_TAPS; ++i) {
         float d = patch_blocker_m(clamp(uv + radius * vogel(i), lo, hi), size, p, p_test, n, receiver_m, bias_m,
                                   texel_m);
         // A texel with no geometry counts as the centre does (a disc reaching past a closed room's outer
@@ -171,7 +185,7 @@ float patch_visibility(vec2 uv, ivec2 size, vec3 p, vec3 p_test, vec3 n, float b
         bool sample_lit = d >= 1e29 ? centre_lit : d < 0.0;
         lit += sample_lit ? 1.0 : 0.0;
     }
-    return lit / float(SOFT_SAMPLES);
+    return lit / float(SOFT_TAPS);
 }
 #endif
 
@@ -281,8 +295,8 @@ vec3 face_light(vec3 p, vec3 n) {
 // (probes/footprint.comp.glsl). A ray meets the centre's plane within the distances the texel's two
 // neighbours along the footprint see; beyond them it meets what that neighbour sees instead (a wall
 // behind the floor), shaded at the neighbour's point; where the neighbour bounds nothing, the
-// centre's point. Only the probe atlas's grazing texels run this (the list `grazing_texels`,
-// passes/direct_light.py); the others are shaded at their centres by the ATLAS_CENTRES program.
+// centre's point. Only the probe atlas's grazing texels run this (their list, passes/direct_light.py);
+// the others are shaded at their centres by a program of their own.
 vec3 texel_area_light(ivec2 px, vec3 p, vec3 n) {
     vec4 origin = texelFetch(footprint_origin, px, 0);
     vec4 step = texelFetch(footprint_step, px, 0);
@@ -306,6 +320,9 @@ vec3 texel_area_light(ivec2 px, vec3 p, vec3 n) {
             q = texelFetch(gbuf_position, px + beyond, 0).xyz;
             nq = texelFetch(gbuf_normal, px + beyond, 0).xyz;
         }
+#if defined(SOFT_SUN) || defined(POLYGONS)
+        soft_first = i;
+#endif
         sum += face_light(q, nq);
     }
     return sum / float(AREA_SAMPLES);
@@ -317,32 +334,14 @@ vec3 texel_area_light(ivec2 px, vec3 p, vec3 n) {
 // (texels that see no geometry are never written: 0 since set-up). One store, after the shading: a
 // store on each of its early ways out cost llvmpipe a third more time.
 void main() {
-#ifdef AREA_SAMPLES
-    // One invocation per listed grazing texel (xy: its atlas texel, w: 1; the list's tail is 0).
-    ivec2 entry = ivec2(gl_GlobalInvocationID.xy);
-    if (any(greaterThanEqual(entry, textureSize(grazing_texels, 0)))) {
+    ivec2 px;
+    if (!invocation_texel(textureSize(gbuf_position, 0), px)) {
         return;
     }
-    vec4 listed = texelFetch(grazing_texels, entry, 0);
-    if (listed.w == 0.0) {
-        return;
-    }
-    ivec2 px = ivec2(listed.xy);
-#else
-    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
-    if (any(greaterThanEqual(px, textureSize(gbuf_position, 0)))) {
-        return;
-    }
-#endif
     vec4 pos = texelFetch(gbuf_position, px, 0);
     if (pos.w == 0.0) {
         return;
     }
-#ifdef ATLAS_CENTRES
-    if (any(notEqual(texelFetch(footprint_step, px, 0).xyz, vec3(0.0)))) {
-        return;  // a grazing texel: the AREA_SAMPLES program shades it
-    }
-#endif
     vec3 n = texelFetch(gbuf_normal, px, 0).xyz;
 #ifdef AREA_SAMPLES
     vec3 light = texel_area_light(px, pos.xyz, n);

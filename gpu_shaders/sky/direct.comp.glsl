@@ -6,6 +6,8 @@
 // sky_table, one row per direction: texels 0-3 the rows of its orthographic view-projection, texel 4
 // (axis the light travels along, texel size in m), texel 5 (irradiance normal to it, W/m^2 per colour;
 // w: the tangent of the region's angular radius, its shadows' penumbra).
+#include "common/texel_list.glsl"
+
 const float PI = 3.14159265;
 const float NORMAL_OFFSET_TEXELS = 1.5;  // as the direct pass: the receiver does not shadow itself
 // Taps per direction: few, since the sum over a hundred directions, each turned differently, is what
@@ -28,8 +30,8 @@ float sky_depth(ivec2 tile0, ivec2 t) {
 }
 
 void main() {
-    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
-    if (any(greaterThanEqual(px, textureSize(gbuf_position, 0)))) {
+    ivec2 px;
+    if (!invocation_texel(textureSize(gbuf_position, 0), px)) {
         return;
     }
     vec4 pos = texelFetch(gbuf_position, px, 0);

@@ -149,3 +149,46 @@ def test_too_many_faces_to_keep_solve_every_update(gl, monkeypatch):
     assert method.solves == 2
     monkeypatch.undo()
     _assert_same(method.read(), _fresh_images(gl, "lpv", scene))
+
+
+@pytest.fixture(scope="module")
+def sky_scene():
+    from addon.bridge import scenes
+    from addon.bridge.capture import SceneCache
+
+    scenes.build("window-sky-sun")  # a sun lamp and a sky through a window
+    return SceneCache().update(bpy.context.evaluated_depsgraph_get(), 32, 32)
+
+
+@pytest.mark.parametrize("case", ["lpv", "probes", "probes-2-bounces"])
+def test_a_lamp_move_under_a_sky_redraws_none_of_the_skys_work(gl, sky_scene, case):
+    # The sky's shadow maps (and the probes' sky light on their atlas) depend on the geometry and the
+    # sky's directions, not on the lamps: a lamp's move neither redraws nor re-shades them, and the
+    # images are still those of a method set up for the moved lamp.
+    method = _method(gl, case)
+    method.set_scene(sky_scene)
+    first = method.compute()
+    assert "sky_shadow" in first
+    assert ("probe_sky" in first) == case.startswith("probes")
+    lights = _moved_lights(sky_scene.lights, -0.01)
+    method.set_lights(lights)
+    timings = method.compute(run_gbuffer=False)
+    assert method.solves == 2
+    assert "sky_shadow" not in timings and "probe_sky" not in timings
+    assert ("probe_sky_copy" in timings) == case.startswith("probes")
+    _assert_same(method.read(), _fresh_images(gl, case, replace(sky_scene, lights=lights)))
+
+
+@pytest.mark.parametrize("case", ["lpv", "probes"])
+def test_a_world_change_redraws_the_skys_work(gl, sky_scene, case):
+    # Another world: new directions, so their shadow maps are drawn and the probes' sky light shaded
+    # again, and the images are those of a method set up under that world.
+    method = _method(gl, case)
+    method.set_scene(sky_scene)
+    method.compute()
+    world_map = sky_scene.world_map * np.float32(0.5)
+    method.set_world(sky_scene.world_color, world_map)
+    timings = method.compute(run_gbuffer=False)
+    assert "sky_shadow" in timings
+    assert ("probe_sky" in timings) == (case == "probes")
+    _assert_same(method.read(), _fresh_images(gl, case, replace(sky_scene, world_map=world_map)))

@@ -421,8 +421,13 @@ class DirectMethod:
         self.finish_solve(timings)
 
     def _draw_sky(self, timings: dict[str, float]) -> None:
-        """Every sky direction's shadow map into its sky atlas (solve half); nothing without a world."""
+        """Every sky direction's shadow map into its sky atlas (solve half); nothing without a world. A
+        set of directions is drawn once: its maps change only with the geometry (set_scene makes new
+        sets) or the directions (the world, or their count: a new key), not when a lamp moves."""
         for sky in self.skies():
+            if sky.drawn_key == sky.key:
+                continue
+            sky.drawn_key = sky.key
             with self.step(timings, sky_light.SHADOW_DECL):
                 sky_light.shadow(self.backend, sky.target, self._meshes[sky_light.SHADOW_SPEC.name], sky.layout,
                                  sky.views)
@@ -434,17 +439,18 @@ class DirectMethod:
         self.shade_sky(timings, sky_light.DIRECT_DECL, self.gbuf["position"], self.gbuf["normal"], self.direct)
 
     def shade_sky(self, timings: dict[str, float], decl, position, normal, out, accumulate: bool = True,
-                  most: int | None = None) -> bool:
+                  most: int | None = None, texel_lists=(None,)) -> bool:
         """The sky's direct light (`sky(most)`) at the surfaces `position` / `normal` hold, into `out`
         (added, or replacing at those that hold one), timed as `decl`; False (nothing written) without a
-        world."""
+        world. texel_lists: the texels to shade, as lists (probe_capture.texel_lists); None: every one."""
         sky = self.sky(most)
         if sky is None:
             return False
         with self.step(timings, decl):
             diagonal_m = float(np.linalg.norm(self.bounds_m[1] - self.bounds_m[0]))
-            sky_light.direct(self.backend, position, normal, sky.atlas, sky.bounds, sky.table, out, sky.layout,
-                             diagonal_m, accumulate)
+            for texel_list in texel_lists:
+                sky_light.direct(self.backend, position, normal, sky.atlas, sky.bounds, sky.table, out, sky.layout,
+                                 diagonal_m, accumulate, texel_list)
         return True
 
     def _gather(self, views: list[LightView], timings: dict[str, float], slots, first: bool = True) -> None:

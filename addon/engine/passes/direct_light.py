@@ -34,13 +34,13 @@ def _spec(polygons: bool, soft_sun: bool, area_samples: int = 0) -> ShaderSpec:
     its rows) or a point's, with a sun's soft shadows (SOFT_SUN: the sun's angle) or a hard shadow test.
     One program each, because llvmpipe runs the code of a branch no invocation takes: with both kinds in
     one program a spot's shading of the probe atlas took 4.5 x as long (docs/PROBES.md).
-    The probe atlas shaded by its texels' areas (ProbesConfig.area_samples) takes two: area_samples 1,
-    ATLAS_CENTRES, every texel but the grazing ones at its centre; area_samples > 1, AREA_SAMPLES, the
-    listed grazing texels (`grazing_texels`) at that many points along their footprints
-    (probe_capture.FOOTPRINT). Apart, so that the grazing texels' loop runs only where they are."""
+    area_samples 0: every pixel of the G-buffer. On the probe atlas, one invocation per texel of a list
+    (TEXEL_LIST, `texel_list`: probe_capture.texel_lists), because llvmpipe's cost is per invocation
+    whatever it does: area_samples 1, each at its centre; > 1 (AREA_SAMPLES, ProbesConfig.area_samples),
+    the grazing texels at that many points along their footprints (probe_capture.FOOTPRINT)."""
     area = area_samples > 1
-    footprint = ("footprint_step",) if area_samples == 1 else \
-        ("footprint_origin", "footprint_step", "footprint_neighbours", "grazing_texels") if area else ()
+    listed = ("texel_list",) if area_samples >= 1 else ()
+    footprint = ("footprint_origin", "footprint_step", "footprint_neighbours") if area else ()
     return ShaderSpec(
         name="direct_shade" + ("_polygons" if polygons else "") + ("_soft_sun" if soft_sun else "")
         + ("_atlas_centres" if area_samples == 1 else f"_atlas_area{area_samples}" if area else ""),
@@ -48,7 +48,8 @@ def _spec(polygons: bool, soft_sun: bool, area_samples: int = 0) -> ShaderSpec:
         local_size=(8, 8, 1),
         samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("rsm_position", "2D"),
                   Sampler("rsm_normal", "2D"))
-        + ((Sampler("emitters", "2D"),) if polygons else ()) + tuple(Sampler(name, "2D") for name in footprint),
+        + ((Sampler("emitters", "2D"),) if polygons else ())
+        + tuple(Sampler(name, "2D") for name in listed + footprint),
         images=(Image("direct", "2D", "RGBA32F", "read_write"),),
         uniforms=(
             Var("light_view_projection", "mat4"),
@@ -61,7 +62,7 @@ def _spec(polygons: bool, soft_sun: bool, area_samples: int = 0) -> ShaderSpec:
                Var("light_view_projection_inverse", "mat4")) if polygons else ())
         + ((Var("sun_tan_half", "float"),) if soft_sun else ()),
         defines=((("POLYGONS", "1"),) if polygons else ()) + ((("SOFT_SUN", "1"),) if soft_sun else ())
-        + ((("ATLAS_CENTRES", "1"),) if area_samples == 1 else (("AREA_SAMPLES", str(area_samples)),) if area else ()),
+        + ((("TEXEL_LIST", "1"),) if listed else ()) + ((("AREA_SAMPLES", str(area_samples)),) if area else ()),
     )
 
 
@@ -74,29 +75,25 @@ DECL = PassDecl("direct_light", "gather", (GBUF_POSITION, GBUF_NORMAL, RSM_POSIT
 
 
 def run(backend: Backend, gbuf_position, gbuf_normal, shadow: dict, direct, view: LightView,
-        shadow_bias_texels: float, emitters, accumulate: bool = True, footprint=None) -> None:
+        shadow_bias_texels: float, emitters, accumulate: bool = True, lists=()) -> None:
     """`shadow`: the shadow map's "position" and "normal" textures (the RSM's, or a sun's own map).
     `emitters`: the emitter table texture; the view's uniforms give its rows (poly_first, poly_count).
     accumulate: add to `direct`; False: replace its pixels that see geometry (those that see none are not
-    written: the caller keeps them 0). footprint: where the G-buffer is a probe atlas to shade by its
-    texels' areas, (probe_capture.footprint's textures by name with the grazing texels' list, samples):
-    the texels that do not graze at their centres, then the listed ones along their footprints."""
+    written: the caller keeps them 0). lists: where the G-buffer is a probe atlas, the texels to shade
+    instead of every pixel, as (texel list, samples, footprint textures by name) each: the list's texels
+    shaded at `samples` points along their footprints (1: at their centres, no footprint needed)."""
     view_uniforms = view.uniforms
     soft_sun = view_uniforms["light_kind"] == KIND_CODE["SUN"] and view_uniforms["sun_tan_half"] > 0.0
     polygons = view_uniforms.get("poly_count", 0) > 0
     samplers = {"gbuf_position": gbuf_position, "gbuf_normal": gbuf_normal, "rsm_position": shadow["position"],
                 "rsm_normal": shadow["normal"], "emitters": emitters}
-    if footprint is None:
-        passes = ((_spec(polygons, soft_sun), direct.size),)
-    else:
-        textures, samples = footprint
-        samplers.update(textures)
-        passes = ((_spec(polygons, soft_sun, 1), direct.size),
-                  (_spec(polygons, soft_sun, samples), textures["grazing_texels"].size))
-    for spec, size in passes:
+    passes = [(_spec(polygons, soft_sun, samples), texels.size, {"texel_list": texels, **footprint})
+              for texels, samples, footprint in lists] or [(_spec(polygons, soft_sun), direct.size, {})]
+    for spec, size, more in passes:
         names = {u.name for u in spec.uniforms}
         uniforms = {k: v for k, v in view_uniforms.items() if k in names}
         uniforms["shadow_bias_texels"] = shadow_bias_texels
         uniforms["accumulate"] = int(accumulate)
+        bound = {**samplers, **more}
         backend.dispatch(backend.program(spec), group_count(size, spec.local_size), uniforms=uniforms,
-                         samplers={s.name: samplers[s.name] for s in spec.samplers}, images={"direct": direct})
+                         samplers={s.name: bound[s.name] for s in spec.samplers}, images={"direct": direct})

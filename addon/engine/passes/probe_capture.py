@@ -71,12 +71,18 @@ FOOTPRINT = (_atlas("footprint_origin", "xyz: the texel's probe position (m); w:
                     "w: the greatest distance to follow its plane (m)"),
              _atlas("footprint_neighbours", "xy, zw: atlas offsets of the neighbours seen nearer and farther along "
                     "the footprint ((0, 0): none)"))
+FOOTPRINT_DECL = PassDecl("probe_footprint", "setup", (ATLAS_POSITION, ATLAS_NORMAL, OFFSET), FOOTPRINT,
+                          "per grazing atlas texel, its probe, footprint step and plane's distance range")
+# The atlas texels the per-light direct pass shades, as lists: llvmpipe runs a compute shader's every
+# branch for every invocation, so a texel that sees nothing costs as much as a lit one unless it is
+# left out of the dispatch (docs/PROBES.md, "What the light update costs").
+ATLAS_TEXELS = Port("probes", "atlas_texels", "RGBA32F", "list",
+                    "xy: an atlas texel that sees geometry and is shaded at its centre; w: 1 (0 past the list's end)")
 GRAZING_TEXELS = Port("probes", "grazing_texels", "RGBA32F", "list",
                       "xy: an atlas texel whose footprint_step is not 0; w: 1 (0 past the list's end)")
-GRAZING_LIST_WIDTH = 1024  # entries per row of the grazing texels' list
-FOOTPRINT_DECL = PassDecl("probe_footprint", "setup", (ATLAS_POSITION, ATLAS_NORMAL, OFFSET),
-                          (*FOOTPRINT, GRAZING_TEXELS),
-                          "per grazing atlas texel, its probe, footprint step and plane's distance range; their list")
+TEXEL_LIST_WIDTH = 1024  # entries per row of a list of texels
+LISTS_DECL = PassDecl("probe_texel_lists", "setup", (ATLAS_POSITION, FOOTPRINT[1]), (ATLAS_TEXELS, GRAZING_TEXELS),
+                      "the atlas texels that see geometry (read back), apart from the grazing ones with area samples")
 
 SPEC = ShaderSpec(
     name="probe_capture",
@@ -177,20 +183,34 @@ def moments(backend: Backend, atlas: dict, out_moments, out_state, grid: ProbeGr
 
 
 def footprint(backend: Backend, atlas: dict, offset, grid: ProbeGrid) -> dict:
-    """FOOTPRINT's textures by name (each grazing texel's footprint, from the capture and the probes'
-    positions: grid + `offset`) and GRAZING_TEXELS, the list of the grazing texels (read back: the
-    direct pass shades them apart, so that their loop runs only where they are)."""
+    """FOOTPRINT's textures by name: each grazing texel's footprint, from the capture and the probes'
+    positions (grid + `offset`)."""
     out = declare.allocate(backend, FOOTPRINT, grid.atlas_size)
     backend.dispatch(backend.program(FOOTPRINT_SPEC), group_count(grid.atlas_size, FOOTPRINT_SPEC.local_size),
                      uniforms=grid_uniforms(FOOTPRINT_SPEC, grid),
                      samplers={"atlas_position": atlas["position"], "atlas_normal": atlas["normal"],
                                "probe_offset": offset},
                      images=out)
-    step = backend.read(out["footprint_step"])  # rows are texel rows y, from 0
-    y, x = np.nonzero(np.any(step[..., :3] != 0.0, axis=-1))
-    width = int(min(GRAZING_LIST_WIDTH, max(len(x), 1)))
+    return out
+
+
+def texel_lists(backend: Backend, atlas: dict, footprint: dict | None) -> dict:
+    """LISTS_DECL's lists by name: ATLAS_TEXELS, every atlas texel that sees geometry, and with a
+    `footprint` (area samples) GRAZING_TEXELS, those of them that graze, which ATLAS_TEXELS then leaves
+    out (the direct pass shades them apart, so that their loop runs only where they are)."""
+    sees = backend.read(atlas["position"])[..., 3] != 0.0  # rows are texel rows y, from 0
+    if footprint is None:
+        return {ATLAS_TEXELS.name: texel_list(backend, sees)}
+    grazing = np.any(backend.read(footprint["footprint_step"])[..., :3] != 0.0, axis=-1)
+    return {ATLAS_TEXELS.name: texel_list(backend, sees & ~grazing),
+            GRAZING_TEXELS.name: texel_list(backend, sees & grazing)}
+
+
+def texel_list(backend: Backend, mask: np.ndarray):
+    """The texels where `mask` ((h, w) bool) holds, as a texture TEXEL_LIST_WIDTH entries wide (one
+    entry where there are none): xy the texel, w 1; entries past the list's end are 0."""
+    y, x = np.nonzero(mask)
+    width = int(min(TEXEL_LIST_WIDTH, max(len(x), 1)))
     table = np.zeros((-(-max(len(x), 1) // width) * width, 4), np.float32)
     table[:len(x)] = np.stack([x, y, np.zeros_like(x), np.ones_like(x)], axis=-1)
-    out[GRAZING_TEXELS.name] = backend.texture((width, len(table) // width),
-                                               data=table.reshape(-1, width, 4))
-    return out
+    return backend.texture((width, len(table) // width), data=table.reshape(-1, width, 4))

@@ -24,6 +24,7 @@ from .probe_capture import (
     ATLAS_ALBEDO,
     ATLAS_NORMAL,
     ATLAS_POSITION,
+    ATLAS_TEXELS,
     ATLAS_UNIFORMS,
     FOOTPRINT,
     GRAZING_TEXELS,
@@ -41,10 +42,15 @@ IRRADIANCE = Port("probes", "irradiance", "RGBA32F", "probe_atlas",
 IRRADIANCE_TEXELS = 4  # m: each face of a probe's irradiance cube map is m x m normals
 
 SHADE_DECL = PassDecl("probe_direct", "solve", (ATLAS_POSITION, ATLAS_NORMAL, RSM_POSITION, RSM_NORMAL, LIGHT_VIEWS,
-                                                EMITTERS, *FOOTPRINT, GRAZING_TEXELS),
+                                                EMITTERS, ATLAS_TEXELS, *FOOTPRINT, GRAZING_TEXELS),
                       (ATLAS_DIRECT,), "one light face's shadow-mapped direct light on the probe atlas, added")
-SKY_DECL = PassDecl("probe_sky", "solve", (ATLAS_POSITION, ATLAS_NORMAL, SKY_DEPTH, SKY_BOUNDS, SKY_TABLE),
-                    (ATLAS_DIRECT,), "the sky's shadowed direct light on the probe atlas (sky_light.direct), first")
+ATLAS_SKY = Port("probes", "sky", "RGBA32F", "probe_atlas", "the sky's irradiance / pi at the surface a texel sees")
+SKY_DECL = PassDecl("probe_sky", "solve", (ATLAS_POSITION, ATLAS_NORMAL, ATLAS_TEXELS, GRAZING_TEXELS, SKY_DEPTH,
+                                           SKY_BOUNDS, SKY_TABLE),
+                    (ATLAS_SKY,), "the sky's shadowed direct light on the probe atlas (sky_light.direct), kept "
+                    "until the geometry or the sky's directions change")
+SKY_COPY_DECL = PassDecl("probe_sky_copy", "solve", (ATLAS_SKY,), (ATLAS_DIRECT,),
+                         "the kept sky light as the solve's first face on the atlas")
 PROJECT_DECL = PassDecl("probe_project", "solve", (ATLAS_ALBEDO, ATLAS_DIRECT), (SH,),
                         "the atlas shaded and projected to L2 SH per probe (first bounce)")
 REPROJECT_DECL = PassDecl("probe_reproject", "solve", (ATLAS_ALBEDO, ATLAS_DIRECT, ATLAS_INDIRECT), (SH,),
@@ -85,14 +91,17 @@ SPECS = {(bounce, encoding): _spec(bounce, encoding) for bounce in (False, True)
 
 
 def shade(backend: Backend, atlas: dict, atlas_direct, shadow: dict, view: LightView, shadow_bias_texels: float,
-          emitters, first: bool, footprint: dict | None = None, area_samples: int = 1) -> None:
-    """atlas_direct += one light face's direct light; the solve's first face (`first`) replaces the last
-    solve's light instead, at every texel that sees geometry (the others the caller keeps 0). With
-    area_samples > 1 (ProbesConfig.area_samples) a texel that sees its surface at a grazing angle is
-    shaded at that many points of its footprint (`footprint`: probe_capture.footprint's textures)."""
+          emitters, first: bool, texel_lists: dict, footprint: dict | None = None, area_samples: int = 1) -> None:
+    """atlas_direct += one light face's direct light at the texels `texel_lists` (probe_capture.texel_lists)
+    holds; the solve's first face (`first`) replaces the last solve's light instead (the texels no list
+    holds see no geometry: the caller keeps them 0). With area_samples > 1 (ProbesConfig.area_samples)
+    the grazing texels are shaded at that many points of their footprints (`footprint`:
+    probe_capture.footprint's textures)."""
+    lists = [(texel_lists[ATLAS_TEXELS.name], 1, {})]
+    if area_samples > 1:
+        lists.append((texel_lists[GRAZING_TEXELS.name], area_samples, footprint))
     direct_light.run(backend, atlas["position"], atlas["normal"], shadow, atlas_direct, view,
-                     shadow_bias_texels, emitters, accumulate=not first,
-                     footprint=(footprint, area_samples) if area_samples > 1 else None)
+                     shadow_bias_texels, emitters, accumulate=not first, lists=lists)
 
 
 def run(backend: Backend, atlas: dict, atlas_direct, sh, grid: ProbeGrid, atlas_indirect=None) -> None:

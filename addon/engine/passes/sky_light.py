@@ -59,17 +59,24 @@ BOUNDS_SPEC = ShaderSpec(
     defines=(("BLOCK", str(BLOCK_TEXELS)),),
 )
 
-DIRECT_SPEC = ShaderSpec(
-    name="sky_direct",
-    compute="sky/direct.comp.glsl",
-    local_size=(8, 8, 1),
-    defines=(("BLOCK", str(BLOCK_TEXELS)),),
-    samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("sky_depth_atlas", "2D"),
-              Sampler("sky_bounds", "2D"), Sampler("sky_table", "2D")),
-    images=(Image("direct", "2D", "RGBA32F", "read_write"),),
-    uniforms=(Var("sky_count", "int"), Var("tiles_x", "int"), Var("tile_texels", "int"),
-              Var("scene_diagonal_m", "float"), Var("accumulate", "int")),
-)
+def _direct_spec(listed: bool) -> ShaderSpec:
+    """listed: one invocation per texel of a list (`texel_list`, probe_capture.texel_lists) instead of
+    per pixel: the probe atlas's texels that see geometry (llvmpipe's cost is per invocation)."""
+    return ShaderSpec(
+        name="sky_direct" + ("_listed" if listed else ""),
+        compute="sky/direct.comp.glsl",
+        local_size=(8, 8, 1),
+        defines=(("BLOCK", str(BLOCK_TEXELS)),) + ((("TEXEL_LIST", "1"),) if listed else ()),
+        samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("sky_depth_atlas", "2D"),
+                  Sampler("sky_bounds", "2D"), Sampler("sky_table", "2D"))
+        + ((Sampler("texel_list", "2D"),) if listed else ()),
+        images=(Image("direct", "2D", "RGBA32F", "read_write"),),
+        uniforms=(Var("sky_count", "int"), Var("tiles_x", "int"), Var("tile_texels", "int"),
+                  Var("scene_diagonal_m", "float"), Var("accumulate", "int")),
+    )
+
+
+DIRECT_SPECS = {listed: _direct_spec(listed) for listed in (False, True)}
 
 SKY_TABLE = Port("scene", "sky_table", "RGBA32F", "table",
                  "per sky direction: view-projection rows, axis and texel size (m), irradiance (W/m^2)")
@@ -132,6 +139,7 @@ class SkyShadows:
 
     def __init__(self):
         self.key = None  # what the directions were made from (the world and their count)
+        self.drawn_key = None  # the key the shadow atlas was last drawn for (it holds until the key changes)
         self.layout: SkyLayout | None = None
         self.rsm = None  # (textures, target) of the directions' RSM tiles, rsm_target()
 
@@ -210,14 +218,18 @@ def bounds(backend: Backend, atlas, out, layout: SkyLayout) -> None:
 
 
 def direct(backend: Backend, gbuf_position, gbuf_normal, atlas, sky_bounds, sky_table, out, layout: SkyLayout,
-           scene_diagonal_m: float, accumulate: bool = True) -> None:
+           scene_diagonal_m: float, accumulate: bool = True, texel_list=None) -> None:
     """`scene_diagonal_m`: the bounds' diagonal, the farthest a blocker can be from its receiver (it
     sizes the blocker search: the widest penumbra). accumulate: add to `out`; False: replace its pixels
-    that see geometry (those that see none are not written)."""
-    backend.dispatch(backend.program(DIRECT_SPEC), group_count(out.size, DIRECT_SPEC.local_size),
+    that see geometry (those that see none are not written). texel_list: shade only the texels it
+    lists (probe_capture.texel_list) instead of every pixel."""
+    spec = DIRECT_SPECS[texel_list is not None]
+    samplers = {"gbuf_position": gbuf_position, "gbuf_normal": gbuf_normal, "sky_depth_atlas": atlas,
+                "sky_bounds": sky_bounds, "sky_table": sky_table}
+    if texel_list is not None:
+        samplers["texel_list"] = texel_list
+    backend.dispatch(backend.program(spec), group_count((texel_list or out).size, spec.local_size),
                      uniforms={"sky_count": layout.count, "tiles_x": layout.tiles_x,
                                "tile_texels": layout.tile_texels, "scene_diagonal_m": scene_diagonal_m,
                                "accumulate": int(accumulate)},
-                     samplers={"gbuf_position": gbuf_position, "gbuf_normal": gbuf_normal,
-                               "sky_depth_atlas": atlas, "sky_bounds": sky_bounds, "sky_table": sky_table},
-                     images={"direct": out})
+                     samplers=samplers, images={"direct": out})
