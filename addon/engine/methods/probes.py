@@ -136,6 +136,10 @@ class ProbesMethod(OneBounceMethod):
             copy.run(self.backend, self.atlas_sky, self.atlas_direct)
         self._faces_shaded = 1
 
+    def forget_kept_light(self) -> None:
+        super().forget_kept_light()
+        self._atlas_sky_for = None  # the sky's light on the atlas (begin_solve)
+
     def skies(self) -> list:
         """The camera's sky directions and the atlas's (ProbesConfig.atlas_sky_directions)."""
         skies = super().skies()
