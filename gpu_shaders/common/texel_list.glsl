@@ -1,6 +1,7 @@
 // The texel an invocation shades. With TEXEL_LIST: entry gl_GlobalInvocationID.xy of the list
 // `texel_list` (xy: a probe atlas texel, w: 1; the list's tail is 0; probe_capture.texel_list), so that
-// a pass runs only where the list says (llvmpipe's cost is per invocation). Else the invocation's own
+// a pass runs only where the list says (llvmpipe runs every branch of an invocation, so one that would
+// return at once still costs). Else the invocation's own
 // pixel of an image `size` large. False: none (past the list's end or the image's edge).
 bool invocation_texel(ivec2 size, out ivec2 px) {
 #ifdef TEXEL_LIST

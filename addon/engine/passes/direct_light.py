@@ -35,9 +35,10 @@ def _spec(polygons: bool, soft_sun: bool, area_samples: int = 0) -> ShaderSpec:
     One program each, because llvmpipe runs the code of a branch no invocation takes: with both kinds in
     one program a spot's shading of the probe atlas took 4.5 x as long (docs/PROBES.md).
     area_samples 0: every pixel of the G-buffer. On the probe atlas, one invocation per texel of a list
-    (TEXEL_LIST, `texel_list`: probe_capture.texel_lists), because llvmpipe's cost is per invocation
-    whatever it does: area_samples 1, each at its centre; > 1 (AREA_SAMPLES, ProbesConfig.area_samples),
-    the grazing texels at that many points along their footprints (probe_capture.FOOTPRINT)."""
+    (TEXEL_LIST, `texel_list`: probe_capture.texel_lists), so that the texels that see nothing cost no
+    invocation (docs/PROBES.md, "What the light update costs"): area_samples 1, each at its centre;
+    > 1 (AREA_SAMPLES, ProbesConfig.area_samples), the grazing texels at that many points along their
+    footprints (probe_capture.FOOTPRINT)."""
     area = area_samples > 1
     listed = ("texel_list",) if area_samples >= 1 else ()
     footprint = ("footprint_origin", "footprint_step", "footprint_neighbours") if area else ()

@@ -73,9 +73,9 @@ FOOTPRINT = (_atlas("footprint_origin", "xyz: the texel's probe position (m); w:
                     "the footprint ((0, 0): none)"))
 FOOTPRINT_DECL = PassDecl("probe_footprint", "setup", (ATLAS_POSITION, ATLAS_NORMAL, OFFSET), FOOTPRINT,
                           "per grazing atlas texel, its probe, footprint step and plane's distance range")
-# The atlas texels the per-light direct pass shades, as lists: llvmpipe runs a compute shader's every
-# branch for every invocation, so a texel that sees nothing costs as much as a lit one unless it is
-# left out of the dispatch (docs/PROBES.md, "What the light update costs").
+# The atlas texels the per-light passes shade, as lists: llvmpipe runs every branch of a compute shader
+# for every invocation, so a texel that sees nothing still costs an invocation unless the dispatch
+# leaves it out (5-10 % of the atlas passes; docs/PROBES.md, "What the light update costs").
 ATLAS_TEXELS = Port("probes", "atlas_texels", "RGBA32F", "list",
                     "xy: an atlas texel that sees geometry and is shaded at its centre; w: 1 (0 past the list's end)")
 GRAZING_TEXELS = Port("probes", "grazing_texels", "RGBA32F", "list",

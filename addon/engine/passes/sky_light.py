@@ -61,7 +61,7 @@ BOUNDS_SPEC = ShaderSpec(
 
 def _direct_spec(listed: bool) -> ShaderSpec:
     """listed: one invocation per texel of a list (`texel_list`, probe_capture.texel_lists) instead of
-    per pixel: the probe atlas's texels that see geometry (llvmpipe's cost is per invocation)."""
+    per pixel: the probe atlas's texels that see geometry, so that the others cost no invocation."""
     return ShaderSpec(
         name="sky_direct" + ("_listed" if listed else ""),
         compute="sky/direct.comp.glsl",
