@@ -8,7 +8,8 @@ alpha) and convert its rel_rmse_8 into a Cycles-equivalent speed-up along the cu
 product, and into a second one along the curve of Cycles + Open Image Denoise (every render of Cycles'
 curve denoised, anchors.py). With `--anchors ...,eevee` each scene also gets one EEVEE render at its best
 GI setting, and each row our time against EEVEE's where our error is as low or lower. Each row also
-times the three kinds of update (`updates.update_costs`: a geometry change, lights moved, camera moved).
+gets the three kinds of update timed (a geometry change, lights moved, camera moved), all of a scene's
+rows in turn in one process (`updates.update_costs_in_turn`), so that their ratios hold.
 Writes a Markdown report, one log-log plot per scene and `results.json` (one record per scene x method x
 setting, `results_json`), the report and the JSON from the same result.
 
@@ -319,7 +320,10 @@ def format_report(result: dict) -> str:
                      "per-pass waits, as in the viewport: full = everything; lights = every light moved 1 cm "
                      "(light views, solve, gathers); camera = the camera moved 1 cm (G-buffer and gathers; the "
                      "solve too where the method cannot keep its light field). camera/full = what navigating "
-                     "costs against a full update.\n")
+                     "costs against a full update. Timed in turn: all of a scene's rows are set up in one "
+                     f"process, and each of {result['repeat']} rounds times one update of each kind for every "
+                     "row, so the machine's load over the minutes falls alike on all rows and their ratios "
+                     "hold.\n")
     if result.get("skipped"):
         lines.append("Skipped: " + "; ".join(f"{k} ({v})" for k, v in result["skipped"].items()) + ".\n")
     lines += [format_scene(sc) for sc in result["scenes"]]
@@ -395,7 +399,7 @@ class Options:
     res: int = 128
     ref_spp: int | None = None  # None: REF_SPP, or QUICK_REF_SPP with quick
     bounces: int = 1
-    update_costs: bool = True  # time full / lights / camera updates per row (updates.update_costs)
+    update_costs: bool = True  # time full / lights / camera updates per row (updates.update_costs_in_turn)
     row_filter: str = "all"  # ROW_FILTERS: which registry rows of each method run
     anchors: tuple[str, ...] = DEFAULT_ANCHORS  # anchors.ANCHORS measured besides raw Cycles
     out: Path = Path("benchmarks")
@@ -572,7 +576,7 @@ def _run_row(opt: Options, blend: Path, scene: str, method: str, setting: dict, 
     run_dir = opt.cache / "runs" / scene / f"{method}-{label.replace(' ', '').replace(',', '_')}"
     run_dir.mkdir(parents=True, exist_ok=True)
     settings = make_configs(method, setting, opt.res, opt.bounces)
-    st = render_file(blend, run_dir, settings, repeat=repeat, profile_updates=opt.update_costs)
+    st = render_file(blend, run_dir, settings, repeat=repeat)
     m = _compare(run_dir / f"{product}.exr", ref_dir / f"{product}.exr")
     noise = _seed_noise(blend, run_dir, settings, product)
     if m["rel_rmse_8"] is None:
@@ -592,7 +596,7 @@ def _run_row(opt: Options, blend: Path, scene: str, method: str, setting: dict, 
             "default": is_default_row(method, setting, opt.res, opt.bounces), "product": product,
             "config": st["config"], "image_size": st["image_size"], "triangles": st["triangles"],
             "timings_ms": st["timings_ms"], "total_ms": st["total_ms"], "runs": st["runs"],
-            "update_ms": st.get("update_ms"), "metrics": m, "noise": noise, "speedup": speed,
+            "update_ms": None, "metrics": m, "noise": noise, "speedup": speed,
             "speedup_oidn": speed_oidn, "vs_eevee": against_eevee(m["rel_rmse_8"], our_s, product, eevee),
             "full": _compare_full(run_dir, ref_dir), "renderer": st["renderer"], "work": st.get("work", {})}
 
@@ -658,6 +662,7 @@ def run_bench(opt: Options) -> dict:
     from tqdm import tqdm
 
     from ..engine import methods as method_registry
+    from .pipeline import methods_in_turn_update_costs
     from .reference import check_settings
 
     quick = opt.quick
@@ -674,7 +679,8 @@ def run_bench(opt: Options) -> dict:
     opt.out.mkdir(parents=True, exist_ok=True)
     cache = opt.cache
     eevee_on = "eevee" in opt.anchors
-    steps = len(scene_list) * (3 + eevee_on + len(jobs))  # blend + 2 references + curve (+ EEVEE), then one per run
+    # blend + 2 references + curve (+ EEVEE), then one per run (+ the update costs)
+    steps = len(scene_list) * (3 + eevee_on + len(jobs) + (opt.update_costs and bool(jobs)))
     bar = tqdm(total=steps, desc="bench", unit="step", file=sys.stderr)
     result = {"command": opt.command, "res": opt.res, "bounces": opt.bounces, "ref_spp": ref_spp,
               "repeat": repeat, "quick": quick, "curve_spp": spps, "update_costs": opt.update_costs,
@@ -713,6 +719,13 @@ def run_bench(opt: Options) -> dict:
                            sc["notes"])
             renderers.add(row.pop("renderer"))
             sc["runs"].append(row)
+            bar.update()
+        if opt.update_costs and jobs:
+            bar.set_postfix_str(f"{name}: update costs, every row in turn")
+            costs = methods_in_turn_update_costs(
+                blend, [make_configs(method, setting, opt.res, opt.bounces) for method, setting in jobs], repeat)
+            for row, update_ms in zip(sc["runs"], costs, strict=True):
+                row["update_ms"] = update_ms
             bar.update()
         plot_scene(sc, opt.out / sc["plot"])
         result["scenes"].append(sc)

@@ -18,7 +18,7 @@ from ..engine import choice, methods, metrics, registry
 from ..engine.backends.moderngl_backend import ModernGLBackend
 from ..engine.config import settings as complete_settings
 from ..engine.errors import SceneError
-from ..engine.updates import update_costs
+from ..engine.updates import update_costs, update_costs_in_turn
 from . import images
 from .capture import SceneCache, define_light_switch, image_size
 
@@ -38,6 +38,33 @@ def open_blend(path: Path) -> None:
         bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
     except RuntimeError as exc:
         raise SceneError(f"cannot open {path}: {str(exc).strip().splitlines()[-1]}") from None
+
+
+def capture_blend(blend: Path, resolution: int):
+    """Open `blend` and capture its scene for images `resolution` px on the long side; returns the
+    captured scene and the image's (width, height)."""
+    open_blend(blend)
+    define_light_switch()  # read the per-light include switch saved in the file
+    scene = bpy.context.scene
+    if scene.camera is None:
+        raise SceneError(f"{blend}: the scene has no camera")
+    width, height = image_size(scene, resolution)
+    return SceneCache().update(bpy.context.evaluated_depsgraph_get(), width, height), (width, height)
+
+
+def methods_in_turn_update_costs(blend: Path, settings_list: list[dict], rounds: int) -> list[dict]:
+    """updates.update_costs_in_turn for one method per {group: config} settings on `blend` (all at the
+    first's resolution): each set up on the same captured scene and run once (shaders compiled, light field
+    solved) before the rounds."""
+    settings_list = [complete_settings(**settings) for settings in settings_list]
+    captured, _ = capture_blend(blend, settings_list[0]["gi"].resolution)
+    warm = []
+    for settings in settings_list:
+        method = methods.create(backend(), settings)
+        method.set_scene(captured)
+        method.run()
+        warm.append(method)
+    return update_costs_in_turn(warm, rounds)
 
 
 def render_row(be, captured, settings: dict, model, key: str) -> np.ndarray:
@@ -134,13 +161,7 @@ def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
     settings = complete_settings(**settings)
     gi = settings["gi"]
     progress(f"opening {blend}")
-    open_blend(blend)
-    define_light_switch()  # read the per-light include switch saved in the file
-    scene = bpy.context.scene
-    if scene.camera is None:
-        raise SceneError(f"{blend}: the scene has no camera")
-    width, height = image_size(scene, gi.resolution)
-    captured = SceneCache().update(bpy.context.evaluated_depsgraph_get(), width, height)
+    captured, (width, height) = capture_blend(blend, gi.resolution)
     if budget:
         progress("choosing the method for the budget")
     requested = settings

@@ -53,3 +53,19 @@ def update_costs(method, repeat: int) -> dict[str, float]:
     finally:
         method.profile = profile
     return {kind: statistics.median(ms) for kind, ms in samples.items()}
+
+
+def update_costs_in_turn(methods: list, rounds: int) -> list[dict[str, float]]:
+    """update_costs of several methods set up on one scene, timed in turn: each of `rounds` rounds times
+    one update of each kind for every method, and each kind's cost is its median over the rounds.
+
+    A shared machine's load drifts over minutes; timed one method after another, a method timed in a busy
+    minute reads slower than one timed in a quiet minute (lpv's light update on the Cornell box read
+    100 to 195 ms in runs minutes apart). Taken in turn, the drift falls alike on every method, so the
+    ratios between them, which is what a benchmark compares, hold within one run."""
+    samples = [{kind: [] for kind in ("full", "lights", "camera")} for _ in methods]
+    for _ in range(rounds):
+        for method, kinds in zip(methods, samples, strict=True):
+            for kind, ms in update_costs(method, 1).items():
+                kinds[kind].append(ms)
+    return [{kind: statistics.median(ms) for kind, ms in kinds.items()} for kinds in samples]
