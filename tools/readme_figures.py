@@ -73,7 +73,8 @@ def update_costs_block(results: dict) -> str:
     lines = ["**Update costs** of each method at its default settings.", "",
              _produced_by(results) + f" Medians of {results['repeat']} updates of each kind; full = a geometry "
              "change (the upload, the setup passes and everything after), lights = every light moved 1 cm, camera = "
-             "the camera moved 1 cm.", "",
+             "the camera moved 1 cm. A scene's methods are timed in turn in one process, one update of each kind per "
+             "round, so the machine's changing load falls alike on all of them.", "",
              "| scene | size | method | full ms | lights ms | camera ms | camera / full |",
              "| --- | --- | --- | --- | --- | --- | --- |"]
     for r in records:
