@@ -17,6 +17,21 @@
 // near-field light lost). The bake of the Cornell floor (tests/e2e/test_bake_vs_cycles.py: 1024 VPLs,
 // 64 x 64 texels, the first row 4 cm from the walls) bounds it: rel_rmse_8 / bias 0.126 / 0.948 at
 // 1 / 256, 0.149 / 0.931 at 1 / 16, 0.208 / 0.900 at 1 / 4 (bound 0.18, bias within 0.08).
+//
+// Near draws (multiple importance sampling). A receiver's brightest VPLs are its near ones, and in a
+// large RSM they are few: under Sponza's sun a shaded gallery floor gets most of its light from the
+// lit courtyard floor a metre or two away, a few texels of a 256^2 map that its one draw per 16^2
+// block rarely meets (88 % of the squared difference between two seeds sat in 1 % of the pixels).
+// Points near the receiver in the world project near its own texel c in the light's view, so besides
+// the strata each pixel draws near_strata^2 texels in each of NEAR_WINDOWS squares centred at c (sides
+// in NEAR_SIDE_BLOCKS), one per cell of a near_strata^2 split of the window: stratified as the blocks
+// are, for without it a smooth near field (a wall's crease) grew noisier, the windows' random draws
+// replacing part of the strata's. Every draw, of either kind, is weighted by the
+// balance heuristic over the expected draws per texel: 1 / (1 / weight + near_density(t)), where
+// 1 / weight is the strata's (each texel lies in one block and is drawn with probability 1 / weight)
+// and near_density(t) the windows' (near_strata^2 / side^2 in each window holding t). Its expectation is
+// the sum over every texel of its light, whatever the densities: unbiased, with the integrand
+// unchanged (the disk keeps the block's share), so only the noise moves.
 // With VOXEL_VISIBILITY, each VPL counts only if the segment between the receiver and the VPL, both
 // moved `offset_cells` off their surfaces along their normals, crosses no occupied voxel (a march in
 // half-cell steps through the voxelizer's occupancy).
@@ -25,6 +40,9 @@
 
 const float PI = 3.14159265;
 const float DISK_SHARE = 0.0625;  // 1 / 16
+const int NEAR_WINDOWS = 3;
+// The windows' sides in blocks: a quarter block, a block, four blocks (below).
+const float NEAR_SIDE_BLOCKS[NEAR_WINDOWS] = float[NEAR_WINDOWS](0.25, 1.0, 4.0);
 
 #ifdef VOXEL_VISIBILITY
 // 1 if no occupied voxel lies on the segment, skipping its first and last cell: a VPL low on a wall
@@ -45,6 +63,44 @@ float visible(vec3 from_ws, vec3 to_ws) {
 }
 #endif
 
+// The light of the VPL at RSM texel t on receiver x (normal n), unweighted (E, W/m^2 per texel drawn).
+vec3 vpl_light(ivec2 t, vec3 x, vec3 n, float disk_share) {
+    vec4 vpl_pos = texelFetch(rsm_position, t, 0);
+    if (vpl_pos.w == 0.0) {
+        return vec3(0.0);
+    }
+    vec4 vpl_normal = texelFetch(rsm_normal, t, 0);
+    vec3 d = vpl_pos.xyz - x;
+    float r2 = dot(d, d);
+    vec3 w = d * inversesqrt(max(r2, 1e-20));
+    float cos_x = dot(n, w);
+    float cos_vpl = -dot(vpl_normal.xyz, w);
+    if (cos_x <= 0.0 || cos_vpl <= 0.0) {
+        return vec3(0.0);
+    }
+    float disk_m2 = disk_share * vpl_normal.w;
+#ifdef VOXEL_VISIBILITY
+    float offset_m = offset_cells * cell_size;
+    if (visible(x + n * offset_m, vpl_pos.xyz + vpl_normal.xyz * offset_m) == 0.0) {
+        return vec3(0.0);
+    }
+#endif
+    return texelFetch(rsm_flux, t, 0).rgb * (cos_x * cos_vpl / (PI * (r2 + disk_m2 / PI)));
+}
+
+// The near windows' expected draws at texel t (windows centred at `centre`, sides `sides`, texels).
+float near_density(ivec2 t, ivec2 centre, ivec2 sides[NEAR_WINDOWS]) {
+    int near_draws = near_strata * near_strata;
+    float density = 0.0;
+    for (int k = 0; k < NEAR_WINDOWS; ++k) {
+        ivec2 lo = centre - sides[k] / 2;
+        if (all(greaterThanEqual(t, lo)) && all(lessThan(t, lo + sides[k]))) {
+            density += float(near_draws) / float(sides[k].x * sides[k].y);
+        }
+    }
+    return density;
+}
+
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(px, textureSize(gbuf_position, 0)))) {
@@ -61,6 +117,17 @@ void main() {
     float weight = block.x * block.y;
     float disk_share = DISK_SHARE * weight;
     uint pixel_id = uint(px.y * 65536 + px.x);
+    // The receiver's own texel; no near draws where it lies behind the light's view (a cube face's
+    // back), so that the densities stay those of the draws made.
+    vec4 clip = rsm_view_projection * vec4(x, 1.0);
+    bool near = near_strata > 0 && clip.w > 0.0;
+    ivec2 centre = ivec2(floor((clip.xy / max(clip.w, 1e-20) * 0.5 + 0.5) * vec2(rsm_size)));
+    ivec2 sides[NEAR_WINDOWS];
+    for (int k = 0; k < NEAR_WINDOWS; ++k) {
+        sides[k] = max(ivec2(block * NEAR_SIDE_BLOCKS[k] + 0.5), ivec2(1));
+    }
+    float strata_density = 1.0 / weight;
+    int near_draws = near_strata * near_strata;
     // Progressive refinement: the n-th gather (sample_index) keeps the update's draws and moves each
     // by n x the R2 sequence's steps (Roberts 2018), so a pixel's draws in a block over the samples form
     // one low-discrepancy set (each still uniform in the block: unbiased). Cornell 128 px, 16 samples:
@@ -73,28 +140,30 @@ void main() {
             vec2 u = fract(vec2(random01(pixel_id, stratum, uint(seed) * 2u),
                                 random01(pixel_id, stratum, uint(seed) * 2u + 1u)) + sample_step);
             ivec2 t = min(ivec2((vec2(i, j) + u) * block), rsm_size - 1);
-            vec4 vpl_pos = texelFetch(rsm_position, t, 0);
-            if (vpl_pos.w == 0.0) {
-                continue;
+            vec3 light = vpl_light(t, x, n, disk_share);
+            if (any(greaterThan(light, vec3(0.0)))) {
+                irradiance += light / (strata_density + (near ? near_density(t, centre, sides) : 0.0));
             }
-            vec4 vpl_normal = texelFetch(rsm_normal, t, 0);
-            vec3 d = vpl_pos.xyz - x;
-            float r2 = dot(d, d);
-            vec3 w = d * inversesqrt(max(r2, 1e-20));
-            float cos_x = dot(n, w);
-            float cos_vpl = -dot(vpl_normal.xyz, w);
-            if (cos_x <= 0.0 || cos_vpl <= 0.0) {
-                continue;
+        }
+    }
+    // The near draws, once per pixel: in the dispatch of the first block row.
+    if (near && row_begin == 0) {
+        for (int k = 0; k < NEAR_WINDOWS; ++k) {
+            vec2 cell = vec2(sides[k]) / float(near_strata);
+            for (int s = 0; s < near_draws; ++s) {
+                uint draw = uint(strata_per_side * strata_per_side + k * near_draws + s);
+                vec2 u = fract(vec2(random01(pixel_id, draw, uint(seed) * 2u),
+                                    random01(pixel_id, draw, uint(seed) * 2u + 1u)) + sample_step);
+                vec2 within = (vec2(s % near_strata, s / near_strata) + u) * cell;
+                ivec2 t = centre - sides[k] / 2 + min(ivec2(within), sides[k] - 1);
+                if (any(lessThan(t, ivec2(0))) || any(greaterThanEqual(t, rsm_size))) {
+                    continue;  // off the map: no light there, and its density counted all the same
+                }
+                vec3 light = vpl_light(t, x, n, disk_share);
+                if (any(greaterThan(light, vec3(0.0)))) {
+                    irradiance += light / (strata_density + near_density(t, centre, sides));
+                }
             }
-            vec3 phi = texelFetch(rsm_flux, t, 0).rgb;
-            float disk_m2 = disk_share * vpl_normal.w;
-#ifdef VOXEL_VISIBILITY
-            float offset_m = offset_cells * cell_size;
-            if (visible(x + n * offset_m, vpl_pos.xyz + vpl_normal.xyz * offset_m) == 0.0) {
-                continue;
-            }
-#endif
-            irradiance += phi * (weight * cos_x * cos_vpl / (PI * (r2 + disk_m2 / PI)));
         }
     }
     vec4 acc = imageLoad(indirect, px);

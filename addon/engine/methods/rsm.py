@@ -54,7 +54,7 @@ class RsmMethod(OneBounceMethod):
             share = self.vpl_shares.get(view.light_index)
             vpls = self.rsm_config.vpl_samples if share is None else max(1, round(self.rsm_config.vpl_samples * share))
             rsm_gather.run(self.backend, self.gbuf, self.rsm, self.indirect, vpls,
-                           self.gi.seed + view.light_index * 6 + max(view.face_index, 0),
+                           self.gi.seed + view.light_index * 6 + max(view.face_index, 0), view.view_projection,
                            occupancy=self.voxels["vox_albedo"] if self.voxels else None,
                            grid=self.voxels and self.grid, offset_cells=self.rsm_config.voxel_offset_cells,
                            sample=self.sample_index)
