@@ -117,11 +117,13 @@ void main() {
     float weight = block.x * block.y;
     float disk_share = DISK_SHARE * weight;
     uint pixel_id = uint(px.y * 65536 + px.x);
-    // The receiver's own texel; no near draws where it lies behind the light's view (a cube face's
-    // back), so that the densities stay those of the draws made.
+    // The receiver's own texel. No near draws where it lies behind the light's view (a cube face's
+    // back) or far off the map (where the texel would overflow an int): a choice per pixel, so the
+    // densities stay those of the draws made.
     vec4 clip = rsm_view_projection * vec4(x, 1.0);
-    bool near = near_strata > 0 && clip.w > 0.0;
-    ivec2 centre = ivec2(floor((clip.xy / max(clip.w, 1e-20) * 0.5 + 0.5) * vec2(rsm_size)));
+    vec2 ndc = clip.xy / max(clip.w, 1e-20);
+    bool near = near_strata > 0 && clip.w > 0.0 && all(lessThan(abs(ndc), vec2(16.0)));
+    ivec2 centre = ivec2(floor((clamp(ndc, -16.0, 16.0) * 0.5 + 0.5) * vec2(rsm_size)));
     ivec2 sides[NEAR_WINDOWS];
     for (int k = 0; k < NEAR_WINDOWS; ++k) {
         sides[k] = max(ivec2(block * NEAR_SIDE_BLOCKS[k] + 0.5), ivec2(1));
