@@ -23,7 +23,7 @@
 // lit courtyard floor a metre or two away, a few texels of a 256^2 map that its one draw per 16^2
 // block rarely meets (88 % of the squared difference between two seeds sat in 1 % of the pixels).
 // Points near the receiver in the world project near its own texel c in the light's view, so besides
-// the strata each pixel draws near_strata^2 texels in each of NEAR_WINDOWS squares centred at c (sides
+// the strata each pixel draws near_strata^2 texels in each of three squares centred at c (sides
 // in NEAR_SIDE_BLOCKS), one per cell of a near_strata^2 split of the window: stratified as the blocks
 // are, for without it a smooth near field (a wall's crease) grew noisier, the windows' random draws
 // replacing part of the strata's. Every draw, of either kind, is weighted by the
@@ -40,9 +40,8 @@
 
 const float PI = 3.14159265;
 const float DISK_SHARE = 0.0625;  // 1 / 16
-const int NEAR_WINDOWS = 3;
-// The windows' sides in blocks: a quarter block, a block, four blocks (below).
-const float NEAR_SIDE_BLOCKS[NEAR_WINDOWS] = float[NEAR_WINDOWS](0.25, 1.0, 4.0);
+// The near squares' sides in blocks: a quarter block, a block, four blocks (below).
+const vec3 NEAR_SIDE_BLOCKS = vec3(0.25, 1.0, 4.0);
 
 #ifdef VOXEL_VISIBILITY
 // 1 if no occupied voxel lies on the segment, skipping its first and last cell: a VPL low on a wall
@@ -88,17 +87,15 @@ vec3 vpl_light(ivec2 t, vec3 x, vec3 n, float disk_share) {
     return texelFetch(rsm_flux, t, 0).rgb * (cos_x * cos_vpl / (PI * (r2 + disk_m2 / PI)));
 }
 
-// The near windows' expected draws at texel t (windows centred at `centre`, sides `sides`, texels).
-float near_density(ivec2 t, ivec2 centre, ivec2 sides[NEAR_WINDOWS]) {
-    int near_draws = near_strata * near_strata;
-    float density = 0.0;
-    for (int k = 0; k < NEAR_WINDOWS; ++k) {
-        ivec2 lo = centre - sides[k] / 2;
-        if (all(greaterThanEqual(t, lo)) && all(lessThan(t, lo + sides[k]))) {
-            density += float(near_draws) / float(sides[k].x * sides[k].y);
-        }
-    }
-    return density;
+// The near squares' expected draws at texel t: `densities` (draws per texel) summed over the squares
+// of `sides` texels centred at `centre` that hold t. One unsigned compare per axis and square: t lies
+// in a square of side s iff 0 <= t - (centre - s / 2) < s.
+float near_density(ivec2 t, ivec2 centre, ivec3 sides, vec3 densities) {
+    ivec2 d = t - centre;
+    bvec3 inside = bvec3(all(lessThan(uvec2(d + sides.x / 2), uvec2(sides.x))),
+                         all(lessThan(uvec2(d + sides.y / 2), uvec2(sides.y))),
+                         all(lessThan(uvec2(d + sides.z / 2), uvec2(sides.z))));
+    return dot(vec3(inside), densities);
 }
 
 void main() {
@@ -124,12 +121,12 @@ void main() {
     vec2 ndc = clip.xy / max(clip.w, 1e-20);
     bool near = near_strata > 0 && clip.w > 0.0 && all(lessThan(abs(ndc), vec2(16.0)));
     ivec2 centre = ivec2(floor((clamp(ndc, -16.0, 16.0) * 0.5 + 0.5) * vec2(rsm_size)));
-    ivec2 sides[NEAR_WINDOWS];
-    for (int k = 0; k < NEAR_WINDOWS; ++k) {
-        sides[k] = max(ivec2(block * NEAR_SIDE_BLOCKS[k] + 0.5), ivec2(1));
-    }
-    float strata_density = 1.0 / weight;
+    // RSM faces are square: block.x is the block's side.
+    ivec3 sides = max(ivec3(block.x * NEAR_SIDE_BLOCKS + 0.5), ivec3(1));
     int near_draws = near_strata * near_strata;
+    // No near draws: no near density either, so every draw keeps the strata's weight alone.
+    vec3 densities = near ? float(near_draws) / vec3(sides * sides) : vec3(0.0);
+    float strata_density = 1.0 / weight;
     // Progressive refinement: the n-th gather (sample_index) keeps the update's draws and moves each
     // by n x the R2 sequence's steps (Roberts 2018), so a pixel's draws in a block over the samples form
     // one low-discrepancy set (each still uniform in the block: unbiased). Cornell 128 px, 16 samples:
@@ -142,29 +139,24 @@ void main() {
             vec2 u = fract(vec2(random01(pixel_id, stratum, uint(seed) * 2u),
                                 random01(pixel_id, stratum, uint(seed) * 2u + 1u)) + sample_step);
             ivec2 t = min(ivec2((vec2(i, j) + u) * block), rsm_size - 1);
-            vec3 light = vpl_light(t, x, n, disk_share);
-            if (any(greaterThan(light, vec3(0.0)))) {
-                irradiance += light / (strata_density + (near ? near_density(t, centre, sides) : 0.0));
-            }
+            irradiance += vpl_light(t, x, n, disk_share) / (strata_density + near_density(t, centre, sides, densities));
         }
     }
     // The near draws, once per pixel: in the dispatch of the first block row.
     if (near && row_begin == 0) {
-        for (int k = 0; k < NEAR_WINDOWS; ++k) {
-            vec2 cell = vec2(sides[k]) / float(near_strata);
+        for (int k = 0; k < 3; ++k) {
+            int side = sides[k];
+            vec2 cell = vec2(float(side) / float(near_strata));
             for (int s = 0; s < near_draws; ++s) {
                 uint draw = uint(strata_per_side * strata_per_side + k * near_draws + s);
                 vec2 u = fract(vec2(random01(pixel_id, draw, uint(seed) * 2u),
                                     random01(pixel_id, draw, uint(seed) * 2u + 1u)) + sample_step);
                 vec2 within = (vec2(s % near_strata, s / near_strata) + u) * cell;
-                ivec2 t = centre - sides[k] / 2 + min(ivec2(within), sides[k] - 1);
+                ivec2 t = centre - side / 2 + min(ivec2(within), ivec2(side - 1));
                 if (any(lessThan(t, ivec2(0))) || any(greaterThanEqual(t, rsm_size))) {
                     continue;  // off the map: no light there, and its density counted all the same
                 }
-                vec3 light = vpl_light(t, x, n, disk_share);
-                if (any(greaterThan(light, vec3(0.0)))) {
-                    irradiance += light / (strata_density + near_density(t, centre, sides));
-                }
+                irradiance += vpl_light(t, x, n, disk_share) / (strata_density + near_density(t, centre, sides, densities));
             }
         }
     }
