@@ -24,12 +24,12 @@
 // block rarely meets (88 % of the squared difference between two seeds sat in 1 % of the pixels).
 // Points near the receiver in the world project near its own texel c in the light's view, so besides
 // the strata each pixel draws near_strata^2 texels in each of three squares centred at c (sides
-// in NEAR_SIDE_BLOCKS), one per cell of a near_strata^2 split of the window: stratified as the blocks
-// are, for without it a smooth near field (a wall's crease) grew noisier, the windows' random draws
+// in NEAR_SIDE_BLOCKS), one per cell of a near_strata^2 split of the square: stratified as the blocks
+// are, for without it a smooth near field (a wall's crease) grew noisier, the squares' random draws
 // replacing part of the strata's. Every draw, of either kind, is weighted by the
 // balance heuristic over the expected draws per texel: 1 / (1 / weight + near_density(t)), where
 // 1 / weight is the strata's (each texel lies in one block and is drawn with probability 1 / weight)
-// and near_density(t) the windows' (near_strata^2 / side^2 in each window holding t). Its expectation is
+// and near_density(t) the squares' (near_strata^2 / side^2 in each square holding t). Its expectation is
 // the sum over every texel of its light, whatever the densities: unbiased, with the integrand
 // unchanged (the disk keeps the block's share), so only the noise moves.
 // With VOXEL_VISIBILITY, each VPL counts only if the segment between the receiver and the VPL, both

@@ -2,11 +2,11 @@
 
 Inputs: G-buffer position and normal; one RSM face's position, normal (w = surfel area, m^2) and flux
 (W). Uniforms: strata_per_side (VPLs per pixel = strata_per_side^2), the face's view-projection and
-near_strata (near_strata^2 draws near the receiver's own texel per window, besides the strata), seed,
-sample_index;
-with voxel visibility also the voxelizer's occupancy (`vox_albedo`, a = occupancy) and its grid. Output: `indirect`
-(RGBA32F, camera resolution), accumulated over faces and lights, in Cycles' Diffuse Indirect unit
-(indirect irradiance / pi). One bounce. See gpu_shaders/rsm/gather.comp.glsl for the estimator.
+near_strata (near_strata^2 draws near the receiver's own texel in each of three squares, besides the
+strata), seed, sample_index; with voxel visibility also the voxelizer's occupancy (`vox_albedo`,
+a = occupancy) and its grid. Output: `indirect` (RGBA32F, camera resolution), accumulated over faces
+and lights, in Cycles' Diffuse Indirect unit (indirect irradiance / pi). One bounce. See
+gpu_shaders/rsm/gather.comp.glsl for the estimator.
 """
 
 from __future__ import annotations
@@ -58,8 +58,8 @@ def strata_per_side(vpl_samples: int) -> int:
 
 
 def near_strata(vpl_samples: int) -> int:
-    """Draws near the receiver (gather.comp.glsl, "Near draws"): near_strata^2 per window, about half a
-    row of strata each (1 at 16 VPLs and fewer, 3 at 256), so the three windows add ~10 % to the strata."""
+    """Draws near the receiver (gather.comp.glsl, "Near draws"): near_strata^2 in each of three squares,
+    about half a row of strata each (1 at 16 VPLs and fewer, 3 at 256: 27 draws beside the 256)."""
     return max(1, round(math.sqrt(strata_per_side(vpl_samples) / 2)))
 
 
@@ -82,7 +82,7 @@ def run(backend: Backend, gbuf: dict, rsm: dict, indirect, vpl_samples: int, see
         samplers["occupancy"] = occupancy
     # Worst-case loop iterations per VPL: 1, or the march's half-cell steps across the grid diagonal.
     per_vpl = 1 if grid is None else int(np.ceil(2.0 * np.linalg.norm(grid.dims))) + 1
-    # The first dispatch also makes the NEAR_WINDOWS (3) windows' near draws.
+    # The first dispatch also makes the three squares' near draws.
     rows = max(1, (MAX_LOOP_ITERATIONS - 3 * near * near * per_vpl) // (k * per_vpl))
     for begin in range(0, k, rows):
         backend.dispatch(backend.program(spec), group_count(indirect.size, spec.local_size),
