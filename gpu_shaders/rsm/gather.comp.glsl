@@ -1,16 +1,21 @@
 // RSM indirect gather (Dachsbacher & Stamminger 2005), no visibility: every pixel sums the light of
 // VPLs drawn from one RSM face, added to `indirect` in Cycles' Diffuse Indirect unit (E / pi).
 //
-// Sampling: the RSM is split into strata_per_side^2 equal blocks; each pixel draws one texel per block
-// (its own hash, so the estimate is unbiased and the noise is per-pixel, not structured) weighted by
-// the block's texel count (refinement gathers step along a sequence, below). One dispatch handles
-// block rows [row_begin, row_end): llvmpipe silently stops a shader after 65,535 loop iterations, so
-// the caller splits long visibility marches. A VPL of flux phi is a Lambertian disk of area A:
+// Sampling: the RSM is split into strata_per_side^2 = k^2 blocks; each pixel makes k^2 strata draws
+// (its own hash, so the estimate is unbiased and the noise is per-pixel, not structured), each in a
+// block picked with the probability block_pdf gives it and then uniformly within the block, weighted by
+// 1 / (expected draws per texel) (refinement gathers step along a sequence, below). block_pdf is the
+// blocks' view importance (rsm/importance*.comp.glsl): the mean over receivers spread across the
+// G-buffer of the share of each one's light the block holds, half of it uniform; uniform, it is one
+// draw per block. Under Sponza's sun 7 % of the map's texels can light anything the camera sees (the
+// rest is roof facing the sky), so uniform draws mostly miss. One dispatch handles draws
+// [row_begin k, row_end k): llvmpipe silently stops a shader after 65,535 loop iterations, so the
+// caller splits long visibility marches. A VPL of flux phi is a Lambertian disk of area A:
 //     E += phi / pi * cos_vpl * cos_x / (r^2 + A / pi)
 // The A / pi term is the on-axis form factor of a disk: it keeps nearby VPLs from spiking. A drawn VPL
-// stands for its whole block (`weight` texels), so its disk is taken as DISK_SHARE of the block's area,
-// A = DISK_SHARE x weight x surfel area: a VPL within a few centimetres of the receiver no longer spikes
-// by the block's weight (at 256 VPLs 88 % of the squared difference between two seeds sat in 1 % of
+// stands for a block of `weight` texels at one draw per block, so its disk is taken as DISK_SHARE of
+// that area, A = DISK_SHARE x weight x surfel area: a VPL within a few centimetres of the receiver no
+// longer spikes by the block's weight (at 256 VPLs 88 % of the squared difference between two seeds sat in 1 % of
 // the pixels, next to the walls). Cornell 128 px, 256 VPLs, the two geometric denoise iterations
 // (tools/noise_table.py; noise / rel_rmse_8 / bias): share 1 / 256 (the surfel alone) 0.059 / 0.193 /
 // 1.14; 1 / 16 0.041 / 0.195; 1 / 4 0.034 / 0.201 / 1.13; 1 (the block) 0.023 / 0.221 (the corners' real
@@ -27,9 +32,9 @@
 // in NEAR_SIDE_BLOCKS), one per cell of a near_strata^2 split of the square: stratified as the blocks
 // are, for without it a smooth near field (a wall's crease) grew noisier, the squares' random draws
 // replacing part of the strata's. Every draw, of either kind, is weighted by the
-// balance heuristic over the expected draws per texel: 1 / (1 / weight + near_density(t)), where
-// 1 / weight is the strata's (each texel lies in one block and is drawn with probability 1 / weight)
-// and near_density(t) the squares' (near_strata^2 / side^2 in each square holding t). Its expectation is
+// balance heuristic over the expected draws per texel: 1 / (strata_density(t) + near_density(t)), the
+// strata's k^2 block_pdf / (the block's texels) and the squares' (near_strata^2 / side^2 in each square
+// holding t). Its expectation is
 // the sum over every texel of its light, whatever the densities: unbiased, with the integrand
 // unchanged (the disk keeps the block's share), so only the noise moves.
 // With VOXEL_VISIBILITY, each VPL counts only if the segment between the receiver and the VPL, both
@@ -37,55 +42,10 @@
 // half-cell steps through the voxelizer's occupancy).
 
 #include "common/hash.glsl"
+#include "rsm/vpl.glsl"
 
-const float PI = 3.14159265;
-const float DISK_SHARE = 0.0625;  // 1 / 16
 // The near squares' sides in blocks: a quarter block, a block, four blocks (below).
 const vec3 NEAR_SIDE_BLOCKS = vec3(0.25, 1.0, 4.0);
-
-#ifdef VOXEL_VISIBILITY
-// 1 if no occupied voxel lies on the segment, skipping its first and last cell: a VPL low on a wall
-// sits within a cell of the floor's voxels, which would otherwise hide it from the floor it lights.
-float visible(vec3 from_ws, vec3 to_ws) {
-    vec3 a = (from_ws - grid_origin) / cell_size;
-    vec3 b = (to_ws - grid_origin) / cell_size;
-    float len = length(b - a);
-    int steps = int(ceil(len * 2.0));
-    for (int s = 2; s < steps - 1; ++s) {
-        ivec3 c = ivec3(floor(mix(a, b, float(s) / float(steps))));
-        if (all(greaterThanEqual(c, ivec3(0))) && all(lessThan(c, grid_dims))
-            && texelFetch(occupancy, c, 0).a > 0.5) {
-            return 0.0;
-        }
-    }
-    return 1.0;
-}
-#endif
-
-// The light of the VPL at RSM texel t on receiver x (normal n), unweighted (E, W/m^2 per texel drawn).
-vec3 vpl_light(ivec2 t, vec3 x, vec3 n, float disk_share) {
-    vec4 vpl_pos = texelFetch(rsm_position, t, 0);
-    if (vpl_pos.w == 0.0) {
-        return vec3(0.0);
-    }
-    vec4 vpl_normal = texelFetch(rsm_normal, t, 0);
-    vec3 d = vpl_pos.xyz - x;
-    float r2 = dot(d, d);
-    vec3 w = d * inversesqrt(max(r2, 1e-20));
-    float cos_x = dot(n, w);
-    float cos_vpl = -dot(vpl_normal.xyz, w);
-    if (cos_x <= 0.0 || cos_vpl <= 0.0) {
-        return vec3(0.0);
-    }
-    float disk_m2 = disk_share * vpl_normal.w;
-#ifdef VOXEL_VISIBILITY
-    float offset_m = offset_cells * cell_size;
-    if (visible(x + n * offset_m, vpl_pos.xyz + vpl_normal.xyz * offset_m) == 0.0) {
-        return vec3(0.0);
-    }
-#endif
-    return texelFetch(rsm_flux, t, 0).rgb * (cos_x * cos_vpl / (PI * (r2 + disk_m2 / PI)));
-}
 
 // The near squares' expected draws at texel t: `densities` (draws per texel) summed over the squares
 // of `sides` texels centred at `centre` that hold t. One unsigned compare per axis and square: t lies
@@ -96,6 +56,31 @@ float near_density(ivec2 t, ivec2 centre, ivec3 sides, vec3 densities) {
                          all(lessThan(uvec2(d + sides.y / 2), uvec2(sides.y))),
                          all(lessThan(uvec2(d + sides.z / 2), uvec2(sides.z))));
     return dot(vec3(inside), densities);
+}
+
+// Block i's texels along each axis are [block_lo(i), block_lo(i + 1)): whole texels, so a texel lies in
+// exactly one block even where the map's side is not a multiple of strata_per_side. Float arithmetic,
+// exact here (integers below 2^24, a quotient that is an integer comes out exact, any other lies at
+// least 1 / strata_per_side from one): llvmpipe runs integer division one lane at a time.
+ivec2 block_lo(ivec2 i, ivec2 rsm_size) {
+    return ivec2(floor(vec2(i * rsm_size) / float(strata_per_side)));
+}
+
+// The block holding texel t: the last i with block_lo(i) <= t, i.e. floor(((t + 1) k - 1) / size).
+ivec2 block_of(ivec2 t, ivec2 rsm_size) {
+    return ivec2(floor(vec2((t + 1) * strata_per_side - 1) / vec2(rsm_size)));
+}
+
+// The strata's expected draws at texel t. Guided: strata_per_side^2 draws, each in block i with
+// probability block_pdf(i).x, uniform within the block. Else one draw per block of `weight` texels.
+float strata_density(ivec2 t, ivec2 rsm_size, bool guided, float weight) {
+    if (!guided) {
+        return 1.0 / weight;
+    }
+    ivec2 i = block_of(t, rsm_size);
+    ivec2 texels = block_lo(i + 1, rsm_size) - block_lo(i, rsm_size);
+    float pdf = texelFetch(block_pdf, i, 0).x;
+    return float(strata_per_side * strata_per_side) * pdf / float(texels.x * texels.y);
 }
 
 void main() {
@@ -126,20 +111,59 @@ void main() {
     int near_draws = near_strata * near_strata;
     // No near draws: no near density either, so every draw keeps the strata's weight alone.
     vec3 densities = near ? float(near_draws) / vec3(sides * sides) : vec3(0.0);
-    float strata_density = 1.0 / weight;
     // Progressive refinement: the n-th gather (sample_index) keeps the update's draws and moves each
-    // by n x the R2 sequence's steps (Roberts 2018), so a pixel's draws in a block over the samples form
-    // one low-discrepancy set (each still uniform in the block: unbiased). Cornell 128 px, 16 samples:
-    // noise 0.012 with a fresh seed per sample, 0.0058 so.
+    // by n x the R2 sequence's steps (Roberts 2018) within its block, and its block choice by n x the
+    // golden ratio, so a pixel's draws over the samples form one low-discrepancy set (each still drawn
+    // with the same densities: unbiased). Cornell 128 px, 16 samples: noise 0.012 with a fresh seed per
+    // sample, 0.0058 so.
     vec2 sample_step = float(sample_index) * vec2(0.75487767, 0.56984029);
+    float choice_step = float(sample_index) * 0.61803399;
+    // The strata, draws [row_begin k, row_end k) of k^2. Unguided (block_pdf.y = 0, the same in every
+    // block): draw s = j k + i takes a texel uniformly in block (i, j). Guided: draw s picks its block by
+    // inverting block_pdf's running sum at (s + v) / k^2, one draw per interval of equal probability,
+    // then a texel uniformly in the block; the walk over the blocks restarts in each dispatch (at most
+    // k^2 steps besides its draws) and computes a block's texels only when it moves.
+    bool guided = texelFetch(block_pdf, ivec2(0), 0).y > 0.5;
+    int blocks = strata_per_side * strata_per_side;
     vec3 irradiance = vec3(0.0);
-    for (int j = row_begin; j < row_end; ++j) {
-        for (int i = 0; i < strata_per_side; ++i) {
-            uint stratum = uint(j * strata_per_side + i);
-            vec2 u = fract(vec2(random01(pixel_id, stratum, uint(seed) * 2u),
+    if (guided) {
+        int b = 0;
+        ivec2 i = ivec2(0);  // block b's column and row, stepped with it (no integer division)
+        float pdf = texelFetch(block_pdf, i, 0).x;
+        float cdf_end = pdf;
+        ivec2 lo = block_lo(i, rsm_size);
+        ivec2 texels = block_lo(i + 1, rsm_size) - lo;
+        for (int s = row_begin * strata_per_side; s < row_end * strata_per_side; ++s) {
+            uint stratum = uint(s);
+            float v = fract(random01(pixel_id, stratum + 0x40000000u, uint(seed)) + choice_step);
+            float u = (float(s) + v) / float(blocks);
+            if (cdf_end <= u) {
+                while (cdf_end <= u && b < blocks - 1) {
+                    ++b;
+                    i = i.x + 1 < strata_per_side ? ivec2(i.x + 1, i.y) : ivec2(0, i.y + 1);
+                    pdf = texelFetch(block_pdf, i, 0).x;
+                    cdf_end += pdf;
+                }
+                lo = block_lo(i, rsm_size);
+                texels = block_lo(i + 1, rsm_size) - lo;
+            }
+            vec2 w = fract(vec2(random01(pixel_id, stratum, uint(seed) * 2u),
                                 random01(pixel_id, stratum, uint(seed) * 2u + 1u)) + sample_step);
-            ivec2 t = min(ivec2((vec2(i, j) + u) * block), rsm_size - 1);
-            irradiance += vpl_light(t, x, n, disk_share) / (strata_density + near_density(t, centre, sides, densities));
+            ivec2 t = lo + min(ivec2(w * vec2(texels)), texels - 1);
+            // strata_density(t) without its look-ups: t lies in block i, drawn with probability pdf.
+            float density = float(blocks) * pdf / float(texels.x * texels.y);
+            irradiance += vpl_light(t, x, n, disk_share) / (density + near_density(t, centre, sides, densities));
+        }
+    } else {
+        for (int j = row_begin; j < row_end; ++j) {
+            for (int i = 0; i < strata_per_side; ++i) {
+                uint stratum = uint(j * strata_per_side + i);
+                vec2 w = fract(vec2(random01(pixel_id, stratum, uint(seed) * 2u),
+                                    random01(pixel_id, stratum, uint(seed) * 2u + 1u)) + sample_step);
+                ivec2 t = min(ivec2((vec2(i, j) + w) * block), rsm_size - 1);
+                float density = 1.0 / weight + near_density(t, centre, sides, densities);
+                irradiance += vpl_light(t, x, n, disk_share) / density;
+            }
         }
     }
     // The near draws, once per pixel: in the dispatch of the first block row.
@@ -156,7 +180,9 @@ void main() {
                 if (any(lessThan(t, ivec2(0))) || any(greaterThanEqual(t, rsm_size))) {
                     continue;  // off the map: no light there, and its density counted all the same
                 }
-                irradiance += vpl_light(t, x, n, disk_share) / (strata_density + near_density(t, centre, sides, densities));
+                float density = strata_density(t, rsm_size, guided, weight)
+                                + near_density(t, centre, sides, densities);
+                irradiance += vpl_light(t, x, n, disk_share) / density;
             }
         }
     }

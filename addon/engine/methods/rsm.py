@@ -24,6 +24,8 @@ class RsmMethod(OneBounceMethod):
     PASSES = declare.extend(OneBounceMethod.PASSES, setup=(voxelize.DECL,),
                             gather=(rsm_gather.DECL, accumulate.DECL, denoise.DECL))
     NOISY = ("indirect",)
+    # rsm_gather's scratch for its blocks' view importance, made on the first gather.
+    block_importance: dict | None = None
 
     def set_scene(self, scene) -> None:
         super().set_scene(scene)
@@ -53,8 +55,11 @@ class RsmMethod(OneBounceMethod):
         with self.step(timings, rsm_gather.DECL):
             share = self.vpl_shares.get(view.light_index)
             vpls = self.rsm_config.vpl_samples if share is None else max(1, round(self.rsm_config.vpl_samples * share))
+            if self.block_importance is None:
+                self.block_importance = rsm_gather.importance_textures(self.backend, self.rsm_config.vpl_samples)
             rsm_gather.run(self.backend, self.gbuf, self.rsm, self.indirect, vpls,
                            self.gi.seed + view.light_index * 6 + max(view.face_index, 0), view.view_projection,
+                           self.block_importance,
                            occupancy=self.voxels["vox_albedo"] if self.voxels else None,
                            grid=self.voxels and self.grid, offset_cells=self.rsm_config.voxel_offset_cells,
                            sample=self.sample_index)
