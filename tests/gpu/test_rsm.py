@@ -131,6 +131,16 @@ def test_default_vpls_near_field_disk(gl):
     crease = ratios[min(ratios)]
     assert 0.90 <= crease <= 1.0
 
+def raw_indirect_over_seeds(gl, scene, rows: slice, cols: slice, seeds: int = 16) -> np.ndarray:
+    """The unfiltered gather's indirect (red) in a window of the image, one image per seed 0..seeds-1."""
+    images = []
+    for seed in range(seeds):
+        method = RsmMethod(gl, GIConfig(method="rsm", denoise=False, seed=seed), RsmConfig())
+        method.set_scene(scene)
+        images.append(method.run().images["indirect"][rows, cols, 0])
+    return np.array(images)
+
+
 def test_near_draws_keep_the_mean_and_cut_the_crease_noise(gl, monkeypatch):
     # The near draws (gather.comp.glsl, "Near draws") weigh every draw by the balance heuristic over
     # both kinds' densities: the expectation is the strata's alone, only the noise changes. Same wall
@@ -146,13 +156,9 @@ def test_near_draws_keep_the_mean_and_cut_the_crease_noise(gl, monkeypatch):
     def seeds(near: bool) -> np.ndarray:
         if not near:
             monkeypatch.setattr(rsm_gather, "near_strata", lambda vpl_samples: 0)
-        images = []
-        for seed in range(16):
-            method = RsmMethod(gl, GIConfig(method="rsm", denoise=False, seed=seed), RsmConfig())
-            method.set_scene(scene)
-            images.append(method.run().images["indirect"][31:39, 8:40, 0])
+        images = raw_indirect_over_seeds(gl, scene, slice(31, 39), slice(8, 40))
         monkeypatch.undo()
-        return np.array(images)
+        return images
 
     with_near, strata = seeds(True), seeds(False)
     mean_ratio = with_near.mean() / strata.mean()
@@ -196,13 +202,9 @@ def test_view_importance_keeps_the_mean_and_cuts_the_noise(gl, monkeypatch):
 
     def seeds(view_importance: bool) -> np.ndarray:
         monkeypatch.setattr(rsm_gather, "block_pdf", recorded if view_importance else unguided)
-        images = []
-        for seed in range(16):
-            method = RsmMethod(gl, GIConfig(method="rsm", denoise=False, seed=seed), RsmConfig())
-            method.set_scene(scene)
-            images.append(method.run().images["indirect"][8:39, 8:40, 0])
+        images = raw_indirect_over_seeds(gl, scene, slice(8, 39), slice(8, 40))
         monkeypatch.undo()
-        return np.array(images)
+        return images
 
     with_importance, uniform = seeds(True), seeds(False)
     assert guided and all(guided)  # the view's light comes from a small part of the map: drawn by it
