@@ -147,6 +147,9 @@ void main() {
                 lo = block_lo(i, rsm_size);
                 texels = block_lo(i + 1, rsm_size) - lo;
             }
+            if (any(equal(texels, ivec2(0)))) {
+                continue;  // a map of fewer texels than blocks a side: this block holds none
+            }
             vec2 w = fract(vec2(random01(pixel_id, stratum, uint(seed) * 2u),
                                 random01(pixel_id, stratum, uint(seed) * 2u + 1u)) + sample_step);
             ivec2 t = lo + min(ivec2(w * vec2(texels)), texels - 1);
