@@ -189,15 +189,12 @@ def test_view_importance_keeps_the_mean_and_cuts_the_noise(gl, monkeypatch):
 
     guided = []
 
-    def unguided(backend, gbuf, rsm, importance, vpl_samples):
-        pdf = importance["block_pdf"]
-        backend.write(pdf, np.zeros((pdf.size[1], pdf.size[0], 4), np.float32))  # y = 0: one draw per block
-        return pdf
+    def unguided(backend, gbuf, rsm, importance, vpl_samples, out):
+        backend.write(out, np.zeros((out.size[1], out.size[0], 4), np.float32))  # y = 0: one draw per block
 
-    def recorded(backend, gbuf, rsm, importance, vpl_samples):
-        pdf = real_block_pdf(backend, gbuf, rsm, importance, vpl_samples)
-        guided.append(bool(backend.read(pdf)[0, 0, 1] > 0.5))
-        return pdf
+    def recorded(backend, gbuf, rsm, importance, vpl_samples, out):
+        real_block_pdf(backend, gbuf, rsm, importance, vpl_samples, out)
+        guided.append(bool(backend.read(out)[0, 0, 1] > 0.5))
 
     real_block_pdf = rsm_gather.block_pdf
 
@@ -233,14 +230,12 @@ def test_any_block_pdf_keeps_the_mean(gl, monkeypatch, rsm_texels, vpls):
     rng = np.random.default_rng(7)
 
     def written(guided: bool):
-        def block_pdf(backend, gbuf, rsm, importance, vpl_samples):
-            pdf = importance["block_pdf"]
+        def block_pdf(backend, gbuf, rsm, importance, vpl_samples, out):
             k = rsm_gather.strata_per_side(vpl_samples)
-            values = np.zeros((pdf.size[1], pdf.size[0], 4), np.float32)
+            values = np.zeros((out.size[1], out.size[0], 4), np.float32)
             values[:k, :k, 0] = 0.5 / k**2 + 0.5 * rng.dirichlet(np.ones(k * k)).reshape(k, k) if guided else 1 / k**2
             values[..., 1] = float(guided)
-            backend.write(pdf, values)
-            return pdf
+            backend.write(out, values)
         return block_pdf
 
     def seeds(guided: bool) -> np.ndarray:
@@ -258,6 +253,33 @@ def test_any_block_pdf_keeps_the_mean(gl, monkeypatch, rsm_texels, vpls):
     # draw weighted by another block's probability. (An empty block's draw would fetch texel -1, which
     # llvmpipe reads as 0 and other drivers need not: the gather skips it, which no image here shows.)
     assert mean_ratio == pytest.approx(1.0, abs=0.01)
+
+
+def test_refinement_keeps_each_faces_block_pdf(gl, monkeypatch):
+    # A refinement gather keeps the G-buffer and the RSMs, so each face's block_pdf from the update's
+    # gather still holds: it is not computed again (RsmMethod.block_pdfs). A point light's six faces.
+    from addon.engine.passes import rsm_gather
+
+    calls = []
+    real_block_pdf = rsm_gather.block_pdf
+
+    def counted(*args):
+        calls.append(args[-1])
+        real_block_pdf(*args)
+
+    monkeypatch.setattr(rsm_gather, "block_pdf", counted)
+    light = Light("POINT", [0.5, 0, 1.5], [0, 0, -1], [1, 1, 1], power_w=200.0)
+    cam = Camera(look_along([4, 0, 1], [-1, 0, 0], [0, 0, 1]), perspective(np.radians(40), 0.1, 100), 24, 24)
+    scene = scene_of([rect([0, -1, 0], [2, 0, 0], [0, 2, 0]), rect([0, -1, 0], [0, 2, 0], [0, 0, 2])],
+                     [[0.5] * 3, [0.8] * 3], light, cam)
+    method = RsmMethod(gl, GIConfig(method="rsm", denoise=False), RsmConfig(resolution=64))
+    method.set_scene(scene)
+    method.compute()
+    first = method.read()["indirect"]
+    assert len(calls) == 6 and len({id(t) for t in calls}) == 6  # one block_pdf per face
+    method.refine()
+    assert len(calls) == 6  # none recomputed
+    assert method.samples == 2 and not np.array_equal(method.read()["indirect"], first)  # yet a new gather ran
 
 
 def test_rsm_method_refuses_several_bounces(gl):

@@ -24,8 +24,11 @@ class RsmMethod(OneBounceMethod):
     PASSES = declare.extend(OneBounceMethod.PASSES, setup=(voxelize.DECL,),
                             gather=(rsm_gather.DECL, accumulate.DECL, denoise.DECL))
     NOISY = ("indirect",)
-    # rsm_gather's scratch for its blocks' view importance, made on the first gather.
+    # rsm_gather.block_pdf's scratch, made on the first gather, and each face's block_pdf by (light,
+    # face): computed on an update's gather and kept through the refinement gathers that follow, which
+    # keep the G-buffer and the RSMs it is made from.
     block_importance: dict | None = None
+    block_pdfs: dict | None = None
 
     def set_scene(self, scene) -> None:
         super().set_scene(scene)
@@ -57,9 +60,16 @@ class RsmMethod(OneBounceMethod):
             vpls = self.rsm_config.vpl_samples if share is None else max(1, round(self.rsm_config.vpl_samples * share))
             if self.block_importance is None:
                 self.block_importance = rsm_gather.importance_textures(self.backend, self.rsm_config.vpl_samples)
+                self.block_pdfs = {}
+            face = (view.light_index, view.face_index)
+            if face not in self.block_pdfs:
+                self.block_pdfs[face] = rsm_gather.pdf_texture(self.backend, self.rsm_config.vpl_samples)
+            if self.sample_index == 0:
+                rsm_gather.block_pdf(self.backend, self.gbuf, self.rsm, self.block_importance, vpls,
+                                     self.block_pdfs[face])
             rsm_gather.run(self.backend, self.gbuf, self.rsm, self.indirect, vpls,
                            self.gi.seed + view.light_index * 6 + max(view.face_index, 0), view.view_projection,
-                           self.block_importance,
+                           self.block_pdfs[face],
                            occupancy=self.voxels["vox_albedo"] if self.voxels else None,
                            grid=self.voxels and self.grid, offset_cells=self.rsm_config.voxel_offset_cells,
                            sample=self.sample_index)

@@ -105,20 +105,25 @@ def _samplers(gbuf: dict, rsm: dict) -> dict:
 
 
 def importance_textures(backend: Backend, vpl_samples: int) -> dict:
-    """Scratch textures of the blocks' view importance for faces of up to `vpl_samples` VPLs (k^2 blocks):
-    `block_share` (blocks x receivers) and `block_mean` (k x k), R32F, and `block_pdf` (k x k, RGBA32F);
-    a face of fewer VPLs uses their corner."""
+    """Scratch of block_pdf for faces of up to `vpl_samples` VPLs (k^2 blocks): `block_share` (blocks x
+    receivers) and `block_mean` (k x k), R32F; a face of fewer VPLs uses their corner."""
     k = strata_per_side(vpl_samples)
     return {"block_share": backend.texture((k * k, RECEIVERS_PER_SIDE**2), "R32F"),
-            "block_mean": backend.texture((k, k), "R32F"), "block_pdf": backend.texture((k, k))}
+            "block_mean": backend.texture((k, k), "R32F")}
 
 
-def block_pdf(backend: Backend, gbuf: dict, rsm: dict, importance: dict, vpl_samples: int):
+def pdf_texture(backend: Backend, vpl_samples: int):
+    """A face's block_pdf (k x k, RGBA32F) for faces of up to `vpl_samples` VPLs."""
+    k = strata_per_side(vpl_samples)
+    return backend.texture((k, k))
+
+
+def block_pdf(backend: Backend, gbuf: dict, rsm: dict, importance: dict, vpl_samples: int, out) -> None:
     """The probability of each of the face's k x k blocks to be drawn by a strata draw, written into
-    importance["block_pdf"].x (rsm/importance*.comp.glsl): the mean over the receivers of the share of
+    `out`.x (a pdf_texture; rsm/importance*.comp.glsl): the mean over the receivers of the share of
     their light that the block holds, half of it uniform, where that is predicted to cut the variance
-    4x or more (block_pdf.y = 1), else uniform (0: the gather draws one texel per block). Returns that
-    texture."""
+    4x or more (out.y = 1), else uniform (0: the gather draws one texel per block). `importance` is
+    importance_textures' scratch."""
     k = strata_per_side(vpl_samples)
     uniforms = {"strata_per_side": k, "receivers_per_side": RECEIVERS_PER_SIDE}
     backend.dispatch(backend.program(SPEC_IMPORTANCE),
@@ -130,16 +135,14 @@ def block_pdf(backend: Backend, gbuf: dict, rsm: dict, importance: dict, vpl_sam
                      samplers={"block_share": importance["block_share"]},
                      images={"block_mean": importance["block_mean"]})
     backend.dispatch(backend.program(SPEC_IMPORTANCE_PDF), blocks, uniforms={"strata_per_side": k},
-                     samplers={"block_mean": importance["block_mean"]}, images={"block_pdf": importance["block_pdf"]})
-    return importance["block_pdf"]
+                     samplers={"block_mean": importance["block_mean"]}, images={"block_pdf": out})
 
 
 def run(backend: Backend, gbuf: dict, rsm: dict, indirect, vpl_samples: int, seed: int, view_projection,
-        importance: dict, occupancy=None, grid: Grid | None = None, offset_cells: float = 1.5,
-        sample: int = 0) -> None:
+        pdf, occupancy=None, grid: Grid | None = None, offset_cells: float = 1.5, sample: int = 0) -> None:
     """Gather one RSM face (drawn through `view_projection`, the face's local-space 4 x 4) into
-    `indirect`; `importance` is importance_textures' scratch, refilled here from this face and G-buffer;
-    pass the voxelizer's `vox_albedo` and grid for visibility. `seed` is the update's; `sample` the
+    `indirect`, drawing its blocks by `pdf` (block_pdf's, for this face and G-buffer); pass the
+    voxelizer's `vox_albedo` and grid for visibility. `seed` is the update's; `sample` the
     gather's index among those averaged since (DirectMethod.sample_index): the draws step along a
     low-discrepancy sequence with it."""
     spec = SPEC if occupancy is None else SPEC_VOXEL_VISIBILITY
@@ -147,7 +150,7 @@ def run(backend: Backend, gbuf: dict, rsm: dict, indirect, vpl_samples: int, see
     near = near_strata(vpl_samples)
     uniforms = {"strata_per_side": k, "seed": seed, "sample_index": sample,
                 "rsm_view_projection": view_projection, "near_strata": near}
-    samplers = {**_samplers(gbuf, rsm), "block_pdf": block_pdf(backend, gbuf, rsm, importance, vpl_samples)}
+    samplers = {**_samplers(gbuf, rsm), "block_pdf": pdf}
     if occupancy is not None:
         uniforms.update(grid_origin=grid.origin_m, cell_size=grid.cell_size_m, grid_dims=grid.dims,
                         offset_cells=offset_cells)
