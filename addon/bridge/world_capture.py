@@ -5,11 +5,13 @@ The common case, an HDRI (an Environment Texture of a float image in a linear co
 vector unlinked, straight into the Background's Color), is read directly: every image pixel is binned
 into the map by its direction, weighted by its solid angle, so a small bright sun keeps its energy
 (tens of milliseconds). Any other node tree (a Sky Texture, mixes, mappings) Bounce does not evaluate
-itself: Cycles renders the world alone, from a panoramic equirectangular camera at the origin, MAP_ROWS
-x MAP_COLS pixels, one sample per pixel (camera rays see only the background: no noise but the filter,
-which is narrowed). That costs about 1.5 s on this project's 2-core CPU machine (most of it Cycles'
-scene sync), so the map is cached by a fingerprint of the world's node tree and made again only when
-that changes. A constant background (no link into its Color) needs no map: capture.world_color gives it.
+itself: Cycles renders the world alone, from a panoramic equirectangular camera at the origin,
+MAP_SUPERSAMPLE^2 pixels per texel of the MAP_ROWS x MAP_COLS map, one sample per pixel (camera rays
+see only the background: no noise but the filter, which is narrowed), and each texel is the mean of
+its pixels by solid angle (a texel's centre alone misses the horizon's steep band). That costs about
+1.5 s on this project's 2-core CPU machine (most of it Cycles' scene sync), so the map is cached by a
+fingerprint of the world's node tree and made again only when that changes. A constant background
+(no link into its Color) needs no map: capture.world_color gives it.
 
 The interactive viewport never renders from its timer (a second's stall per edit of the sky): it asks
 `capture(world, render=False)`, which reads an HDRI (each image's binning cached apart from the
@@ -18,15 +20,16 @@ already made for this exact node tree: kept in the world by the Capture World Li
 saved with the .blend, keyed by the node tree and Blender's version), or rendered by a bake or a
 render in the same session.
 
-A Sky Texture's sun disc (on by default; half a degree wide) falls between the map's point-sampled
-texels, 5.6 degrees apart, and would be lost with most of a clear day's light: each disc Bounce can
-place (its Vector input unlinked) becomes a SUN light along the node's sun direction, its irradiance
-measured by a second render, a pinhole view three disc diameters wide around it (the pixels' excess
-over the sky at the view's border times their solid angles), and the map is rendered from a copy of
-the world with those discs off, so nothing is counted twice (`Captured.suns`). A disc turned by a
-linked Vector is left out with a warning. An HDRI's sun is taken out of its pixels the same way
-(`_take_sun`) before they are binned: a sun texel of the map would light through the sky pass's coarse
-shadow tiles from a direction up to 2.8 degrees off.
+A Sky Texture's sun disc (on by default; half a degree wide) is about as wide as the render's
+samples are apart (0.7 degrees): a sample hits it or misses it by chance, and most of a clear day's
+light with it. So each disc Bounce can place (its Vector input unlinked) becomes a SUN light along the
+node's sun direction, its irradiance measured by a second render, a pinhole view three disc diameters
+wide around it (the pixels' excess over the sky at the view's border times their solid angles), and
+the map is rendered from a copy of the world with those discs off, so nothing is counted twice
+(`Captured.suns`). A disc turned by a linked Vector is not placed, with a warning (samples that hit it
+by chance keep its light). An HDRI's sun is taken out of its pixels the same way (`_take_sun`) before
+they are binned: a sun texel of the map would light through the sky pass's coarse shadow tiles from a
+direction up to 2.8 degrees off.
 
 Cycles' equirectangular camera, rotated to look along +x with +z up, puts longitude increasing to the
 left: its columns are read reversed to match world.py's layout (tests/blender/test_world_capture.py
@@ -46,10 +49,16 @@ import numpy as np
 from mathutils import Vector
 
 from ..engine.scene import Light
-from ..engine.world import LUMA
+from ..engine.world import LUMA, downsample
 from . import compat
 
 MAP_ROWS, MAP_COLS = 32, 64
+# Pixels rendered per map texel and side. A sky's radiance changes fastest at the horizon: the ground's
+# first row (-5.6..0 degrees) of Blender's default Sky Texture averages 2.4 times its centre's radiance,
+# and the sky's light through a window onto the opposite wall is mostly that band (window-sky). 8 x 8
+# samples hold each texel's mean to ~1 % there; the render costs ~40 ms more than one sample (most of
+# its ~1.4 s is Cycles' scene sync).
+MAP_SUPERSAMPLE = 8
 _cache: dict[str, Captured] = {}
 _binned_images: dict[tuple, tuple] = {}  # an HDRI's (map, suns) at strength 1, by (name, filepath, size)
 
@@ -194,7 +203,7 @@ def forget() -> None:
 class Captured(NamedTuple):
     """A world as Bounce lights with it: its radiance map (MAP_ROWS, MAP_COLS, 3) float32 W/m^2/sr, and
     its suns as SUN lights (Light), their light left out of the map: its Sky Textures' discs (half a
-    degree, between the map's point-sampled texels 5.6 degrees apart) or an HDRI's sun (`_take_sun`)."""
+    degree, about the width of the render's pixels) or an HDRI's sun (`_take_sun`)."""
 
     map: np.ndarray
     suns: tuple = ()
@@ -233,7 +242,8 @@ STORED_MAP, STORED_SUNS, STORED_KEY = "bounce_world_map", "bounce_world_suns", "
 
 
 def _stored_key(world) -> str:
-    text = f"{bpy.app.version_string}|{fingerprint(world, with_file=False)}"
+    # MAP_SUPERSAMPLE too: a map kept by a build that sampled the world otherwise is made again.
+    text = f"{bpy.app.version_string}|{MAP_SUPERSAMPLE}|{fingerprint(world, with_file=False)}"
     return hashlib.sha256(text.encode()).hexdigest()
 
 
@@ -349,15 +359,18 @@ def _measure_sun(world, node) -> Light | None:
 
 
 def _render_map(world) -> np.ndarray:
-    """The world rendered from a panoramic equirectangular camera at the origin, MAP_ROWS x MAP_COLS."""
+    """The world rendered from a panoramic equirectangular camera at the origin, MAP_SUPERSAMPLE^2
+    pixels per texel of the MAP_ROWS x MAP_COLS map, averaged into it by solid angle."""
 
     def equirectangular(cam_data, cam):
         cam_data.type = "PANO"
         cam_data.panorama_type = "EQUIRECTANGULAR"
         cam.rotation_euler = (math.pi / 2, 0.0, -math.pi / 2)  # looking along +x, +z up
 
-    rgb = _render_view(world, MAP_COLS, MAP_ROWS, equirectangular)
-    return np.ascontiguousarray(np.maximum(rgb[:, ::-1], 0.0), np.float32)  # columns mirrored (module doc)
+    k = MAP_SUPERSAMPLE
+    rgb = _render_view(world, MAP_COLS * k, MAP_ROWS * k, equirectangular)
+    fine = np.maximum(rgb[:, ::-1], 0.0)  # columns mirrored (module doc)
+    return np.ascontiguousarray(downsample(fine, k), np.float32)
 
 
 def _render_view(world, width: int, height: int, setup) -> np.ndarray:

@@ -35,6 +35,18 @@ def directions(height: int, width: int) -> tuple[np.ndarray, np.ndarray]:
     return d, np.repeat(band[:, None], width, axis=1)
 
 
+def downsample(fine: np.ndarray, factor: int) -> np.ndarray:
+    """A map of `factor` x `factor` times fewer texels (h / factor, w / factor, c): each texel the mean
+    of the fine texels it holds, weighted by their solid angles, so every texel keeps its int L dw."""
+    h, w, c = fine.shape
+    if h % factor or w % factor:
+        raise ValueError(f"a {w} x {h} map does not split into {factor} x {factor} blocks")
+    _, omega = directions(h, w)
+    blocks = (h // factor, factor, w // factor, factor)
+    weighted = (np.asarray(fine, np.float64) * omega[..., None]).reshape(*blocks, c).sum(axis=(1, 3))
+    return weighted / omega.reshape(blocks).sum(axis=(1, 3))[..., None]
+
+
 def texel_vectors(height: int, width: int) -> np.ndarray:
     """Per texel int w dw over its latitude-longitude rectangle (h, w, 3), in closed form: a uniform
     map's vector irradiance sums exactly (a floor under a uniform sky gets pi L, not a quadrature of it)."""

@@ -83,6 +83,35 @@ def test_sky_direction_count_follows_the_worlds_share():
     assert sky_direction_count([], [sun], 256, 16, 5.0) == 0  # no world, no directions
 
 
+def test_downsample_keeps_each_texels_light():
+    # A texel of the coarse map is its fine texels' mean by solid angle, so int L dw over it is the
+    # fine texels' sum (to fp64 rounding), and a uniform map stays uniform.
+    from addon.engine.world import downsample
+
+    rng = np.random.default_rng(3)
+    fine = rng.random((32, 64, 3))
+    coarse = downsample(fine, 4)
+    assert coarse.shape == (8, 16, 3)
+    _, fine_omega = directions(32, 64)
+    _, coarse_omega = directions(8, 16)
+    per_texel = (fine * fine_omega[..., None]).reshape(8, 4, 16, 4, 3).sum(axis=(1, 3))
+    np.testing.assert_allclose(coarse * coarse_omega[..., None], per_texel, rtol=1e-12)
+    np.testing.assert_allclose(downsample(constant_map([0.5, 1.0, 2.0], 32, 64), 8),
+                               constant_map([0.5, 1.0, 2.0], 4, 8), rtol=1e-12)
+    with pytest.raises(ValueError):
+        downsample(fine, 5)
+
+
+def test_sky_directions_least_is_a_quarter_of_the_most_within_a_draw_budget():
+    from addon.engine.methods.direct import SKY_LEAST_TRIANGLE_DRAWS, sky_directions_least
+
+    assert sky_directions_least(100, 256) == 64  # the camera's default: a quarter of 256
+    assert sky_directions_least(100, 64) == 16  # the probes' atlas: a quarter of 64
+    assert sky_directions_least(SKY_LEAST_TRIANGLE_DRAWS // 32, 256) == 32  # 64 draws would pass the budget
+    assert sky_directions_least(67_405, 256) == 16  # Sponza: never below 16
+    assert sky_directions_least(100, 8) == 8  # never more than the most
+
+
 def test_power_shares_split_by_luminance_and_never_divide_by_zero():
     from addon.engine.scene import Light
     from addon.engine.world import power_shares
