@@ -90,8 +90,9 @@ class RsmConfig(_Validated):
     # The world's direct light: at most this many regions of the sky (the same importance-stratified
     # split, finer), each shadowed by a sky_texels^2 tile of one atlas and all evaluated in one pass over
     # the G-buffer (passes/sky_light.py). The count is this times the world's share of the scene's
-    # direct light, at least 16 (world.sky_direction_count): a sky lighting a room through its window
-    # gets most of them, a dim world beside a sun few (docs/DIRECT.md).
+    # direct light (world.sky_direction_count), at least a quarter of it within a budget of shadow draws
+    # (direct.sky_directions_least): a sky lighting a room through its window gets most of them, a dim
+    # world beside a sun few (docs/DIRECT.md).
     sky_directions: int = _num(256, 1, 1024, "most regions of the sky its direct light is split into, one pass "
                                "for all (fewer when the world gives less of the light)")
     sky_texels: int = _num(64, 16, 1024, "shadow map side in texels of each sky direction")

@@ -180,7 +180,7 @@ class DirectMethod:
         self._emitter_rows = None  # the emitter table on the GPU (light_views)
         self._world_key, self._world_suns = None, []
         self._world_map = None
-        self._skies: dict[int, sky_light.SkyShadows] = {}  # sky(): per most directions asked for
+        self._skies: dict[tuple, sky_light.SkyShadows] = {}  # sky(): per (most, least) directions asked for
         self.vpl_shares: dict[int, float] = {}
         self._solved_for = None  # lights_key of the light field on the GPU; None: none is
         self.solves = 0          # how many updates solved (bakes report it)
@@ -246,23 +246,24 @@ class DirectMethod:
             self._world_suns = world.world_suns(world_map, count) if count and world_map is not None else []
         return self._world_suns
 
-    def sky(self, most: int | None = None) -> sky_light.SkyShadows | None:
+    def sky(self, most: int | None = None, least: int | None = None) -> sky_light.SkyShadows | None:
         """The sky's directions (world.py's regions split by power x width) on the GPU, as many as the
-        world's share of the scene's light asks (world.sky_direction_count) and at most `most`
-        (RsmConfig.sky_directions by default); None without a world. Remade when the world or that
-        count changes (the bounds change only with set_scene, which resets them)."""
+        world's share of the scene's light asks (world.sky_direction_count), at most `most`
+        (RsmConfig.sky_directions by default) and at least `least` (sky_directions_least by default);
+        None without a world. Remade when the world or that count changes (the bounds change only with
+        set_scene, which resets them)."""
         suns = self.world_suns()
         if not suns:
             return None
         most = self.rsm_config.sky_directions if most is None else most
+        least = sky_directions_least(self.scene.triangle_count, most) if least is None else min(least, most)
         lo, hi = self.bounds_m
-        count = world.sky_direction_count(suns, [*self.source.lights, *self.emissive], most,
-                                          sky_directions_least(self.scene.triangle_count, most),
+        count = world.sky_direction_count(suns, [*self.source.lights, *self.emissive], most, least,
                                           0.5 * float(np.linalg.norm(hi - lo)))
         key = (self._world_key, count)
-        shadows = next((s for s in self._skies.values() if s.key == key), None)  # another `most`'s: drawn once
+        shadows = next((s for s in self._skies.values() if s.key == key), None)  # another call's: drawn once
         if shadows is None:
-            shadows = self._skies.setdefault(most, sky_light.SkyShadows())
+            shadows = self._skies.setdefault((most, least), sky_light.SkyShadows())
             shadows.update(self.backend, key, world.world_suns(self._world_map, count, by_width=True), self.bounds_m,
                            self.rsm_config.sky_texels)
         return shadows if shadows.layout is not None else None
