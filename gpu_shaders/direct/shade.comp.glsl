@@ -50,6 +50,95 @@ vec2 vogel(int i) {
 }
 #endif
 
+// Whether receiver p lies in front of the plane of the surface a shadow-map texel stores (its position
+// and its normal, which the RSM turns towards the light), so that surface cannot block p's light: a real
+// blocker crosses the segment from the light to p, so p lies behind its plane, while a wall p stands in
+// front of (a floor's last pixels looking up the wall beside them) does not, and a zero-thickness wall
+// between p and the light still does (p lies behind the side the light sees). The margin, 1 % of a
+// texel, absorbs fp32 rounding at a crease. docs/DIRECT.md, "The shadow test".
+bool in_front_of(vec3 p, vec4 occ_position, vec3 occ_normal, float texel_m) {
+    return dot(p - occ_position.xyz, occ_normal) >= -0.01 * texel_m;
+}
+
+#ifndef POLYGONS
+// The exact hard shadow. A shadow map's texel holds the surface its centre sees, so a test against the
+// texel puts an edge anywhere within it: a window's sunlit patch came out a camera pixel off along its
+// edges at 1024 texels, and a 4096-texel map still flipped single pixels. Here the map only says which
+// triangles to try: each texel names the triangle it sees (rsm.frag.glsl), and the receiver is lit
+// unless the segment from it to the light crosses one of those the 3 x 3 texels around its own name.
+// The segment projects into the map at that texel (a sun's map is orthographic along its rays; a
+// lamp's is a perspective from its centre), and whatever crosses it first from the light covers that
+// point, so the nearest texels see it unless it is thinner than a texel and hidden there behind a
+// surface nearer the light (docs/DIRECT.md, "The shadow test").
+// How far the segment starts off the receiver's surface, in shadow-map texels: far above fp32's rounding
+// of a position (1e-7 of the scene's size, against 2e-5 for a sun's 1024-texel map), far below a pixel.
+const float EXACT_LIFT_TEXELS = 0.02;
+// Crossings nearer the start than this many texels do not shadow. Where two surfaces meet (a floor and
+// a wall) the G-buffer's depth test may keep a floor point a hair beyond the wall's plane, and its
+// segment would cross the wall at once: cornell's floor-wall seam read 0 over 14 pixels with no margin.
+const float EXACT_NEAR_TEXELS = 0.05;
+
+ivec2 shadow_texel(vec3 q, ivec2 size) {
+    vec4 clip = light_view_projection * vec4(q, 1.0);
+    return clamp(ivec2((clip.xy / clip.w * 0.5 + 0.5) * vec2(size)), ivec2(0), size - 1);
+}
+
+vec3 occluder_corner(int t, int k) {
+    return texelFetch(occluders, ivec2(3 * (t % OCCLUDER_ROW) + k, t / OCCLUDER_ROW), 0).xyz;
+}
+
+// Whether q + s w crosses triangle t (either side) for s_min < s < s_max (Moller and Trumbore's test).
+bool segment_crosses(int t, vec3 q, vec3 w, float s_min, float s_max) {
+    vec3 a = occluder_corner(t, 0);
+    vec3 e1 = occluder_corner(t, 1) - a;
+    vec3 e2 = occluder_corner(t, 2) - a;
+    vec3 h = cross(w, e2);
+    float det = dot(e1, h);
+    if (abs(det) <= 1e-7 * length(e1) * length(e2)) {
+        return false;  // the segment runs along the triangle's plane (or it has no area): no crossing
+    }
+    vec3 from_a = q - a;
+    float u = dot(from_a, h) / det;
+    vec3 g = cross(from_a, e1);
+    float v = dot(w, g) / det;
+    float s_hit = dot(e2, g) / det;
+    return u >= 0.0 && v >= 0.0 && u + v <= 1.0 && s_hit > s_min && s_hit < s_max;
+}
+
+// How far x lies from the light along its rays: a sun's depth along them, a lamp's distance.
+float light_depth(vec3 x) {
+    return light_kind == LIGHT_SUN ? dot(x, emit_axis) : length(x - light_pos_ws);
+}
+
+// 0 where a triangle the map names in the 3 x 3 texels around `centre` crosses the segment from q along
+// w (s_min < s < s_max); else 0 where all 9 texels hold a surface that blocks q (nearer the light, q
+// behind its plane: in_front_of), else 1. The second rule is for a gap narrower than a texel in a
+// blocker nearer the light: no texel sees through it, so the map names nothing behind it, though what
+// is behind may cover q (Sponza's balustrades under its arches, seen from the sphere lamp's 256-texel
+// map, lit a gallery floor). At a real edge some texel around q sees past the blocker.
+float exact_visibility(ivec2 centre, vec3 q, vec3 w, float s_min, float s_max, ivec2 size, float texel_m) {
+    float q_depth = light_depth(q);
+    bool all_block = true;
+    int last = -1;  // neighbouring texels mostly see one triangle: each run of it is tried once
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            ivec2 texel = clamp(centre + ivec2(dx, dy), ivec2(0), size - 1);
+            int t = int(texelFetch(rsm_flux, texel, 0).w) - 1;
+            if (t >= 0 && t != last && segment_crosses(t, q, w, s_min, s_max)) {
+                return 0.0;
+            }
+            last = t;
+            if (all_block) {
+                vec4 occ = texelFetch(rsm_position, texel, 0);
+                all_block = occ.w > 0.0 && light_depth(occ.xyz) < q_depth
+                    && !in_front_of(q, occ, texelFetch(rsm_normal, texel, 0).xyz, texel_m);
+            }
+        }
+    }
+    return all_block ? 0.0 : 1.0;
+}
+#endif
+
 #ifdef SOFT_SUN
 // A sun of angular diameter 2 atan(sun_tan_half) casts a penumbra (receiver depth - blocker depth) x
 // sun_tan_half wide on each side. A world region (world.py) is such a sun, as wide as its share of the sky.
@@ -77,11 +166,11 @@ vec2 receiver_slope(vec3 n, ivec2 size) {
     return vec2(b.y * da - a.y * db, a.x * db - b.x * da) / det;
 }
 
-// A texel with no geometry lies outside everything the sun sees. Taken as lit, it lets a disc that
-// reaches past a closed room's outer walls light the room's inside; it counts as the centre does.
-float soft_sun_visibility(vec2 uv, ivec2 size, float receiver, float bias_m, float texel_m, vec3 n) {
+// The sun's visible share of its disc from receiver p (depth `receiver` at map position uv; q: p lifted
+// for the exact test). Blockers are searched for in a disc as wide as the widest penumbra; with none,
+// p sees the whole sun.
+float soft_sun_visibility(vec2 uv, ivec2 size, float receiver, float bias_m, float texel_m, vec3 n, vec3 q) {
     vec2 slope = receiver_slope(n, size);
-    float centre_lit = sun_depth(uv, size) >= receiver - bias_m ? 1.0 : 0.0;
     float search = min(MAX_SOFT_TEXELS, sun_tan_half * float(size.x));
     float blockers = 0.0;
     float depth_sum = 0.0;
@@ -96,26 +185,36 @@ float soft_sun_visibility(vec2 uv, ivec2 size, float receiver, float bias_m, flo
     if (blockers == 0.0) {
         return 1.0;
     }
-    float radius = clamp((receiver - depth_sum / blockers) * sun_tan_half / texel_m, 0.5, MAX_SOFT_TEXELS);
+    // Each tap is a ray to a point of the sun's disc (uniform over it: the Vogel spiral), tested exactly:
+    // around where it passes the blockers' mean depth (the texel the classic filter reads), then against
+    // the triangles the map names along its path across the map, from the receiver's texel outwards half
+    // a texel at a time, as far as the blocker search reached.
+    float ahead_m = max(receiver - depth_sum / blockers, 0.0);
+    vec3 axis_x = normalize(vec3(light_view_projection[0][0], light_view_projection[1][0], light_view_projection[2][0]));
+    vec3 axis_y = normalize(vec3(light_view_projection[0][1], light_view_projection[1][1], light_view_projection[2][1]));
+    float s_min = EXACT_NEAR_TEXELS * texel_m;
     float lit = 0.0;
     for (int i = 0; i < SOFT_TAPS; ++i) {
-        vec2 offset = radius * vogel(i);
-        float d = sun_depth(uv + offset, size);
-        lit += d >= 1e29 ? centre_lit : (d >= receiver + dot(slope, offset) - bias_m ? 1.0 : 0.0);
+        vec2 v = vogel(i);
+        vec3 d = -emit_axis + sun_tan_half * (v.x * axis_x + v.y * axis_y);  // 1 along the sun per metre
+        vec3 w = normalize(d);
+        float tap_lit = exact_visibility(shadow_texel(q + ahead_m * d, size), q, w, s_min, 1e30, size, texel_m);
+        float step_m = 0.5 * texel_m / max(length(v) * sun_tan_half, 1e-9);  // half a texel sideways
+        int steps = int(ceil(2.0 * search * length(v)));
+        int last = -1;
+        for (int k = 0; k <= steps && tap_lit > 0.0; ++k) {
+            int t = int(texelFetch(rsm_flux, shadow_texel(q + float(k) * step_m * d, size), 0).w) - 1;
+            if (t >= 0 && t != last && segment_crosses(t, q, w, s_min, 1e30)) {
+                tap_lit = 0.0;
+            }
+            last = t;
+        }
+        lit += tap_lit;
     }
     return lit / float(SOFT_TAPS);
 }
 #endif
 
-// Whether receiver p lies in front of the plane of the surface a shadow-map texel stores (its position
-// and its normal, which the RSM turns towards the light), so that surface cannot block p's light: a real
-// blocker crosses the segment from the light to p, so p lies behind its plane, while a wall p stands in
-// front of (a floor's last pixels looking up the wall beside them) does not, and a zero-thickness wall
-// between p and the light still does (p lies behind the side the light sees). The margin, 1 % of a
-// texel, absorbs fp32 rounding at a crease. docs/DIRECT.md, "The shadow test".
-bool in_front_of(vec3 p, vec4 occ_position, vec3 occ_normal, float texel_m) {
-    return dot(p - occ_position.xyz, occ_normal) >= -0.01 * texel_m;
-}
 
 #ifdef POLYGONS
 // A light with a shape (an area light's patch, an emissive group) is shadowed from its position c over a
@@ -189,30 +288,6 @@ float patch_visibility(vec2 uv, ivec2 size, vec3 p, vec3 p_test, vec3 n, float b
 }
 #endif
 
-#if !defined(SOFT_SUN) && !defined(POLYGONS)
-ivec2 shadow_texel(vec3 q, ivec2 size) {
-    vec4 clip = light_view_projection * vec4(q, 1.0);
-    return clamp(ivec2((clip.xy / clip.w * 0.5 + 0.5) * vec2(size)), ivec2(0), size - 1);
-}
-
-// The hard shadow test of point q: nothing the map stores at q's texel is nearer the light than q.
-bool shadow_lit(vec3 q, ivec2 size, float bias_m) {
-    vec4 occ = texelFetch(rsm_position, shadow_texel(q, size), 0);
-    if (occ.w <= 0.0) {
-        return true;
-    }
-    float receiver = light_kind == LIGHT_SUN ? dot(q, emit_axis) : length(q - light_pos_ws);
-    float occluder = light_kind == LIGHT_SUN ? dot(occ.xyz, emit_axis) : length(occ.xyz - light_pos_ws);
-    return receiver <= occluder + bias_m;
-}
-
-// Whether p lies in front of the plane of the surface at q's texel (nothing there: yes).
-bool in_front_of_texel(vec3 p, vec3 q, ivec2 size, float texel_m) {
-    ivec2 texel = shadow_texel(q, size);
-    vec4 occ = texelFetch(rsm_position, texel, 0);
-    return occ.w <= 0.0 || in_front_of(p, occ, texelFetch(rsm_normal, texel, 0).xyz, texel_m);
-}
-#endif
 
 // This face's direct light (irradiance / pi) at surface point p of normal n: 0 where another face shades
 // it, where the light does not reach it, or in its shadow.
@@ -243,10 +318,16 @@ vec3 face_light(vec3 p, vec3 n) {
     }
 #endif
     // Shadow test against the RSM's stored positions. The receiver is lifted off its surface by 1.5 RSM
-    // texels (normal-offset bias here; along the light's ray in the hard test below) so it does not
-    // shadow itself; every bias is in texels, so the result does not depend on the scene's scale.
+    // texels (normal-offset bias; the exact hard test below lifts it far less) so it does not shadow
+    // itself; every bias is in texels, so the result does not depend on the scene's scale.
     vec3 p_test = p + n * (1.5 * texel_m);
     float bias_m = shadow_bias_texels * texel_m;
+#if !defined(SOFT_SUN) && !defined(POLYGONS)
+    // The exact test's segment starts a little off the receiver's surface instead (EXACT_LIFT_TEXELS:
+    // fp32's rounding of where the G-buffer put it, plus the user's shadow bias), so its own triangle
+    // lies behind it. Its whole length projects to one point of the map, in the face its start lies in.
+    p_test = p + n * ((EXACT_LIFT_TEXELS + shadow_bias_texels) * texel_m);
+#endif
     if (face_index >= 0 && cube_face(p_test - light_pos_ws) != face_index) {
         return vec3(0.0);  // another face of this point light shades this pixel: the one p_test projects into
     }
@@ -266,21 +347,14 @@ vec3 face_light(vec3 p, vec3 n) {
         ivec2 size = textureSize(rsm_position, 0);
 #if defined(SOFT_SUN)
         lit = soft_sun_visibility((ndc.xy * 0.5 + 0.5) * vec2(size), size, dot(p_test, emit_axis), bias_m, texel_m,
-                                  n);
+                                  n, p + n * ((EXACT_LIFT_TEXELS + shadow_bias_texels) * texel_m));
 #elif defined(POLYGONS)
         lit = patch_visibility((ndc.xy * 0.5 + 0.5) * vec2(size), size, p, p_test, n, bias_m, texel_m);
 #else
-        // Two lookups. Along the ray: the receiver moved towards the light by the same 1.5 texels of
-        // height over the cosine keeps its own texel (no sideways move, so real shadow edges stay put);
-        // it is lit if nothing there is nearer the light. That move can cross a surface within a few
-        // texels (a zero-thickness wall at its foot, a solid touching another), so where the ray's
-        // texel holds a surface the receiver lies behind, the normal offset's test must agree.
-        float facing = dot(n, to_light);
-        vec3 p_ray = facing > 0.0 ? p + to_light * (1.5 * texel_m / max(facing, 0.1)) : p_test;
-        lit = shadow_lit(p_ray, size, bias_m) ? 1.0 : 0.0;
-        if (lit > 0.0 && !in_front_of_texel(p, p_ray, size, texel_m)) {
-            lit = shadow_lit(p_test, size, bias_m) ? 1.0 : 0.0;
-        }
+        float reach = light_kind == LIGHT_SUN ? 1e30 : length(light_pos_ws - p_test);
+        vec3 w = light_kind == LIGHT_SUN ? to_light : (light_pos_ws - p_test) / reach;
+        lit = exact_visibility(shadow_texel(p_test, size), p_test, w, EXACT_NEAR_TEXELS * texel_m, reach, size,
+                               texel_m);
 #endif
     }
     return irradiance * (lit / PI);

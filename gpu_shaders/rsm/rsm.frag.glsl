@@ -3,6 +3,9 @@
 // the angle to the face axis, no 1/r^2) or albedo * E * texel area (sun: texel_scale = area in m^2).
 // Surfel area = the texel's footprint on the surface: solid angle * r^2 / cos, or area / cos for a sun,
 // times area_weight (1; a sky RSM tile's share of the sky's power, passes/sky_light.table).
+// The flux's w names the triangle the texel sees, its index in the drawn mesh + 1 (0: none): the direct
+// pass's exact shadow test (direct/shade.comp.glsl) intersects the shadow ray with it. A float holds every
+// index below 2^24 exactly.
 #include "common/light.glsl"
 
 void main() {
@@ -44,5 +47,5 @@ void main() {
     }
     out_position = vec4(v_pos_ws, 1.0);
     out_normal = vec4(n, area_m2 * area_weight);
-    out_flux = vec4(flux, 0.0);
+    out_flux = vec4(flux, float(gl_PrimitiveID + 1));
 }

@@ -108,17 +108,15 @@ def test_occluder_casts_a_shadow(gl, kind):
     assert img[row, col] > 0.1
 
 
-def sun_shadow_errors(gl, sun_shadow_texels, away_m=0.005, sun_x=0.23, sun_y=0.31):
-    """Floor pixels farther than away_m from the exact edge of a hard sun shadow whose visibility is not
-    exactly 0 or 1. The sun shines along (sun_x, sun_y, -1): the occluder 0.3..0.7 at z = 1 shadows the
-    floor where x lies in [0.3, 0.7] + sun_x and y in [0.3, 0.7] + sun_y."""
-    light = Light("SUN", [0, 0, H], [sun_x, sun_y, -1.0], [1, 1, 1], sun_strength=3.0)
-    method = DirectMethod(gl, GIConfig(), RsmConfig(resolution=16, sun_shadow_texels=sun_shadow_texels))
+def shadow_edge_errors(gl, light, shadow_square, rsm_texels, sun_shadow_texels, away_m):
+    """Floor pixels farther than away_m from the exact edge of `light`'s hard shadow whose visibility is
+    not exactly 0 or 1 (1e-4 of the lit value: fp32). The occluder 0.3..0.7 at z = 1 shadows the floor
+    in `shadow_square` (x0, x1, y0, y1); pixels whose camera ray meets the occluder are skipped."""
+    method = DirectMethod(gl, GIConfig(), RsmConfig(resolution=rsm_texels, sun_shadow_texels=sun_shadow_texels))
     scene = make_scene(light)
     method.set_scene(scene)
     img = method.run().images["direct"][..., 0]
-    lit_value = 3.0 * (1.0 / np.linalg.norm([sun_x, sun_y, 1.0])) / np.pi  # E cos / pi
-    x0, x1, y0, y1 = 0.3 + sun_x, 0.7 + sun_x, 0.3 + sun_y, 0.7 + sun_y
+    x0, x1, y0, y1 = shadow_square
     wrong = 0
     for row in range(SIZE):
         for col in range(SIZE):
@@ -126,6 +124,10 @@ def sun_shadow_errors(gl, sun_shadow_texels, away_m=0.005, sun_x=0.23, sun_y=0.3
             seen_at_occluder = 0.8 * p[:2]
             if max(abs(p[0]), abs(p[1])) > 0.98 or np.all((0.3 <= seen_at_occluder) & (seen_at_occluder <= 0.7)):
                 continue
+            if light.kind == "SUN":
+                lit_value = 3.0 * -light.direction[2] / np.pi  # E cos / pi (Light normalises its direction)
+            else:
+                lit_value = point_irradiance_over_pi(light.power_w / (4 * np.pi), p)
             inside = x0 <= p[0] <= x1 and y0 <= p[1] <= y1
             edge_m = min(p[0] - x0, x1 - p[0], p[1] - y0, y1 - p[1]) if inside else \
                 np.hypot(max(x0 - p[0], 0.0, p[0] - x1), max(y0 - p[1], 0.0, p[1] - y1))
@@ -134,12 +136,64 @@ def sun_shadow_errors(gl, sun_shadow_texels, away_m=0.005, sun_x=0.23, sun_y=0.3
     return wrong
 
 
-def test_a_sun_shadows_from_its_own_finer_map(gl):
-    # RsmConfig.sun_shadow_texels: a sun's direct light reads a shadow map of its own. With the RSM at 16
-    # texels (12.5 cm) and no map of its own, pixels more than 5 mm from the exact shadow edge come out
-    # wrong (measured: 10 of them); with a 512-texel map of its own (~5 mm texels) none does.
-    assert sun_shadow_errors(gl, 0) > 0
-    assert sun_shadow_errors(gl, 512) == 0
+def test_a_hard_sun_shadow_is_exact_from_a_coarse_map(gl):
+    # The sun shines along (0.23, 0.31, -1): the occluder 0.3..0.7 at z = 1 shadows the floor where x lies
+    # in [0.3, 0.7] + 0.23 and y in [0.3, 0.7] + 0.31. The exact test (the triangles the map names) puts
+    # the edge where the geometry does: with a 16-texel map (12.5 cm texels) and no map of its own, no
+    # pixel farther than 0.1 mm from it is wrong. Without it, 10 pixels farther than 5 mm were, and a
+    # 512-texel map of its own (5 mm texels) was needed for none to be.
+    sun = Light("SUN", [0, 0, H], [0.23, 0.31, -1.0], [1, 1, 1], sun_strength=3.0)
+    assert shadow_edge_errors(gl, sun, (0.53, 0.93, 0.61, 1.01), 16, 0, away_m=1e-4) == 0
+
+
+def test_a_soft_sun_shadow_is_exact_beyond_its_penumbra_from_a_coarse_map(gl):
+    # A sun 2 degrees wide along (0.23, 0.31, -1) (1.08 m of its rays between the occluder and the floor):
+    # its penumbra reaches tan(1 degree) x 1.08 m / cos 21 degrees = 2 cm either side of the hard
+    # edge. Beyond 3 cm the floor is exactly lit or exactly dark, with a 16-texel map (12.5 cm texels)
+    # and no map of its own; the classic filter of that map got 14 pixels wrong.
+    sun = Light("SUN", [0, 0, H], [0.23, 0.31, -1.0], [1, 1, 1], sun_strength=3.0, sun_angle_rad=np.radians(2.0))
+    assert shadow_edge_errors(gl, sun, (0.53, 0.93, 0.61, 1.01), 16, 0, away_m=0.03) == 0
+
+
+def test_a_blocker_seen_only_through_a_slit_narrower_than_a_texel_still_shadows(gl):
+    # A sun straight down; a roof at z = 1 over the whole floor but for a 2 mm slit x in [0, 0.002]; under
+    # the slit a plate at z = 0.5 (|x|, |y| <= 0.2). No texel of a 16-texel map sees through the slit (its
+    # centres lie at x = +-0.0625, ...), so the map names the roof only, which the floor's ray under the
+    # slit does not cross: the plate, which it does cross, is hidden. Exact answer under the slit and the
+    # plate: 0. The camera, under the roof at z = 0.4, puts a pixel centre on that floor point.
+    floor = quad(-1, 1, -1, 1, 0.0)
+    roof = quad(-1, 0.0, -1, 1, 1.0) + quad(0.002, 1, -1, 1, 1.0)
+    plate = quad(-0.2, 0.2, -0.2, 0.2, 0.5)
+    tris = np.array(floor + roof + plate, np.float32)
+    normals = np.zeros_like(tris)
+    normals[..., 2] = 1.0
+    target = np.array([0.001, 0.0, 0.0])
+    half_pixel_m = np.tan(np.radians(15)) * 0.4 / SIZE  # the camera's pixel centres beside its axis
+    cam = Camera(look_along([target[0] - half_pixel_m, -half_pixel_m, 0.4], [0, 0, -1], [0, 1, 0]),
+                 perspective(np.radians(30), 0.1, 100), SIZE, SIZE)
+    sun = Light("SUN", [0, 0, H], [0.0, 0.0, -1.0], [1, 1, 1], sun_strength=3.0)
+    scene = Scene(tris, normals, np.full((len(tris), 3), 0.8, np.float32), np.zeros((len(tris), 3), np.float32),
+                  [sun], camera=cam)
+    method = DirectMethod(gl, GIConfig(), RsmConfig(resolution=16, sun_shadow_texels=0))
+    method.set_scene(scene)
+    img = method.run().images["direct"][..., 0]
+    row, col = pixel_of(cam, target)
+    p = floor_point_at_pixel(cam, row, col)
+    assert 0.0 < p[0] < 0.002 and abs(p[1]) < 0.2  # the pixel's floor point lies under the slit and the plate
+    assert img[row, col] == 0.0
+    row, col = pixel_of(cam, np.array([-0.05, 0.05, 0.0]))  # under the roof: dark too
+    assert img[row, col] == 0.0
+
+
+@pytest.mark.parametrize("kind", ["POINT", "SPOT"])
+def test_a_lamps_hard_shadow_is_exact_from_a_coarse_map(gl, kind):
+    # A lamp at (0, 0, 2) shadows through the occluder at z = 1 the floor square [0.6, 1.4]^2, cut by the
+    # floor's edge at 1 (x2 from the lamp's foot: similar triangles). A 16-texel RSM's texels are 12.5 cm
+    # wide there; no pixel farther than 0.1 mm from the exact edge may be wrong (a test against the
+    # nearest texel's depth got 8 wrong for the point light, 16 for the spot).
+    light = Light(kind, [0, 0, H], [0, 0, -1], [1, 1, 1], power_w=300.0, spot_size_rad=np.radians(120),
+                  spot_blend=0.0)
+    assert shadow_edge_errors(gl, light, (0.6, 1.4, 0.6, 1.4), 16, 0, away_m=1e-4) == 0
 
 
 @pytest.mark.parametrize("shape, sx, sy", [("SQUARE", 1.0, 1.0), ("DISK", 1.2, 1.2), ("RECTANGLE", 1.6, 0.4)])

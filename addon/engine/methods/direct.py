@@ -171,6 +171,9 @@ class DirectMethod:
         for spec, select in selections.items():
             attrs = triangle_attributes(self.scene, spec, select)
             self._meshes[spec.name] = be.mesh(be.program(spec), attrs, "triangles") if attrs is not None else None
+        # The RSM's triangles by the index its texels name (rsm.frag.glsl): the direct pass's exact shadows.
+        table = rsm.occluder_table(self.scene.positions_m[not_emitting])
+        self.occluders = be.texture((table.shape[1], table.shape[0]), data=table)
         n = self.rsm_config.resolution
         self._rsm_slots: list[tuple[dict, object]] = []  # (textures, target) per kept face, made on use
         self._kept_faces = max(1, RSM_KEEP_BYTES // (RSM_BYTES_PER_TEXEL * n * n))
@@ -212,15 +215,15 @@ class DirectMethod:
 
     def shadow_map(self, view: LightView) -> tuple[dict, LightView]:
         """What the direct pass tests `view`'s shadows against, and the view as that map's texels see it:
-        the RSM's position and normal textures, or a sun's own finer map's with its texel area scaled to
-        match."""
+        the RSM's position, normal and flux textures, or a sun's own finer map's with its texel area scaled
+        to match, and the occluder table the flux names triangles in."""
         if not self._own_sun_shadow(view):
-            return {k: self.rsm[k] for k in ("position", "normal")}, view
+            return {**{k: self.rsm[k] for k in ("position", "normal", "flux")}, "occluders": self.occluders}, view
         scale = (self.rsm_config.resolution / self.rsm_config.sun_shadow_texels) ** 2
         fine = replace(view, texel_scale=view.texel_scale * scale,
                        uniforms={**view.uniforms, "texel_scale": view.texel_scale * scale})
         textures = self._sun_shadow_slot(self._slot)[0]
-        return {k: textures[k] for k in ("position", "normal")}, fine
+        return {**{k: textures[k] for k in ("position", "normal", "flux")}, "occluders": self.occluders}, fine
 
     def set_camera(self, camera: Camera) -> None:
         self.source = replace(self.source, camera=camera)

@@ -72,6 +72,8 @@ TRIANGLES = Port("scene", "triangles", "mesh", "scene", "world positions (m), no
 LIGHT_VIEWS = Port("scene", "light_views", "uniforms", "scene",
                    "per light face: view-projection, intensity (W/sr) or sun irradiance (W/m^2)")
 
+OCCLUDERS = Port("scene", "occluders", "RGBA32F", "table",
+                 "the corners (m) of the triangles the RSMs draw, OCCLUDER_ROW triangles of 3 texels per row")
 EMITTERS = Port("scene", "emitters", "RGBA32F", "table",
                 "per polygon of an emitter with its shape: vertices (m), radiance (W/m^2/sr), sidedness")
 
@@ -83,7 +85,8 @@ GBUF_POSITION, GBUF_NORMAL, GBUF_ALBEDO, GBUF_SPECULAR = GBUFFER
 
 RSM = (Port("rsm", "position", "RGBA32F", "rsm", "world position (m), w = 1 where geometry"),
        Port("rsm", "normal", "RGBA32F", "rsm", "world normal, facing the light; w = surfel area (m^2)"),
-       Port("rsm", "flux", "RGBA32F", "rsm", "W reflected by the texel's surfel"))
+       Port("rsm", "flux", "RGBA32F", "rsm",
+            "W reflected by the texel's surfel; w = 1 + index of the triangle it sees in the occluders (0: none)"))
 RSM_POSITION, RSM_NORMAL, RSM_FLUX = RSM
 
 DIRECT = _image("product", "direct", "irradiance / pi: Cycles' Diffuse Direct")

@@ -1,6 +1,7 @@
 """Direct-light pass: shadow-mapped direct diffuse light of one light face at every G-buffer pixel.
 
-Inputs: G-buffer position and normal, the face's RSM position and normal (shadow test), LightView
+Inputs: G-buffer position and normal, the face's RSM position, normal and flux (its w names the triangle
+each texel sees) and the occluder table of those triangles (rsm.occluder_table; the shadow test), LightView
 uniforms, and the emitter table (area_light.emitter_table): a light with polygons (poly_count > 0: an area light's
 patch, an emissive mesh's triangles) gives the exact unshadowed irradiance of its shape, soft-shadowed
 from its position as a disc of its area (emitter_radius_m); the others are points (spots masked,
@@ -15,12 +16,15 @@ from __future__ import annotations
 import functools
 
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
+from . import rsm
 from .declare import (
     DIRECT,
     EMITTERS,
     GBUF_NORMAL,
     GBUF_POSITION,
     LIGHT_VIEWS,
+    OCCLUDERS,
+    RSM_FLUX,
     RSM_NORMAL,
     RSM_POSITION,
     PassDecl,
@@ -31,7 +35,9 @@ from .light_views import KIND_CODE, LightView
 @functools.cache  # one spec, hence one program, per kind
 def _spec(polygons: bool, soft_sun: bool, area_samples: int = 0) -> ShaderSpec:
     """The pass for one kind of light: with its polygons' irradiance (POLYGONS: the emitter table and
-    its rows) or a point's, with a sun's soft shadows (SOFT_SUN: the sun's angle) or a hard shadow test.
+    its rows) or a point's, with a sun's soft shadows (SOFT_SUN: the sun's angle) or a hard shadow; a
+    point's and a sun's shadows tested against the triangles the map names (rsm_flux's w, the occluders
+    table: docs/DIRECT.md, "The shadow test").
     One program each, because llvmpipe runs the code of a branch no invocation takes: with both kinds in
     one program a spot's shading of the probe atlas took 4.5 x as long (docs/PROBES.md).
     area_samples 0: every pixel of the G-buffer. On the probe atlas, one invocation per texel of a list
@@ -40,6 +46,7 @@ def _spec(polygons: bool, soft_sun: bool, area_samples: int = 0) -> ShaderSpec:
     > 1 (AREA_SAMPLES, ProbesConfig.area_samples), the grazing texels at that many points along their
     footprints (probe_capture.FOOTPRINT)."""
     area = area_samples > 1
+    exact = not polygons  # the exact shadow test: the triangles the map names
     listed = ("texel_list",) if area_samples >= 1 else ()
     footprint = ("footprint_origin", "footprint_step", "footprint_neighbours") if area else ()
     return ShaderSpec(
@@ -49,6 +56,7 @@ def _spec(polygons: bool, soft_sun: bool, area_samples: int = 0) -> ShaderSpec:
         local_size=(8, 8, 1),
         samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("rsm_position", "2D"),
                   Sampler("rsm_normal", "2D"))
+        + ((Sampler("rsm_flux", "2D"), Sampler("occluders", "2D")) if exact else ())
         + ((Sampler("emitters", "2D"),) if polygons else ())
         + tuple(Sampler(name, "2D") for name in listed + footprint),
         images=(Image("direct", "2D", "RGBA32F", "read_write"),),
@@ -62,7 +70,8 @@ def _spec(polygons: bool, soft_sun: bool, area_samples: int = 0) -> ShaderSpec:
         ) + ((Var("poly_first", "int"), Var("poly_count", "int"), Var("emitter_radius_m", "float"),
                Var("light_view_projection_inverse", "mat4")) if polygons else ())
         + ((Var("sun_tan_half", "float"),) if soft_sun else ()),
-        defines=((("POLYGONS", "1"),) if polygons else ()) + ((("SOFT_SUN", "1"),) if soft_sun else ())
+        defines=((("POLYGONS", "1"),) if polygons else ())
+        + ((("OCCLUDER_ROW", str(rsm.OCCLUDER_ROW)),) if exact else ()) + ((("SOFT_SUN", "1"),) if soft_sun else ())
         + ((("TEXEL_LIST", "1"),) if listed else ()) + ((("AREA_SAMPLES", str(area_samples)),) if area else ()),
     )
 
@@ -70,14 +79,16 @@ def _spec(polygons: bool, soft_sun: bool, area_samples: int = 0) -> ShaderSpec:
 SPECS = {(polygons, soft_sun): _spec(polygons, soft_sun) for polygons in (False, True) for soft_sun in (False, True)}
 
 
-DECL = PassDecl("direct_light", "gather", (GBUF_POSITION, GBUF_NORMAL, RSM_POSITION, RSM_NORMAL, LIGHT_VIEWS, EMITTERS),
+DECL = PassDecl("direct_light", "gather", (GBUF_POSITION, GBUF_NORMAL, RSM_POSITION, RSM_NORMAL, RSM_FLUX, OCCLUDERS,
+                                          LIGHT_VIEWS, EMITTERS),
                 (DIRECT,),
                 "one light face's shadow-mapped direct light, added")
 
 
 def run(backend: Backend, gbuf_position, gbuf_normal, shadow: dict, direct, view: LightView,
         shadow_bias_texels: float, emitters, accumulate: bool = True, lists=()) -> None:
-    """`shadow`: the shadow map's "position" and "normal" textures (the RSM's, or a sun's own map).
+    """`shadow`: the shadow map's "position", "normal" and "flux" textures (the RSM's, or a sun's own map)
+    and the "occluders" table its flux names triangles in (rsm.occluder_table).
     `emitters`: the emitter table texture; the view's uniforms give its rows (poly_first, poly_count).
     accumulate: add to `direct`; False: replace its pixels that see geometry (those that see none are not
     written: the caller keeps them 0). lists: where the G-buffer is a probe atlas, the texels to shade
@@ -87,7 +98,8 @@ def run(backend: Backend, gbuf_position, gbuf_normal, shadow: dict, direct, view
     soft_sun = view_uniforms["light_kind"] == KIND_CODE["SUN"] and view_uniforms["sun_tan_half"] > 0.0
     polygons = view_uniforms.get("poly_count", 0) > 0
     samplers = {"gbuf_position": gbuf_position, "gbuf_normal": gbuf_normal, "rsm_position": shadow["position"],
-                "rsm_normal": shadow["normal"], "emitters": emitters}
+                "rsm_normal": shadow["normal"], "rsm_flux": shadow["flux"], "occluders": shadow["occluders"],
+                "emitters": emitters}
     passes = [(_spec(polygons, soft_sun, samples), texels.size, {"texel_list": texels, **footprint})
               for texels, samples, footprint in lists] or [(_spec(polygons, soft_sun), direct.size, {})]
     for spec, size, more in passes:

@@ -11,6 +11,8 @@ surfel sends back at the emitter stops there.
 
 from __future__ import annotations
 
+import numpy as np
+
 from ..backends.base import Backend, ShaderSpec, Var
 from .declare import LIGHT_VIEWS, RSM, TRIANGLES, PassDecl
 from .light_views import LightView
@@ -31,6 +33,20 @@ SPEC = ShaderSpec(
     varyings=(Var("v_pos_ws", "vec3"), Var("v_normal_ws", "vec3"), Var("v_albedo", "vec3")),
     outputs=(Var("out_position", "vec4"), Var("out_normal", "vec4"), Var("out_flux", "vec4")),
 )
+
+
+OCCLUDER_ROW = 1024  # triangles per row of the occluder table (3 texels each: 3072 wide, within GL's 16384)
+
+
+def occluder_table(positions_m: np.ndarray) -> np.ndarray:
+    """The corners (n, 3, 3) of the triangles an RSM draws, in draw order, as a (rows, 3 OCCLUDER_ROW, 4)
+    RGBA32F table: triangle t's corner k at texel (3 (t % OCCLUDER_ROW) + k, t // OCCLUDER_ROW), the
+    triangle its texels name (flux.w - 1)."""
+    n = len(positions_m)
+    rows = max(1, -(-n // OCCLUDER_ROW))
+    table = np.zeros((rows * OCCLUDER_ROW * 3, 4), np.float32)
+    table[:n * 3, :3] = np.asarray(positions_m, np.float32).reshape(-1, 3)
+    return table.reshape(rows, OCCLUDER_ROW * 3, 4)
 
 
 DECL = PassDecl("rsm", "solve", (TRIANGLES, LIGHT_VIEWS), RSM, "the scene seen from one light face")
