@@ -13,7 +13,7 @@ its pixels by solid angle (a texel's centre alone misses the horizon's steep ban
 fingerprint of the world's node tree and made again only when that changes. A constant background
 (no link into its Color) needs no map: capture.world_color gives it.
 
-The interactive viewport never renders from its timer (a second's stall per edit of the sky): it asks
+The interactive viewport never renders from its timer (a stall of half a second per edit of the sky): it asks
 `capture(world, render=False)`, which reads an HDRI (each image's binning cached apart from the
 Background's strength, so dragging the strength re-reads nothing) and otherwise returns only a map
 already made for this exact node tree: kept in the world by the Capture World Light operator (`store`:
@@ -57,7 +57,7 @@ MAP_ROWS, MAP_COLS = 32, 64
 # first row (-5.6..0 degrees) of Blender's default Sky Texture averages 2.4 times its centre's radiance,
 # and the sky's light through a window onto the opposite wall is mostly that band (window-sky). 8 x 8
 # samples hold each texel's mean to ~1 % there; the render costs ~40 ms more than one sample (most of
-# its ~1.4 s is Cycles' scene sync).
+# its ~0.4 s is Cycles' set-up).
 MAP_SUPERSAMPLE = 8
 _cache: dict[str, Captured] = {}
 _binned_images: dict[tuple, tuple] = {}  # an HDRI's (map, suns) at strength 1, by (name, filepath, size)
