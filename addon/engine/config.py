@@ -95,7 +95,8 @@ class RsmConfig(_Validated):
     # world beside a sun few (docs/DIRECT.md).
     sky_directions: int = _num(256, 1, 1024, "most regions of the sky its direct light is split into, one pass "
                                "for all (fewer when the world gives less of the light)")
-    sky_texels: int = _num(64, 16, 1024, "shadow map side in texels of each sky direction")
+    sky_texels: int = _num(64, 16, 1024, "shadow map side in texels of each sky direction (at most what keeps "
+                                         "their atlas 2048 texels a side)")
 
 
 @dataclass(frozen=True)

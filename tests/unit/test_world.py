@@ -124,3 +124,18 @@ def test_power_shares_split_by_luminance_and_never_divide_by_zero():
     shares = power_shares([sun(1.0, [0, 1, 0]), sun(2.0, [0, 0, 1])])
     np.testing.assert_allclose(shares, np.array([0.7152, 0.1444]) / 0.8596, rtol=1e-12)
     np.testing.assert_array_equal(power_shares([sun(0.0, [1, 1, 1])] * 4), [0.25] * 4)  # all dark: equal
+
+
+def test_the_sky_atlas_keeps_within_its_widest_side():
+    # SkyLayout.of: tiles of the asked texels rounded up to whole blocks, unless the near-square atlas
+    # would pass ATLAS_MAX_TEXELS (2048) a side: 189 directions take 14 columns, so at most
+    # 2048 // 14 = 146 -> 144 texels (whole blocks of 8). The default 64 texels fit 1024 directions.
+    from addon.engine.passes.sky_light import ATLAS_MAX_TEXELS, SkyLayout
+
+    assert SkyLayout.of(189, 64).tile_texels == 64
+    assert SkyLayout.of(189, 60).tile_texels == 64
+    assert SkyLayout.of(189, 1024).tile_texels == 144
+    assert SkyLayout.of(1024, 64).tile_texels == 64
+    for count in (1, 2, 17, 189, 256, 1024):
+        for texels in (16, 64, 300, 1024):
+            assert max(SkyLayout.of(count, texels).size) <= ATLAS_MAX_TEXELS

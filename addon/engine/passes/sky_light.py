@@ -101,6 +101,12 @@ DIRECT_DECL = PassDecl("sky_direct", "gather", (GBUF_POSITION, GBUF_NORMAL, SKY_
                        (DIRECT,), "the sky's shadowed direct light of every direction, in one pass, added")
 
 
+# The atlas's widest side: 64 MB of RGBA32F, and as much again per RSM tile texture vct adds. 1024 directions
+# of the default 64 texels fill it; 189 directions of 1024 texels (RsmConfig.sky_texels' top) made a
+# 14336-texel atlas of 3 GB that no framebuffer took.
+ATLAS_MAX_TEXELS = 2048
+
+
 @dataclass(frozen=True)
 class SkyLayout:
     """The directions' tiles in the atlas: near square (tiles_x columns); tile_texels a multiple of
@@ -111,8 +117,10 @@ class SkyLayout:
 
     @classmethod
     def of(cls, count: int, texels: int) -> SkyLayout:
-        """`count` tiles of at least `texels` per side, rounded up to whole blocks."""
-        return cls(count, -(-texels // BLOCK_TEXELS) * BLOCK_TEXELS)
+        """`count` tiles of `texels` per side rounded up to whole blocks, at most as many as keep the atlas
+        within ATLAS_MAX_TEXELS a side (at least one block)."""
+        fits = ATLAS_MAX_TEXELS // math.ceil(math.sqrt(count)) // BLOCK_TEXELS * BLOCK_TEXELS
+        return cls(count, max(BLOCK_TEXELS, min(-(-texels // BLOCK_TEXELS) * BLOCK_TEXELS, fits)))
 
     @property
     def tiles_x(self) -> int:
