@@ -9,15 +9,18 @@
 #include "common/texel_list.glsl"
 
 const float PI = 3.14159265;
-// The receiver is lifted along its normal so that its own surface does not shadow it: by half a texel
-// of depth at its own texel, but a wide region's filter disc reaches across texels whose surface
-// lies nearer the sky, so the lift grows with the region's width, up to the direct pass's 1.5 texels
-// (an open floor under 16 directions stays within 1.5 % of pi L). The lift also moves the lookup
-// sideways, so a narrow region's lit patch lands off where it should: window-sky (189 directions,
-// mostly narrow) direct rel_rmse_8 / bias 0.109 / 1.031 with 1.5 texels for all, 0.099 / 1.005 so.
-const float NORMAL_OFFSET_TEXELS = 1.5;
-const float OFFSET_NARROW_TEXELS = 0.75;
-const float OFFSET_PER_TAN = 2.0;  // texels of lift per unit of the region's tan(half-angle)
+// The receiver is lifted half a texel along its normal, for its own texel's depth, and each tap is
+// compared with the receiver's own plane where the plane rises towards the direction there
+// (`plane_slope`), so that a surface lit at a slant does not shadow itself across a wide region's disc.
+// The plane counts at most PLANE_MAX_TEXELS texels of depth: extrapolated further, a grazing direction's
+// disc reached past a closed box's roof (tests/gpu/test_sky.py; 16 texels let its 0.4 m walls through,
+// 1-4 shadowed an open floor under 16 directions by more than 1.5 %). Without the plane, a lift that
+// grew with the region's width (0.75 texels + 2 per unit of tan(half-angle), at most 1.5) moved the
+// lookup sideways, through a window's edge. Direct rel_rmse_8 / bias at 128 px, that lift -> this:
+// window-sky 0.094 / 1.004 -> 0.080 / 1.009, window-sky-sun 0.036 / 1.001 -> 0.030 / 1.001,
+// cornell-grey-world 0.028 -> 0.027.
+const float LIFT_TEXELS = 0.5;
+const float PLANE_MAX_TEXELS = 8.0;
 // Taps per direction: few, since the sum over a hundred directions, each turned differently, is what
 // samples the penumbra (4 + 8 taps: window-sky direct rel_rmse_8 0.207; 16 + 16: 0.203).
 const int SEARCH_TAPS = 4;
@@ -35,6 +38,21 @@ vec2 tap(int i, int n) {
 float sky_depth(ivec2 tile0, ivec2 t) {
     vec4 d = texelFetch(sky_depth_atlas, tile0 + clamp(t, ivec2(0), ivec2(tile_texels - 1)), 0);
     return d.w > 0.0 ? d.x : 1e30;
+}
+
+// The depth along `axis` of the receiver's plane (normal n) per texel of offset in a tile whose rows map
+// a world vector v to texel offsets (dot(row_x, v), dot(row_y, v)) x tile_texels / 2. From two tangents
+// of the plane, their texel steps a, b and depth steps da, db: depth(delta) = [da db] [a b]^-1 delta (as
+// direct/shade.comp.glsl's receiver_slope for a sun's map); 0 where the direction grazes the plane.
+vec2 plane_slope(vec3 n, vec3 row_x, vec3 row_y, vec3 axis) {
+    vec3 t1 = normalize(cross(n, abs(n.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
+    vec3 t2 = cross(n, t1);
+    vec2 a = vec2(dot(row_x, t1), dot(row_y, t1)) * 0.5 * float(tile_texels);
+    vec2 b = vec2(dot(row_x, t2), dot(row_y, t2)) * 0.5 * float(tile_texels);
+    float da = dot(t1, axis);
+    float db = dot(t2, axis);
+    float det = a.x * b.y - a.y * b.x;
+    return abs(det) > 1e-12 ? vec2(b.y * da - a.y * db, a.x * db - b.x * da) / det : vec2(0.0);
 }
 
 void main() {
@@ -57,12 +75,13 @@ void main() {
         }
         vec4 light_texel = texelFetch(sky_table, ivec2(5, k), 0);
         float tan_half = light_texel.w;
-        float offset_texels = min(NORMAL_OFFSET_TEXELS, OFFSET_NARROW_TEXELS + OFFSET_PER_TAN * tan_half);
-        vec4 p_test = vec4(p + n * (offset_texels * axis_texel.w), 1.0);
+        vec4 p_test = vec4(p + n * (LIFT_TEXELS * axis_texel.w), 1.0);
         vec4 row_x = texelFetch(sky_table, ivec2(0, k), 0);
         vec4 row_y = texelFetch(sky_table, ivec2(1, k), 0);
         vec2 ndc = vec2(dot(row_x, p_test), dot(row_y, p_test));
         float receiver = dot(p_test.xyz, axis_texel.xyz);
+        vec2 slope = plane_slope(n, row_x.xyz, row_y.xyz, axis_texel.xyz);
+        float plane_floor = -PLANE_MAX_TEXELS * axis_texel.w;
         // Soft shadow (percentage-closer soft shadows, as a wide sun's in the direct pass): the region is
         // a cone of half-angle atan(tan_half); blockers found in a disc of the widest penumbra give its
         // width (receiver - blocker depth) x tan_half, and the lit share of a disc that wide is the
@@ -93,8 +112,9 @@ void main() {
         float centre = sky_depth(tile0, ivec2(uv));
         float nearest = centre < receiver ? centre : -1e30;
         for (int i = 0; i < SEARCH_TAPS; ++i) {
-            float d = sky_depth(tile0, ivec2(uv + search * (rot * tap(i, SEARCH_TAPS))));
-            if (d < receiver) {
+            vec2 offset = search * (rot * tap(i, SEARCH_TAPS));
+            float d = sky_depth(tile0, ivec2(uv + offset));
+            if (d < receiver + clamp(dot(slope, offset), plane_floor, 0.0)) {
                 nearest = max(nearest, d);
             }
         }
@@ -107,8 +127,10 @@ void main() {
             float radius = clamp((receiver - nearest) * tan_half / texel_m, 0.5, MAX_SOFT_TEXELS);
             lit = 0.0;
             for (int i = 0; i < FILTER_TAPS; ++i) {
-                float d = sky_depth(tile0, ivec2(uv + radius * (rot * tap(i, FILTER_TAPS))));
-                lit += d >= 1e29 ? centre_lit : (d >= receiver ? 1.0 : 0.0);
+                vec2 offset = radius * (rot * tap(i, FILTER_TAPS));
+                float d = sky_depth(tile0, ivec2(uv + offset));
+                float plane = receiver + clamp(dot(slope, offset), plane_floor, 0.0);
+                lit += d >= 1e29 ? centre_lit : (d >= plane ? 1.0 : 0.0);
             }
             lit /= float(FILTER_TAPS);
         }

@@ -41,8 +41,9 @@ def test_open_floor_under_a_uniform_sky_gets_its_radiance(gl, count, rtol):
     # vector irradiances sum to it (world.py, exact for a floor: the first split is the horizon) and
     # nothing but the floor itself is there to block. 128 directions: 1e-3 (fp32 sums). 16: a wide
     # region's soft-shadow disc, at a low direction, reaches floor that lies nearer the sky than the
-    # receiver's offset depth (the floor shadows itself a little; the receiver's plane is not
-    # extrapolated across the disc, which let thin walls leak): measured 1.09 % low, bounded at 1.5 %.
+    # receiver; the receiver's plane, extrapolated across the disc for at most 8 texels of depth, keeps
+    # it lit: measured exact (1.09 % low with a lift instead of the plane), bounded at 1.5 % as a
+    # narrower cap of the plane shadows it (4 texels: more than 1.5 %).
     img = direct(gl, open_floor(), sky_directions=count)
     centre = img[8:24, 8:24, :3].reshape(-1, 3)
     np.testing.assert_allclose(centre, np.broadcast_to(RADIANCE, centre.shape), rtol=rtol)
@@ -52,10 +53,11 @@ def test_open_floor_under_a_uniform_sky_gets_its_radiance(gl, count, rtol):
 @pytest.mark.parametrize("wall_m", [0.1, 0.4])
 def test_closed_box_under_a_sky_stays_dark(gl, wall_m):
     # A closed 2 m box under a bright sky: no direction reaches its inside. Walls 0.4 m thick (about 8
-    # texels of a 64-texel tile): exactly 0. Walls 0.1 m (2 texels): a soft-shadow disc at a grazing
-    # direction reaches past the roof's silhouette to surfaces deeper than the receiver (one depth
-    # layer cannot tell them from the floor seen through an opening); measured 54 of 1024 pixels at
-    # most 0.81 % of the open floor's light, 0.016 % on average: bounded at 1 % and 0.03 %.
+    # texels of a 64-texel tile): exactly 0 (with the receiver's plane extrapolated for 16 texels of depth
+    # instead of 8, 0.06 %). Walls 0.1 m (2 texels): a soft-shadow disc at a grazing direction reaches
+    # past the roof's silhouette to surfaces deeper than the receiver (one depth layer cannot tell them
+    # from the floor seen through an opening); measured 85 of 1024 pixels at most 0.37 % of the open
+    # floor's light, 0.008 % on average: bounded at 1 % and 0.03 %.
     outer = box([-1 - wall_m, -1 - wall_m, -wall_m], [1 + wall_m, 1 + wall_m, 2 + wall_m], inward=False)
     inner = box([-1, -1, 0], [1, 1, 2], inward=True)
     sc = make_scene(parts((*outer, 0.5), (*inner, 0.5)), [], camera([0.5, 0.5, 1.5], [-1, -1, -0.7], size=32))
