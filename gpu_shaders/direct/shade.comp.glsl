@@ -7,6 +7,7 @@
 #include "common/light.glsl"
 #include "common/texel_list.glsl"
 #include "common/polygon.glsl"
+#include "common/receiver_plane.glsl"
 
 const float PI = 3.14159265;
 
@@ -148,29 +149,14 @@ float sun_depth(vec2 uv, ivec2 size) {
     return occ.w > 0.0 ? dot(occ.xyz, emit_axis) : 1e30;  // no geometry: nothing blocks
 }
 
-// The receiver's own plane seen from the sun: its depth change per texel of the shadow map, so a disc
-// sample is compared with the plane's depth there, not the centre's (else a surface the sun lights at
-// a slant shadows itself across the disc). From two tangents of the plane, their texel steps a, b and
-// depth steps da, db: depth(delta) = [da db] [a b]^-1 delta.
-vec2 receiver_slope(vec3 n, ivec2 size) {
-    vec3 t1 = normalize(cross(n, abs(n.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
-    vec3 t2 = cross(n, t1);
-    vec2 a = (light_view_projection * vec4(t1, 0.0)).xy * 0.5 * vec2(size);
-    vec2 b = (light_view_projection * vec4(t2, 0.0)).xy * 0.5 * vec2(size);
-    float da = dot(t1, emit_axis);
-    float db = dot(t2, emit_axis);
-    float det = a.x * b.y - a.y * b.x;
-    if (abs(det) < 1e-12) {
-        return vec2(0.0);  // the sun grazes the surface: it receives (almost) nothing anyway
-    }
-    return vec2(b.y * da - a.y * db, a.x * db - b.x * da) / det;
-}
-
 // The sun's visible share of its disc from receiver p (depth `receiver` at map position uv; q: p lifted
 // for the exact test). Blockers are searched for in a disc as wide as the widest penumbra; with none,
 // p sees the whole sun.
 float soft_sun_visibility(vec2 uv, ivec2 size, float receiver, float bias_m, float texel_m, vec3 n, vec3 q) {
-    vec2 slope = receiver_slope(n, size);
+    // The map's rows: a world vector's offset in NDC.
+    vec3 row_x = vec3(light_view_projection[0][0], light_view_projection[1][0], light_view_projection[2][0]);
+    vec3 row_y = vec3(light_view_projection[0][1], light_view_projection[1][1], light_view_projection[2][1]);
+    vec2 slope = receiver_depth_per_texel(n, row_x, row_y, 0.5 * vec2(size), emit_axis);
     float search = min(MAX_SOFT_TEXELS, sun_tan_half * float(size.x));
     float blockers = 0.0;
     float depth_sum = 0.0;
@@ -190,8 +176,8 @@ float soft_sun_visibility(vec2 uv, ivec2 size, float receiver, float bias_m, flo
     // the triangles the map names along its path across the map, from the receiver's texel outwards half
     // a texel at a time, as far as the blocker search reached.
     float ahead_m = max(receiver - depth_sum / blockers, 0.0);
-    vec3 axis_x = normalize(vec3(light_view_projection[0][0], light_view_projection[1][0], light_view_projection[2][0]));
-    vec3 axis_y = normalize(vec3(light_view_projection[0][1], light_view_projection[1][1], light_view_projection[2][1]));
+    vec3 axis_x = normalize(row_x);
+    vec3 axis_y = normalize(row_y);
     float s_min = EXACT_NEAR_TEXELS * texel_m;
     float lit = 0.0;
     for (int i = 0; i < SOFT_TAPS; ++i) {

@@ -7,11 +7,12 @@
 // (axis the light travels along, texel size in m), texel 5 (irradiance normal to it, W/m^2 per colour;
 // w: the tangent of the region's angular radius, its shadows' penumbra).
 #include "common/texel_list.glsl"
+#include "common/receiver_plane.glsl"
 
 const float PI = 3.14159265;
 // The receiver is lifted half a texel along its normal, for its own texel's depth, and each tap is
 // compared with the receiver's own plane where the plane rises towards the direction there
-// (`plane_slope`), so that a surface lit at a slant does not shadow itself across a wide region's disc.
+// (common/receiver_plane.glsl), so that a surface lit at a slant does not shadow itself across a wide region's disc.
 // The plane counts at most PLANE_MAX_TEXELS texels of depth: extrapolated further, a grazing direction's
 // disc reached past a closed box's roof (tests/gpu/test_sky.py; 16 texels let its 0.4 m walls through,
 // 1-4 shadowed an open floor under 16 directions by more than 1.5 %). Without the plane, a lift that
@@ -40,21 +41,6 @@ float sky_depth(ivec2 tile0, ivec2 t) {
     return d.w > 0.0 ? d.x : 1e30;
 }
 
-// The depth along `axis` of the receiver's plane (normal n) per texel of offset in a tile whose rows map
-// a world vector v to texel offsets (dot(row_x, v), dot(row_y, v)) x tile_texels / 2. From two tangents
-// of the plane, their texel steps a, b and depth steps da, db: depth(delta) = [da db] [a b]^-1 delta (as
-// direct/shade.comp.glsl's receiver_slope for a sun's map); 0 where the direction grazes the plane.
-vec2 plane_slope(vec3 n, vec3 row_x, vec3 row_y, vec3 axis) {
-    vec3 t1 = normalize(cross(n, abs(n.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
-    vec3 t2 = cross(n, t1);
-    vec2 a = vec2(dot(row_x, t1), dot(row_y, t1)) * 0.5 * float(tile_texels);
-    vec2 b = vec2(dot(row_x, t2), dot(row_y, t2)) * 0.5 * float(tile_texels);
-    float da = dot(t1, axis);
-    float db = dot(t2, axis);
-    float det = a.x * b.y - a.y * b.x;
-    return abs(det) > 1e-12 ? vec2(b.y * da - a.y * db, a.x * db - b.x * da) / det : vec2(0.0);
-}
-
 void main() {
     ivec2 px;
     if (!invocation_texel(textureSize(gbuf_position, 0), px)) {
@@ -80,7 +66,7 @@ void main() {
         vec4 row_y = texelFetch(sky_table, ivec2(1, k), 0);
         vec2 ndc = vec2(dot(row_x, p_test), dot(row_y, p_test));
         float receiver = dot(p_test.xyz, axis_texel.xyz);
-        vec2 slope = plane_slope(n, row_x.xyz, row_y.xyz, axis_texel.xyz);
+        vec2 slope = receiver_depth_per_texel(n, row_x.xyz, row_y.xyz, vec2(0.5 * float(tile_texels)), axis_texel.xyz);
         float plane_floor = -PLANE_MAX_TEXELS * axis_texel.w;
         // Soft shadow (percentage-closer soft shadows, as a wide sun's in the direct pass): the region is
         // a cone of half-angle atan(tan_half); blockers found in a disc of the widest penumbra give its
