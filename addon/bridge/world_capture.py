@@ -9,7 +9,7 @@ itself: Cycles renders the world alone, from a panoramic equirectangular camera 
 MAP_SUPERSAMPLE^2 pixels per texel of the MAP_ROWS x MAP_COLS map, one sample per pixel (camera rays
 see only the background: no noise but the filter, which is narrowed), and each texel is the mean of
 its pixels by solid angle (a texel's centre alone misses the horizon's steep band). That costs about
-1.5 s on this project's 2-core CPU machine (most of it Cycles' scene sync), so the map is cached by a
+0.4 s on this project's 2-core CPU machine (most of it Cycles' scene sync), so the map is cached by a
 fingerprint of the world's node tree and made again only when that changes. A constant background
 (no link into its Color) needs no map: capture.world_color gives it.
 
@@ -29,7 +29,7 @@ the map is rendered from a copy of the world with those discs off, so nothing is
 (`Captured.suns`). A disc turned by a linked Vector is not placed, with a warning (samples that hit it
 by chance keep its light). An HDRI's sun is taken out of its pixels the same way (`_take_sun`) before
 they are binned: a sun texel of the map would light through the sky pass's coarse shadow tiles from a
-direction up to 2.8 degrees off.
+direction up to 1.4 degrees off.
 
 Cycles' equirectangular camera, rotated to look along +x with +z up, puts longitude increasing to the
 left: its columns are read reversed to match world.py's layout (tests/blender/test_world_capture.py
@@ -52,13 +52,15 @@ from ..engine.scene import Light
 from ..engine.world import LUMA, downsample
 from . import compat
 
-MAP_ROWS, MAP_COLS = 32, 64
+# 2.8 degrees a texel. The sky pass's directions are regions of whole texels (world.regions), and most
+# of the light a window lets onto the far wall comes from a band a few texels high at the horizon: with
+# 5.6-degree texels its brightest regions were single texels no direction count could split further,
+# each casting the window's shadow as one disc (docs/DIRECT.md, "The map's resolution").
+MAP_ROWS, MAP_COLS = 64, 128
 # Pixels rendered per map texel and side. A sky's radiance changes fastest at the horizon: the ground's
-# first row (-5.6..0 degrees) of Blender's default Sky Texture averages 2.4 times its centre's radiance,
-# and the sky's light through a window onto the opposite wall is mostly that band (window-sky). 8 x 8
-# samples hold each texel's mean to ~1 % there; the render costs ~40 ms more than one sample (most of
-# its ~0.4 s is Cycles' set-up).
-MAP_SUPERSAMPLE = 8
+# first 5.6 degrees of Blender's default Sky Texture average 2.4 times their centre's radiance. 4 x 4
+# samples a texel: the same 256 x 512 render that held a 32-row map's texel means to ~1 % there.
+MAP_SUPERSAMPLE = 4
 _cache: dict[str, Captured] = {}
 _binned_images: dict[tuple, tuple] = {}  # an HDRI's (map, suns) at strength 1, by (name, filepath, size)
 
@@ -98,8 +100,8 @@ def _binned(world, image, strength: float) -> Captured:
 
 # An HDRI's sun: its pixels brighter than SUN_CONTRAST x the median luminance of its lit pixels within
 # SUN_RADIUS_RAD of its brightest pixel (a photographed sun is 10^4-10^6 times the sky, blown out over
-# a degree or two). Left in the 5.6-degree map it would light through a shadow map of the sky pass's
-# tiles (64 texels across the scene: blurred shadows) from a texel centre up to 2.8 degrees off.
+# a degree or two). Left in the 2.8-degree map it would light through a shadow map of the sky pass's
+# tiles (64 texels across the scene: blurred shadows) from a texel centre up to 1.4 degrees off.
 SUN_CONTRAST = 100.0
 SUN_RADIUS_RAD = math.radians(5.0)
 
@@ -242,8 +244,8 @@ STORED_MAP, STORED_SUNS, STORED_KEY = "bounce_world_map", "bounce_world_suns", "
 
 
 def _stored_key(world) -> str:
-    # MAP_SUPERSAMPLE too: a map kept by a build that sampled the world otherwise is made again.
-    text = f"{bpy.app.version_string}|{MAP_SUPERSAMPLE}|{fingerprint(world, with_file=False)}"
+    # The map's size and sampling too: a map kept by a build that sampled the world otherwise is made again.
+    text = f"{bpy.app.version_string}|{MAP_ROWS}x{MAP_COLS}x{MAP_SUPERSAMPLE}|{fingerprint(world, with_file=False)}"
     return hashlib.sha256(text.encode()).hexdigest()
 
 

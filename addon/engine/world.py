@@ -16,6 +16,8 @@ along +x (direction (cos lat cos lon, cos lat sin lon, sin lat)).
 
 from __future__ import annotations
 
+import heapq
+
 import numpy as np
 
 from .scene import Light
@@ -68,26 +70,46 @@ def constant_map(radiance: np.ndarray, height: int = 16, width: int = 32) -> np.
 def regions(power: np.ndarray, count: int, solid_angle: np.ndarray | None = None) -> list[tuple[slice, slice]]:
     """Split the map (per-texel power (h, w)) into `count` rectangles of texels: the two hemispheres
     first, then repeatedly the region of largest power at its power median along its longer side
-    (in texels weighted by cos(lat) for longitude). Regions with no power are never split.
+    (in texels weighted by cos(lat) for longitude). Regions with no power are never split. The
+    rectangles come in the order of the splits' tree (each split's halves where the region was).
 
     With `solid_angle` (per texel, sr) the region split next is the one of largest power x sqrt(solid
     angle): a shadow cast by one direction in place of a region errs by the region's light times its
     angular width, so a dim but wide region (the ground seen through a window) is split too, not only
-    the bright sky."""
+    the bright sky.
+
+    A heap of the unsplit regions by that priority: each split costs the two halves' sums, so 1024
+    regions of a 64 x 128 map take milliseconds (rescoring every region at every split took 4 s)."""
     h, w = power.shape
-    rects = [(slice(0, h // 2), slice(0, w)), (slice(h // 2, h), slice(0, w))] if h >= 2 else [(slice(0, h),
+    roots = [(slice(0, h // 2), slice(0, w)), (slice(h // 2, h), slice(0, w))] if h >= 2 else [(slice(0, h),
                                                                                               slice(0, w))]
-    while len(rects) < count:
-        totals = [power[r].sum() * (1.0 if solid_angle is None else np.sqrt(solid_angle[r].sum())) for r in rects]
-        order = np.argsort(totals)[::-1]
-        for i in order:
-            split = _split(power, rects[i])
-            if split is not None:
-                rects[i:i + 1] = list(split)
-                break
+
+    def priority(rect) -> float:
+        return float(power[rect].sum()) * (1.0 if solid_angle is None else float(np.sqrt(solid_angle[rect].sum())))
+
+    rects = list(roots)  # every region made, by id
+    halves: dict[int, tuple[int, int]] = {}  # id of a split region -> its halves' ids
+    heap = [(-priority(r), i) for i, r in enumerate(roots)]
+    heapq.heapify(heap)
+    leaves = len(roots)
+    while leaves < count and heap:
+        _, i = heapq.heappop(heap)
+        split = _split(power, rects[i])
+        if split is None:
+            continue  # never splittable: dropped from the heap
+        halves[i] = (len(rects), len(rects) + 1)
+        for half in split:
+            heapq.heappush(heap, (-priority(half), len(rects)))
+            rects.append(half)
+        leaves += 1
+    out, stack = [], list(range(len(roots)))[::-1]
+    while stack:  # the leaves, depth first
+        i = stack.pop()
+        if i in halves:
+            stack.extend(halves[i][::-1])
         else:
-            break  # nothing left to split: fewer regions than asked
-    return rects
+            out.append(rects[i])
+    return out
 
 
 def _split(power: np.ndarray, rect: tuple[slice, slice]):

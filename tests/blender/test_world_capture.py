@@ -34,11 +34,11 @@ def test_map_texels_hold_their_directions(fresh_blend):
 
 
 def test_a_texel_holds_the_mean_of_its_directions(fresh_blend):
-    # A world bright (1) above latitude -1.40625 degrees and black below: the edge cuts the first row
-    # below the horizon (-5.625..0 degrees) a quarter of the way down. By solid angle a quarter of that
-    # row is lit: (sin 0 - sin(-1.40625)) / (sin 0 - sin(-5.625)) = 0.2504; its 8 sub-rows of samples
-    # give 2 of 8 weighted by their bands, 0.2505; the texel's centre alone (-2.8 degrees) would read
-    # 0. Rows above read 1 and rows below 0 exactly (every sample lies on one side).
+    # A world bright (1) above latitude -0.703125 degrees and black below: the edge cuts the first row
+    # of the 64-row map below the horizon (-2.8125..0 degrees) a quarter of the way down. By solid angle
+    # a quarter of that row is lit: sin(0.703125) / sin(2.8125) = 0.2501; its 4 sub-rows of samples give
+    # 1 of 4 weighted by their bands, 0.2501; the texel's centre alone (-1.4 degrees) would read 0. Rows
+    # above read 1 and rows below 0 exactly (every sample lies on one side).
     from addon.bridge import compat, world_capture
 
     world = bpy.data.worlds.new("Edge")
@@ -47,14 +47,14 @@ def test_a_texel_holds_the_mean_of_its_directions(fresh_blend):
     xyz = tree.nodes.new("ShaderNodeSeparateXYZ")
     above = tree.nodes.new("ShaderNodeMath")
     above.operation = "GREATER_THAN"
-    above.inputs[1].default_value = math.sin(math.radians(-1.40625))
+    above.inputs[1].default_value = math.sin(math.radians(-0.703125))
     tree.links.new(coord.outputs["Generated"], xyz.inputs[0])
     tree.links.new(xyz.outputs["Z"], above.inputs[0])
     tree.links.new(above.outputs[0], tree.nodes["Background"].inputs["Color"])
     m = world_capture.world_map(world)
     row = m.shape[0] // 2  # the first row below the horizon
     np.testing.assert_allclose(m[:row], 1.0, atol=1e-6)
-    np.testing.assert_allclose(m[row], 0.2504, atol=0.002)
+    np.testing.assert_allclose(m[row], 0.2501, atol=0.002)
     np.testing.assert_allclose(m[row + 1:], 0.0, atol=1e-6)
 
 
@@ -157,8 +157,10 @@ def _hdri_world(hot_pixel=None, name="HDRI"):
 
 def test_hdri_is_read_directly_and_agrees_with_cycles(fresh_blend):
     # The direct read (no render) and Cycles' render of the same smooth world agree texel by texel within
-    # 2 % (the render samples each texel's centre, the read averages the pixels in it: a gradient's
-    # mean over a texel is its centre value).
+    # 2 % (both average each texel's directions; over a linear gradient the read's pixel means and the
+    # render's interpolated samples agree). Not in the two pole rows: a map texel there holds the
+    # image's two edge rows, and Cycles' lookup interpolates the samples beyond their centres with the
+    # image's opposite edge (its extension repeats), 6 % off the pixels' own mean at the bottom.
     import time
 
     from addon.bridge import world_capture
@@ -169,7 +171,7 @@ def test_hdri_is_read_directly_and_agrees_with_cycles(fresh_blend):
     read = world_capture.world_map(world)
     read_s = time.perf_counter() - t0
     rendered = world_capture._render_map(world)
-    np.testing.assert_allclose(read, rendered, rtol=0.02)
+    np.testing.assert_allclose(read[1:-1], rendered[1:-1], rtol=0.02)
     assert read_s < 0.5, read_s  # a read, not a render (~1.5 s)
 
 
