@@ -1,0 +1,174 @@
+"""Where the sky pass's error on window-sky comes from: the direct light computed with exact visibility
+through the window, at three levels of the sky pass's model, each against Cycles (docs/DIRECT.md, "What
+limits the sky pass").
+
+    .venv/bin/python tools/window_sky_oracle.py SCENE.blend REFERENCE_DIR [--res 128] [--counts 186 744]
+
+SCENE.blend is window-sky or window-sky-sun (`python -m addon scene NAME`): a closed room whose one
+opening is the north wall's window, a tunnel through the wall, so a ray from inside sees the sky exactly
+when it passes both of the tunnel's ends. REFERENCE_DIR holds Cycles' `direct.exr` of the same camera and
+size. Each pixel's surface point and normal come from Blender's ray cast through the pixel's centre; the
+world is the map Bounce captures (bridge/world_capture.py), each texel sampled at SUB x SUB directions.
+
+- map: the sum over the map's texels of L cos V dw (exact visibility): what the map alone allows;
+- regions, exact fraction: each of `count` regions (world.world_suns, as the sky pass splits them) as
+  its sun (|V_R| along V_R) times the share of its light the point sees, that share exact: the sky
+  pass's model with a perfect shadow filter;
+- regions, hard: each region's light from its one direction, visibility exact there.
+The suns (the scene's SUN lamps, the sky's captured disc) are added with exact visibility to each.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+SUB = 4  # directions per map texel and side
+PIXEL_CHUNK = 128  # pixels per visibility batch (memory: chunk x directions booleans)
+
+
+def surface_points(scene, res: int) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:
+    """(h * w, 3) points and normals facing the camera of each pixel centre's first hit, rows top down,
+    and (h, w)."""
+    import bpy
+
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    cam = scene.camera
+    aspect = scene.render.resolution_x / scene.render.resolution_y
+    w, h = (res, round(res / aspect)) if aspect >= 1 else (round(res * aspect), res)
+    top_right, bottom_right, bottom_left, top_left = (cam.matrix_world @ v for v in cam.data.view_frame(scene=scene))
+    origin = cam.matrix_world.translation
+    points, normals = np.zeros((h * w, 3)), np.zeros((h * w, 3))
+    for i in range(h):
+        for j in range(w):
+            u, v = (j + 0.5) / w, (i + 0.5) / h
+            d = (top_left.lerp(top_right, u).lerp(bottom_left.lerp(bottom_right, u), v) - origin).normalized()
+            hit, location, normal, *_ = scene.ray_cast(depsgraph, origin, d)
+            if not hit:
+                raise SystemExit(f"pixel ({i}, {j}) sees no geometry: not a closed room")
+            points[i * w + j] = location
+            normals[i * w + j] = normal if normal.dot(d) < 0 else -normal
+    return points, normals, (h, w)
+
+
+def window_tunnel(scene) -> tuple[float, float, tuple, tuple]:
+    """The north wall's opening: its inner and outer y and its x and z ranges, from the wall's parts."""
+    from mathutils import Vector
+
+    def box(name):
+        corners = np.array([scene.objects[name].matrix_world @ Vector(c) for c in scene.objects[name].bound_box])
+        return corners.min(axis=0), corners.max(axis=0)
+
+    (left_lo, left_hi), (right_lo, _) = box("NorthWall.Left"), box("NorthWall.Right")
+    (_, below_hi), (above_lo, _) = box("NorthWall.Below"), box("NorthWall.Above")
+    return left_lo[1], left_hi[1], (left_hi[0], right_lo[0]), (below_hi[2], above_lo[2])
+
+
+def sees_sky(points: np.ndarray, towards: np.ndarray, tunnel) -> np.ndarray:
+    """(points, directions) booleans: the ray leaves the room through both ends of the window's tunnel."""
+    y_in, y_out, (x0, x1), (z0, z1) = tunnel
+    out = np.ones((len(points), len(towards)), bool)
+    dy = np.where(towards[:, 1] > 1e-9, towards[:, 1], np.nan)
+    for y in (y_in, y_out):
+        t = (y - points[:, 1:2]) / dy[None, :]
+        x = points[:, 0:1] + t * towards[None, :, 0]
+        z = points[:, 2:3] + t * towards[None, :, 2]
+        out &= (t > 0) & (x >= x0) & (x <= x1) & (z >= z0) & (z <= z1)
+    return out
+
+
+def sub_directions(h: int, w: int):
+    """SUB x SUB directions per map texel that look north (+y: the only way out): unit vectors, solid
+    angles (exact band areas) and their texel's flat index."""
+    edges = np.pi / 2 - np.pi * np.arange(h * SUB + 1) / (h * SUB)
+    lat = 0.5 * (edges[:-1] + edges[1:])
+    lon = 2 * np.pi * (np.arange(w * SUB) + 0.5) / (w * SUB) - np.pi
+    band = 2 * np.pi * (np.sin(edges[:-1]) - np.sin(edges[1:])) / (w * SUB)
+    lat_g, lon_g = np.meshgrid(lat, lon, indexing="ij")
+    towards = np.stack([np.cos(lat_g) * np.cos(lon_g), np.cos(lat_g) * np.sin(lon_g), np.sin(lat_g)], -1)
+    omega = np.repeat(band[:, None], w * SUB, axis=1)
+    texel = np.arange(h * SUB)[:, None] // SUB * w + np.arange(w * SUB)[None, :] // SUB
+    keep = towards[..., 1].ravel() > 1e-6
+    return towards.reshape(-1, 3)[keep], omega.ravel()[keep], texel.ravel()[keep]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("blend")
+    ap.add_argument("reference")
+    ap.add_argument("--res", type=int, default=128)
+    ap.add_argument("--counts", type=int, nargs="+", default=[186, 744])
+    args = ap.parse_args()
+
+    import bpy
+    from mathutils import Vector
+
+    from addon.bridge import world_capture
+    from addon.bridge.images import read_exr
+    from addon.engine import metrics, world
+
+    bpy.ops.wm.open_mainfile(filepath=str(Path(args.blend).resolve()))
+    scene = bpy.context.scene
+    points, normals, size = surface_points(scene, args.res)
+    tunnel = window_tunnel(scene)
+    captured = world_capture.capture(scene.world)
+    radiance = np.asarray(captured.map, np.float64)
+    h, w = radiance.shape[:2]
+    towards, omega, texel = sub_directions(h, w)
+    texel_radiance = radiance.reshape(-1, 3)[texel]
+
+    suns = [(np.asarray(o.matrix_world.to_3x3() @ Vector((0, 0, 1))),
+             o.data.energy * np.asarray(o.data.color)) for o in scene.objects if o.type == "LIGHT"
+            and o.data.type == "SUN"]
+    suns += [(-s.direction, s.sun_strength * s.color) for s in captured.suns]
+    sun_e = np.zeros((len(points), 3))
+    for toward, irradiance in suns:
+        toward = toward / np.linalg.norm(toward)
+        sun_e += (np.maximum(normals @ toward, 0) * sees_sky(points, toward[None], tunnel)[:, 0])[:, None] * irradiance
+
+    reference = read_exr(Path(args.reference) / "direct.exr")[..., :3]
+
+    def report(label: str, sky_e: np.ndarray) -> None:
+        image = ((sky_e + sun_e) / np.pi).reshape(*size, 3)
+        print(f"{label}: rel_rmse_8 {metrics.rel_rmse_8(image, reference):.4f}, "
+              f"bias {metrics.bias(image, reference):.4f}")
+
+    exact = np.zeros((len(points), 3))
+    for a in range(0, len(points), PIXEL_CHUNK):
+        cos = np.maximum(normals[a:a + PIXEL_CHUNK] @ towards.T, 0)
+        exact[a:a + PIXEL_CHUNK] = (cos * sees_sky(points[a:a + PIXEL_CHUNK], towards, tunnel) * omega) @ texel_radiance
+    report(f"map {h} x {w}, exact visibility", exact)
+
+    _, solid_angle = world.directions(h, w)
+    power = (radiance @ world.LUMA) * solid_angle
+    weight = (texel_radiance @ world.LUMA) * omega  # each direction's share of its region's light
+    for count in args.counts:
+        rects = world.regions(power, count, solid_angle)
+        region_of = np.full(h * w, -1)
+        for k, rect in enumerate(rects):
+            region_of[np.arange(h * w).reshape(h, w)[rect].ravel()] = k
+        suns_r = world.world_suns(radiance, count, by_width=True)
+        lit = [k for k, rect in enumerate(rects)
+               if np.any(world.LUMA @ np.einsum("ijc,ijk->ck", radiance[rect], world.texel_vectors(h, w)[rect]))]
+        assert len(lit) == len(suns_r), "world_suns keeps the regions that carry light, in order"
+        fraction_e, hard_e = np.zeros((len(points), 3)), np.zeros((len(points), 3))
+        for sun, k in zip(suns_r, lit, strict=True):
+            toward = -sun.direction
+            light = np.maximum(normals @ toward, 0)[:, None] * (sun.color * sun.sun_strength)
+            mine = region_of[texel] == k
+            if mine.any():
+                share = sees_sky(points, towards[mine], tunnel) @ weight[mine] / weight[mine].sum()
+                fraction_e += light * share[:, None]
+            hard_e += light * sees_sky(points, toward[None], tunnel)[:, 0:1]
+        report(f"{count} regions, exact fraction", fraction_e)
+        report(f"{count} regions, hard", hard_e)
+
+
+if __name__ == "__main__":
+    main()
