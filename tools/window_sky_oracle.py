@@ -29,6 +29,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from addon.engine import world  # noqa: E402  (after the path: the tool runs from anywhere)
+
 SUB = 4  # directions per map texel and side
 PIXEL_CHUNK = 128  # pixels per visibility batch (memory: chunk x directions booleans)
 
@@ -85,14 +87,8 @@ def sees_sky(points: np.ndarray, towards: np.ndarray, tunnel) -> np.ndarray:
 
 def sub_directions(h: int, w: int):
     """SUB x SUB directions per map texel that look north (+y: the only way out): unit vectors, solid
-    angles (exact band areas) and their texel's flat index."""
-    edges = np.pi / 2 - np.pi * np.arange(h * SUB + 1) / (h * SUB)
-    lat = 0.5 * (edges[:-1] + edges[1:])
-    lon = 2 * np.pi * (np.arange(w * SUB) + 0.5) / (w * SUB) - np.pi
-    band = 2 * np.pi * (np.sin(edges[:-1]) - np.sin(edges[1:])) / (w * SUB)
-    lat_g, lon_g = np.meshgrid(lat, lon, indexing="ij")
-    towards = np.stack([np.cos(lat_g) * np.cos(lon_g), np.cos(lat_g) * np.sin(lon_g), np.sin(lat_g)], -1)
-    omega = np.repeat(band[:, None], w * SUB, axis=1)
+    angles (world.directions of the SUB-times finer map) and their texel's flat index."""
+    towards, omega = world.directions(h * SUB, w * SUB)
     texel = np.arange(h * SUB)[:, None] // SUB * w + np.arange(w * SUB)[None, :] // SUB
     keep = towards[..., 1].ravel() > 1e-6
     return towards.reshape(-1, 3)[keep], omega.ravel()[keep], texel.ravel()[keep]
@@ -111,7 +107,7 @@ def main() -> None:
 
     from addon.bridge import world_capture
     from addon.bridge.images import read_exr
-    from addon.engine import metrics, world
+    from addon.engine import metrics
 
     bpy.ops.wm.open_mainfile(filepath=str(Path(args.blend).resolve()))
     scene = bpy.context.scene

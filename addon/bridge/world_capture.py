@@ -9,7 +9,7 @@ itself: Cycles renders the world alone, from a panoramic equirectangular camera 
 MAP_SUPERSAMPLE^2 pixels per texel of the MAP_ROWS x MAP_COLS map, one sample per pixel (camera rays
 see only the background: no noise but the filter, which is narrowed), and each texel is the mean of
 its pixels by solid angle (a texel's centre alone misses the horizon's steep band). That costs about
-0.4 s on this project's 2-core CPU machine (most of it Cycles' scene sync), so the map is cached by a
+0.3 s on this project's 2-core CPU machine (most of it Cycles' scene sync), so the map is cached by a
 fingerprint of the world's node tree and made again only when that changes. A constant background
 (no link into its Color) needs no map: capture.world_color gives it.
 
