@@ -25,25 +25,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from addon.engine import diffusion_reference as ref  # noqa: E402
 
 
-def closed_box(n: int) -> dict:
-    dims = (n, n, n)
-    occ = np.zeros(dims, bool)
-    normal = np.zeros((*dims, 3))
-    proj = np.zeros((*dims, 3))
-    for axis in range(3):
-        for index, sign in ((1, 1.0), (n - 2, -1.0)):  # walls one cell in from the grid's edge, facing in
-            sl = [slice(None)] * 3
-            sl[2 - axis] = index
-            occ[tuple(sl)] = True
-            normal[tuple(sl)] += sign * np.eye(3)[axis]
-            proj[tuple(sl)] = np.maximum(proj[tuple(sl)], np.eye(3)[axis])
-    length = np.linalg.norm(normal, axis=-1, keepdims=True)
-    normal = np.where(length > 0, normal / np.maximum(length, 1e-30), 0.0)
-    return ref.cells(occ, normal, proj)
-
-
 def box_figures(n: int, transfer: str) -> None:
-    cell = closed_box(n)
+    cell = ref.closed_box_cells(n)
     lit = np.zeros((n, n, n))
     mid = n // 2
     lit[1, mid - 5:mid + 5, mid - 5:mid + 5] = 1.0

@@ -147,6 +147,25 @@ def emit(flux_plus: np.ndarray, flux_minus: np.ndarray, normal: np.ndarray, occu
     return np.where(np.asarray(occupied)[..., None], lobes / np.pi, iso)
 
 
+def closed_box_cells(n: int) -> dict[str, np.ndarray]:
+    """`cells` of a closed cube in an n^3 grid: one-cell walls one cell in from the grid's edge, each
+    fully blocking along its normal, which faces into the box (tools/diffusion_box.py, the tests)."""
+    dims = (n, n, n)
+    occ = np.zeros(dims, bool)
+    normal = np.zeros((*dims, 3))
+    proj = np.zeros((*dims, 3))
+    for axis in range(3):
+        for index, sign in ((1, 1.0), (n - 2, -1.0)):
+            sl = [slice(None)] * 3
+            sl[2 - axis] = index
+            occ[tuple(sl)] = True
+            normal[tuple(sl)] += sign * np.eye(3)[axis]
+            proj[tuple(sl)] = np.maximum(proj[tuple(sl)], np.eye(3)[axis])
+    length = np.linalg.norm(normal, axis=-1, keepdims=True)
+    normal = np.where(length > 0, normal / np.maximum(length, 1e-30), 0.0)
+    return cells(occ, normal, proj)
+
+
 # -- one step ------------------------------------------------------------------------------------------
 TRANSFERS = ("cone", "directional")
 
@@ -181,6 +200,28 @@ def face_fluxes(field: np.ndarray, open_faces: np.ndarray, transfer: str = "cone
     return np.where(s > 0.0, raw * (total[..., None] / np.where(s > 0.0, s, 1.0)), 0.0)
 
 
+def carried_shapes(field: np.ndarray, open_faces: np.ndarray, out: np.ndarray, transfer: str) -> np.ndarray:
+    """(z, y, x, 6, 4): the SH each face's flux `out` (`face_fluxes`) arrives as, per W of it.
+    cone: the face's uniform cone. directional: a face that carries light (raw flux > 0, open) carries
+    M_d L plus its share, by raw flux, of the residual L - sum over the carrying faces of M_d L: what the
+    clamped and closed faces' M_d L held. So the faces together carry L itself, and each its flux `out`.
+    A clamped face's lobe has flux <= 0 but still direction; dropping it (scaling the rest to the flux)
+    lost a little of the light's direction at every step, toward isotropy, and a field near a floor
+    turned downward and the floor absorbed its own light (docs/DIFFUSION.md, "Transfers")."""
+    raw, shape = face_transport(field, transfer)
+    if transfer == "cone":
+        return shape
+    moved = shape * raw[..., None]  # M_d L
+    carrying = out > 0.0
+    kept = np.where(carrying[..., None], moved, 0.0)
+    raw_kept = np.where(carrying, raw, 0.0)
+    total = raw_kept.sum(-1, keepdims=True)
+    share = raw_kept / np.where(total > 0.0, total, 1.0)
+    residual = field - kept.sum(-2)
+    carried = kept + share[..., None] * residual[..., None, :]
+    return carried / np.where(carrying, out, 1.0)[..., None]
+
+
 def inflow(out: np.ndarray) -> np.ndarray:
     """(z, y, x, 6, ...): a[j, d] = what neighbour j - d sends through face d into j (0 from outside)."""
     a = np.zeros_like(out)
@@ -208,12 +249,12 @@ def step(field: np.ndarray, cell: dict, transfer: str = "cone") -> tuple[np.ndar
 
     Each cell gathers its neighbours' face fluxes a_d (`face_fluxes`, `inflow`). An occupied cell's
     surface absorbs block[axis(d)] x a_d, split between its sides (`side_weights`); the rest, and all of
-    an empty cell's inflow, is carried on as the transfer's SH per W (`face_transport`): the next field
+    an empty cell's inflow, is carried on as the transfer's SH per W (`carried_shapes`): the next field
     is sum_d carried_d x shape_d, of flux sum_d carried_d (nothing is gained). Absorbed light is not
     re-emitted within the step: each bounce is its own propagation (`emit` makes the next emitters)."""
     out = face_fluxes(field, cell["open"], transfer)
     a = inflow(out)
-    shape = inflow(np.ascontiguousarray(face_transport(field, transfer)[1]))
+    shape = inflow(np.ascontiguousarray(carried_shapes(field, cell["open"], out, transfer)))
     axis_of_face = np.array([axis for axis, _ in AXES])
     absorbed = a * cell["block"][..., axis_of_face]
     carried = a - absorbed

@@ -34,7 +34,7 @@ vec4 directional(vec4 c, int f) {
 
 // Of one channel's field c: the flux sent through `face` once clamped, masked by the open faces and
 // scaled to the cell's flux (returned, W); `carried` = the SH that flux arrives as (the transfer's shape
-// times the flux; DIRECTIONAL: M_d c x open x scale, which is M_d c / raw x the flux without dividing).
+// times the flux; DIRECTIONAL: M_d c x scale plus the face's share of the residual, below).
 float channel_outflow(vec4 c, vec3 open_plus, vec3 open_minus, int face, out vec4 carried) {
     vec3 along = c.wyz;  // the coefficients of x, y, z
     vec3 raw_plus = RAW_K0 * c.x + RAW_K1 * along;
@@ -48,9 +48,18 @@ float channel_outflow(vec4 c, vec3 open_plus, vec3 open_minus, int face, out vec
     float total = max(DIFFUSION_FLUX_PER_C0 * c.x, 0.0);
     float scale = sum > 0.0 ? total / sum : 0.0;
 #ifdef DIRECTIONAL
-    float open = positive ? open_plus[axis] : open_minus[axis];
-    float raw = positive ? raw_plus[axis] : raw_minus[axis];
-    carried = (raw > 0.0 ? open * scale : 0.0) * directional(c, face);
+    // A face that carries light (raw > 0, open) carries M_f c, plus its share (by flux) of the residual
+    // c - sum over carrying faces of M_f c: what the clamped and closed faces' M_f c held (their lobes
+    // have flux <= 0 but still direction). So the faces together carry c itself and the light keeps its
+    // direction; the flux is through x scale either way (diffusion_reference.carried_shapes).
+    vec3 kp = vec3(greaterThan(plus, vec3(0.0)));
+    vec3 km = vec3(greaterThan(minus, vec3(0.0)));
+    vec3 k_axis = kp + km;
+    float kept = dot(k_axis, vec3(1.0));
+    vec4 residual;  // c - sum over the carrying faces of M_f c, in closed form (`directional`)
+    residual.x = c.x * (1.0 - kept / 6.0) - m_cross * dot(kp - km, along);
+    residual.wyz = along * (1.0 - m_side * kept - (m_along - m_side) * k_axis) - m_cross * c.x * (kp - km);
+    carried = through > 0.0 && total > 0.0 ? directional(c, face) + (through / sum) * residual : vec4(0.0);
 #else
     carried = (through * scale * DIFFUSION_TRANSFER_NORM) * diffusion_cone(face);
 #endif
