@@ -218,12 +218,13 @@ def summary(judged: dict) -> dict:
     return s
 
 
-def report(results_path: str, judged: dict, summ: dict, model: choice.Model) -> str:
+def report(results_path: str, arguments: str, judged: dict, summ: dict, model: choice.Model) -> str:
+    """The report's Markdown; `arguments`: the command line's arguments, results first."""
     lines = ["# Choosing a method for an error budget", "",
              f"Model: addon/engine/choice.py fitted on `{results_path}` ({len(model.scenes)} scenes, "
              f"{len(model.rows)} settings), margin x{model.margin:.2f} (its {MARGIN_QUANTILE:.0%} quantile of "
              "measured / predicted, leave-one-scene-out). Produced by `.venv/bin/python tools/fit_choice.py "
-             f"{results_path}`.", "",
+             f"{arguments}`.", "",
              "Each scene judged by a model fitted without it. met: the choice's measured rel_rmse_8 is within the "
              "budget; possible: some measured setting is; within 2x: met, and its time at most twice the fastest "
              "setting measured within the budget; estimate: the choice's predicted error within a factor 1.5 of "
@@ -277,7 +278,8 @@ def main(argv=None) -> int:
     p.add_argument("results", type=Path, nargs="+",
                    help="bench results.json files of one resolution, reference spp and bounce count (their "
                         "records are pooled: e.g. a run of new methods beside an earlier one of the others)")
-    p.add_argument("--cache", type=Path, default=ROOT / "out" / "bench")
+    default_cache = ROOT / "out" / "bench"
+    p.add_argument("--cache", type=Path, default=default_cache)
     p.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "choice")
     p.add_argument("--model", type=Path, default=choice.MODEL_PATH)
     p.add_argument("--ridge", type=float, default=1.0)
@@ -300,7 +302,9 @@ def main(argv=None) -> int:
     args.model.parent.mkdir(parents=True, exist_ok=True)
     args.model.write_text(json.dumps(model.to_json(), indent=1, sort_keys=True) + "\n")
     args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "REPORT.md").write_text(report(" ".join(map(str, args.results)), judged, summ, model))
+    results_path = " ".join(map(str, args.results))
+    arguments = results_path + ("" if args.cache == default_cache else f" --cache {args.cache}")
+    (args.out / "REPORT.md").write_text(report(results_path, arguments, judged, summ, model))
     (args.out / "judged.json").write_text(json.dumps({"summary": summ, **judged}, indent=1) + "\n")
     print(json.dumps(summ))
     return 0 if all(math.isfinite(r["predicted"]) for r in judged["estimates"]) else 1
