@@ -52,7 +52,7 @@ if str(ROOT) not in sys.path:
 
 from addon.engine.updates import update_costs  # noqa: E402
 
-SCENES = ("cornell", "cornell-glossy", "sponza")
+SCENES = ("cornell", "cornell-glossy", "window-sky", "sponza")
 SPONZA = Path("/work/shared/scenes/sponza/sponza.blend")
 EXPORT_SIZE = (1920, 1080)
 LPV_PASSES = ("lpv_inject", "lpv_propagate", "lpv_lookup")
@@ -83,6 +83,7 @@ def save_scene(scene, path_stem: Path, meta: dict | None = None) -> dict:
         camera_visible=np.asarray(visible, bool),
         specular=scene.specular_f0(),
         roughness=scene.glossy_roughness(),
+        **({} if scene.world_map is None else {"world_map": np.asarray(scene.world_map, np.float32)}),
     )
     info = {
         "lights": [{f.name: _jsonable(getattr(light, f.name)) for f in dataclasses.fields(light)}
@@ -130,7 +131,8 @@ def load_scene(path_stem: Path, size: tuple[int, int] | None = None):
                  emission=arrays["emission"], lights=lights,
                  world_color=np.array(info["world_color"], np.float32), camera=camera,
                  warnings=list(info.get("warnings", [])), camera_visible=arrays["camera_visible"],
-                 specular=arrays.get("specular"), roughness=arrays.get("roughness"))  # absent in older exports
+                 specular=arrays.get("specular"), roughness=arrays.get("roughness"),  # absent in older exports
+                 world_map=arrays.get("world_map"))
 
 
 def export(out: Path, names: list[str]) -> None:
@@ -393,33 +395,10 @@ def fed_gpu_ms(be, stamps: GpuTimestamps, method, fn, warmup: int, repeat: int) 
     return {"gpu": summary(gpu), "submit_ms": summary(submit), "ahead_gpu_ms": summary(ahead)}
 
 
-def _patch_gl_library() -> None:
-    """The backend opens libGL for glFramebufferTextureLayer; where libGL.so.1 cannot load (glvnd's
-    libGLX needs libX11, absent on a bare GPU machine) fall back to libOpenGL.so.0 (no X11)."""
-    from addon.engine.backends import moderngl_backend as mb
-
-    original = mb._gl_library
-
-    def gl_library():
-        try:
-            return original()
-        except OSError:
-            for name in ("libOpenGL.so.0", ctypes.util.find_library("OpenGL")):
-                if name:
-                    try:
-                        return ctypes.CDLL(name)
-                    except OSError:
-                        pass
-            raise
-
-    mb._gl_library = gl_library
-
-
 def run(scenes_dir: Path, out: Path, size: tuple[int, int], repeat: int, warmup: int,
-        only_scenes: list[str] | None, only_configs: list[str] | None) -> dict:
+        only_scenes: list[str] | None, only_configs: list[str] | None, budget_s: float | None = None) -> dict:
     from addon.engine.backends.moderngl_backend import ModernGLBackend
 
-    _patch_gl_library()
     out.mkdir(parents=True, exist_ok=True)
     be = ModernGLBackend()
     be.ctx.__enter__()  # keep the context current: the backend then skips eglMakeCurrent per call
@@ -445,38 +424,47 @@ def run(scenes_dir: Path, out: Path, size: tuple[int, int], repeat: int, warmup:
     }
     print(f"renderer: {report['renderer']}; numpy {np.__version__}; gpu timers: {report['timers']['gpu']}",
           flush=True)
-    stems = sorted(p.with_suffix("") for p in scenes_dir.glob("*.npz"))
-    for stem in stems:
-        if only_scenes and stem.name not in only_scenes:
+    stems = [p.with_suffix("") for p in sorted(scenes_dir.glob("*.npz"))
+             if not only_scenes or p.stem in only_scenes]
+    scenes = {stem.name: load_scene(stem, size) for stem in stems}
+    for name, scene in scenes.items():
+        report["scenes"][name] = {"triangles": scene.triangle_count,
+                                  "lights": [light.kind for light in scene.lights], "configs": {}}
+    rows = [(label, settings) for label, settings in configs(max(size))
+            if not only_configs or label in only_configs]
+    # Every method's defaults on every scene first, then the other rows: a run cut short by its budget
+    # still holds each method's default figures.
+    defaults = [row for row in rows if "-" not in row[0]]  # row_label of a method's defaults: its name alone
+    others = [row for row in rows if "-" in row[0]]
+    order = [(n, row) for row in defaults for n in scenes] + [(n, row) for row in others for n in scenes]
+    start = time.perf_counter()
+    for name, (label, settings) in order:
+        if budget_s is not None and time.perf_counter() - start > budget_s:
+            report["skipped_for_budget"] = report.get("skipped_for_budget", 0) + 1
             continue
-        scene = load_scene(stem, size)
-        entry = {"triangles": scene.triangle_count, "lights": [light.kind for light in scene.lights], "configs": {}}
-        report["scenes"][stem.name] = entry
-        for label, settings in configs(max(size)):
-            if only_configs and label not in only_configs:
-                continue
-            t0 = time.perf_counter()
-            try:
-                method = make_method(be, settings)
-                result = time_method(be, method, scene, warmup, repeat, stamps)
-                result["config"] = {group: cfg.to_dict() for group, cfg in settings.items()}
-                grid = getattr(method, "grid", None)
-                if grid is not None:
-                    result["grid_dims"] = list(grid.dims)
-                if hasattr(method, "lpv_config"):
-                    from addon.engine.methods.lpv import iterations_for, near_steps_for
+        scene, entry = scenes[name], report["scenes"][name]
+        t0 = time.perf_counter()
+        try:
+            method = make_method(be, settings)
+            result = time_method(be, method, scene, warmup, repeat, stamps)
+            result["config"] = {group: cfg.to_dict() for group, cfg in settings.items()}
+            grid = getattr(method, "grid", None)
+            if grid is not None:
+                result["grid_dims"] = list(grid.dims)
+            if hasattr(method, "lpv_config"):
+                from addon.engine.methods.lpv import iterations_for, near_steps_for
 
-                    result["propagation_steps"] = iterations_for(method.lpv_config, method.grid)
-                    result["near_steps"] = near_steps_for(method.lpv_config, method.levels[-1].grid)
-                del method
-            except Exception as exc:  # noqa: BLE001 - one failing config must not lose the others
-                result = {"error": f"{type(exc).__name__}: {exc}", "traceback": traceback.format_exc()}
-            entry["configs"][label] = result
-            gpu_total = result.get("gpu", {}).get("total", {}).get("median", float("nan"))
-            msg = result.get("error") or (f"total {result['wall_total']['median']:.3f} ms wall, "
-                                          f"gpu {gpu_total:.3f} ms")
-            print(f"{stem.name:8s} {label:24s} {msg}  ({time.perf_counter() - t0:.1f} s)", flush=True)
-            (out / "timings.json").write_text(json.dumps(report, indent=1))
+                result["propagation_steps"] = iterations_for(method.lpv_config, method.grid)
+                result["near_steps"] = near_steps_for(method.lpv_config, method.levels[-1].grid)
+            del method
+        except Exception as exc:  # noqa: BLE001 - one failing config must not lose the others
+            result = {"error": f"{type(exc).__name__}: {exc}", "traceback": traceback.format_exc()}
+        entry["configs"][label] = result
+        gpu_total = result.get("gpu", {}).get("total", {}).get("median", float("nan"))
+        msg = result.get("error") or (f"total {result['wall_total']['median']:.3f} ms wall, "
+                                      f"gpu {gpu_total:.3f} ms")
+        print(f"{name:8s} {label:24s} {msg}  ({time.perf_counter() - t0:.1f} s)", flush=True)
+        (out / "timings.json").write_text(json.dumps(report, indent=1))
     (out / "timings.json").write_text(json.dumps(report, indent=1))
     (out / "timings.md").write_text(markdown(report))
     return report
@@ -562,12 +550,19 @@ def main(argv: list[str] | None = None) -> int:
     rn.add_argument("--warmup", type=int, default=3)
     rn.add_argument("--only-scenes", nargs="*")
     rn.add_argument("--only-configs", nargs="*")
+    md = sub.add_parser("markdown", help="timings.md from a timings.json (a run cut short writes only the json)")
+    md.add_argument("json", type=Path)
+    rn.add_argument("--budget-s", type=float, help="start no new (scene, config) after this many seconds")
     args = ap.parse_args(argv)
     if args.cmd == "export":
         export(args.out, args.scenes)
         return 0
+    if args.cmd == "markdown":
+        print(markdown(json.loads(args.json.read_text())), end="")
+        return 0
     w, h = (int(v) for v in args.res.lower().split("x"))
-    report = run(args.scenes, args.out, (w, h), args.repeat, args.warmup, args.only_scenes, args.only_configs)
+    report = run(args.scenes, args.out, (w, h), args.repeat, args.warmup, args.only_scenes, args.only_configs,
+                 args.budget_s)
     print(markdown(report))
     return 0
 

@@ -44,10 +44,13 @@ class _Target(Target):
 def _gl_library():
     """libGL entry points for the calls moderngl lacks: attaching a 3D-texture layer to an FBO, clearing
     depth alone."""
-    for name in ("GL", "OpenGL"):
-        path = ctypes.util.find_library(name)
+    # glvnd's libGL needs libGLX and so libX11, which a headless machine may lack; libOpenGL needs neither.
+    for path in (ctypes.util.find_library("GL"), ctypes.util.find_library("OpenGL"), "libOpenGL.so.0"):
         if path:
-            return ctypes.CDLL(path)
+            try:
+                return ctypes.CDLL(path)
+            except OSError:
+                continue
     raise BackendUnavailable("libGL not found: cannot draw into 3D-texture layers")
 
 
