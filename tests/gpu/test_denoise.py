@@ -235,3 +235,32 @@ def test_iterations_never_read_what_they_write(gl):
         denoise.run(gl, gbuf, tex[1], tex[1], tex[2])
     with pytest.raises(ValueError, match="scratch"):
         denoise.run(gl, gbuf, tex[1], tex[2], None, denoise.Params(iterations=2))
+
+
+@pytest.mark.parametrize("products", [2, 3])
+def test_products_filtered_together_come_out_as_alone(gl, products):
+    # One dispatch filters several products with G-buffer weights computed once; the guided iteration's
+    # luminance weights stay per product. Each output must equal that product filtered alone: the same
+    # float32 operations in the same order, so to rounding (values ~1; 1e-6 allows a compiler's
+    # reassociation of the unrolled loops).
+    rng = np.random.default_rng(5)
+    pos, nrm = floor_and_sphere(64)
+    size = (pos.shape[1], pos.shape[0])
+    ramp = np.linspace(0.0, 4.0, size[0])[None, :, None]  # a real gradient the guided iteration keeps
+    inputs = [rng.uniform(0.0, 2.0, pos.shape) * pos[..., 3:] * (1.0 + k * ramp) for k in range(products)]
+    tex = lambda a: gl.texture(size, data=np.asarray(a, np.float32))  # noqa: E731
+    gbuf = {"position": tex(pos), "normal": tex(nrm)}
+    outs = [gl.texture(size) for _ in inputs]
+    denoise.run(gl, gbuf, [tex(a) for a in inputs], outs, [gl.texture(size) for _ in inputs], PARAMS)
+    for image, out in zip(inputs, outs, strict=True):
+        np.testing.assert_allclose(gl.read(out), on_gpu(gl, pos, nrm, image), atol=1e-6)
+
+
+def test_product_lists_must_match(gl):
+    # Lists of unequal length, and more products than one dispatch binds, are refused.
+    tex = [gl.texture((4, 4)) for _ in range(13)]
+    gbuf = {"position": tex[0], "normal": tex[0]}
+    with pytest.raises(ValueError, match="as many"):
+        denoise.run(gl, gbuf, tex[1:3], tex[3:5], tex[5:6])
+    with pytest.raises(ValueError, match="products per dispatch"):
+        denoise.run(gl, gbuf, tex[1:5], tex[5:9], tex[9:13])

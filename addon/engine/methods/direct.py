@@ -495,20 +495,23 @@ class DirectMethod:
         averaged in (accumulate); the mean is filtered into `shown` (GIConfig.denoise) and shown."""
         self.samples = 1 if first else self.samples + 1
         iterations = denoise.iterations_for(max(self.gbuf["position"].size))
-        for name, roles in self._noisy.items():
+        for roles in self._noisy.values():
             if first:
                 roles["raw"], roles["mean"] = roles["mean"], roles["raw"]
             else:
                 with self.step(timings, accumulate.DECL):
                     accumulate.run(self.backend, roles["raw"], roles["mean"], 1.0 / self.samples)
-            shown = roles["mean"]
-            if self.gi.denoise:
-                with self.step(timings, denoise.DECL):
-                    denoise.run(self.backend, self.gbuf, roles["mean"], roles["shown"], roles["scratch"],
-                                denoise.Params(iterations=iterations))
-                shown = roles["shown"]
-            self._products[name] = shown
-            setattr(self, name, shown)
+        shown = "mean"
+        if self.gi.denoise and self._noisy:
+            # All noisy products in the same dispatches: their G-buffer weights are computed once.
+            roles = list(self._noisy.values())
+            with self.step(timings, denoise.DECL):
+                denoise.run(self.backend, self.gbuf, [r["mean"] for r in roles], [r["shown"] for r in roles],
+                            [r["scratch"] for r in roles], denoise.Params(iterations=iterations))
+            shown = "shown"
+        for name, roles in self._noisy.items():
+            self._products[name] = roles[shown]
+            setattr(self, name, roles[shown])
 
     def refine(self) -> dict[str, float]:
         """One more gather of the noisy products, the next sample (`sample_index`), averaged into them:
