@@ -1,15 +1,15 @@
-"""Full-update timings of every method on a real GPU, for the issue's targets (LPV: one spot light's
-injection, propagation and lookup at 1920x1080 <= 1 ms at 32^3, <= 3 ms at 64^3; VCT later).
+"""Full-update timings of every method on a real GPU at 1920 x 1080 (benchmarks/gpu/REPORT.md).
 
 Two steps, because the GPU machine has no Blender:
 
     # here (bpy from .venv): capture the scenes into .npz + .json files the engine reads without bpy
     .venv/bin/python tools/gpu_timing.py export --out .gpubench
     # anywhere with moderngl and an EGL OpenGL 4.3 context (the GPU machine; llvmpipe for a smoke test)
-    python3 tools/gpu_timing.py run --scenes .gpubench --out DIR [--res 1920x1080] [--repeat 20]
+    python3 tools/gpu_timing.py run --scenes .gpubench --out DIR [--res 1920x1080] [--repeat 20] [--budget-s S]
 
 `run` times each (scene, method config: every registry benchmark row and EXTRA_ROWS) after `set_scene`
-and 3 warm-up updates:
+and 3 warm-up updates, every method's defaults on every scene first, then the other rows; with
+--budget-s it starts none after S seconds:
   wall_total   compute() with method.profile off, then one backend.finish(): what an update costs
   update_ms    updates.update_costs: a geometry change, every light moved 1 cm, the camera moved 1 cm
   gpu_*        GL timestamp queries (glQueryCounter) around every pass, no waits between passes
@@ -17,18 +17,20 @@ and 3 warm-up updates:
   voxelize     a full re-voxelization (every layer redrawn: Voxelizer.invalidate, then run), GPU and wall
   *_fed        the voxelization and LPV's propagation with an update's GPU work queued ahead (fed_gpu_ms):
                their GPU work alone, where Python submits their many dispatches slower than the GPU runs them
-It writes timings.json and timings.md into DIR.
+It writes timings.json after every (scene, config) and timings.md at the end; `markdown JSON` rebuilds
+the .md of a run cut short.
 
 On the lent GPU machine (no moderngl there): carry .whl (cp312 wheels of moderngl 5.13.0 and glcontext
 3.1.0), .gl (glvnd debs: libegl1 libglvnd0 libopengl0 libgl1 libglx0 libgles2) and .gpubench, then
     for f in .gl/*.deb; do dpkg -x $f /; done; ldconfig;
     export __EGL_VENDOR_LIBRARY_FILENAMES=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json;
     python3 -m pip install -q --no-index --no-deps --target /tmp/site .whl/*.whl;
-    PYTHONPATH=/tmp/site:$PWD python3 tools/gpu_timing.py run --scenes .gpubench --out $OUT
-Raster passes (gbuffer, rsm, lpv_inject, vct_inject, voxelize) are far slower on an H100 than on a
-graphics GPU: few of its units run vertex/fragment work. Its compute-pass figures are the meaningful ones.
-The backend's GL context is made current once and
-kept current (a standalone process), so no eglMakeCurrent per backend call is counted.
+    PYTHONPATH=/tmp/site:$PWD python3 tools/gpu_timing.py run --scenes .gpubench --out $OUT --repeat 10 --budget-s 320
+(327 s on an H200: every method's defaults on the four scenes and some rows.) Raster passes (gbuffer,
+rsm, the injections, voxelize) are far slower on a compute GPU (H100, H200) than on a graphics GPU: few
+of its units run vertex/fragment work. Its compute-pass figures are the meaningful ones. The backend's
+GL context is made current once and kept current (a standalone process), so no eglMakeCurrent per
+backend call is counted.
 """
 
 from __future__ import annotations

@@ -28,6 +28,10 @@ OCTREE_JSON = ROOT / "benchmarks" / "octree" / "results.json"
 DIFFUSION_DOC = ROOT / "docs" / "DIFFUSION.md"
 PROBES_DOC = ROOT / "docs" / "PROBES.md"
 PROBES_JSON = ROOT / "benchmarks" / "probes" / "results.json"
+# The GPU runs (tools/gpu_timing.py on a lent GPU; benchmarks/gpu/REPORT.md), in order: a later run's
+# figure for a (scene, setting) replaces an earlier one's.
+GPU_JSON = tuple(ROOT / "benchmarks" / "gpu" / f"h200-{run}.json" for run in ("timings", "rows", "denoise"))
+GPU_SCENES = ("cornell", "window-sky", "sponza")
 DIFFUSION_JSON = (ROOT / "benchmarks" / "diffusion" / "b1" / "results.json",
                   ROOT / "benchmarks" / "diffusion" / "b2" / "results.json")
 LPV_CAMERA_TARGET_PCT = 15  # the issue's target: lpv's camera update <= 15 % of its full update
@@ -364,10 +368,43 @@ def encodings_block(results: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def gpu_block(*runs: dict) -> str:
+    """Table: each method's light and camera updates at its defaults on a GPU at 1920 x 1080, per scene;
+    then the denoise filter's share of vct's update (the issue's target). The runs' geometry changes
+    are left out: their set-up re-made every camera-sized image then (REPORT.md)."""
+    configs: dict[tuple[str, str], dict] = {}
+    for run in runs:
+        for scene, entry in run["scenes"].items():
+            for label, result in entry["configs"].items():
+                if "error" not in result:
+                    configs[(scene, label)] = result
+    last = runs[-1]
+    w, h = last["size"]
+    methods = list(dict.fromkeys(label for (_, label) in configs if "-" not in label))
+    lines = [f"**On a GPU** ({last['renderer'].split(' / ')[1].split('/')[0]}, OpenGL through EGL, no Blender: the "
+             f"scenes captured here and timed there by `tools/gpu_timing.py`; {w} x {h}; medians of "
+             f"{last['repeat']} updates of each kind; `benchmarks/gpu/REPORT.md` gives the runs and their code). "
+             "ms per update: every light moved 1 cm / the camera moved 1 cm.", "",
+             "| method | " + " | ".join(GPU_SCENES) + " |", "| --- |" + " --- |" * len(GPU_SCENES)]
+    for method in methods:
+        cells = []
+        for scene in GPU_SCENES:
+            u = configs.get((scene, method), {}).get("update_ms")
+            cells.append("–" if u is None else f"{u['lights']:.1f} / {u['camera']:.1f}")
+        lines.append(f"| {method} | " + " | ".join(cells) + " |")
+    shares = [(s, configs[(s, "vct")]) for s in GPU_SCENES if (s, "vct") in configs]
+    if shares:
+        lines += ["", "vct's denoise filter (GPU time) costs " + ", ".join(
+            f"{100 * r['gpu']['denoise']['median'] / r['wall_total']['median']:.0f} % on {s}" for s, r in shares)
+            + " of its update (target <= 20 %)."]
+    return "\n".join(lines) + "\n"
+
+
 # block name -> (the file it is in, its results.json file(s), the function that formats them)
 BLOCKS: dict[str, tuple[Path, tuple[Path, ...], Callable[..., str]]] = {
     "headline": (README, (DEFAULTS_JSON, EEVEE_JSON), headline_block),
     "update-costs": (README, (UPDATES_JSON,), update_costs_block),
+    "gpu": (README, GPU_JSON, gpu_block),
     "accuracy": (README, (DEFAULTS_JSON,), accuracy_block),
     "methods": (README, (DEFAULTS_JSON,), methods_block),
     "lpv-octree": (LPV_DOC, (OCTREE_JSON,), octree_block),

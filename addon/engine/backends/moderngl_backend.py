@@ -184,7 +184,10 @@ class ModernGLBackend(Backend):
         if len(size) == 3:
             gl.repeat_z = False
         tex = Texture(tuple(size), fmt, gl)
-        self.write(tex, np.zeros(tuple(reversed(size)) + (comps,), np.float32) if data is None else data)
+        if data is None:  # zeros, as bytes: no float32 array to convert (a 1080p RGBA32F image is 33 MB)
+            gl.write(bytes(int(np.prod(size)) * comps * np.dtype(dtype).itemsize))
+        else:
+            self.write(tex, data)
         return tex
 
     @_in_own_context

@@ -187,7 +187,10 @@ class DirectMethod:
         self.vpl_shares: dict[int, float] = {}
         self._solved_for = None  # lights_key of the light field on the GPU; None: none is
         self.solves = 0          # how many updates solved (bakes report it)
-        self._size = None
+        # The camera-sized images stay when the camera's size does (a geometry change rewrites them all;
+        # at 1920 x 1080 re-making them cost ~200 ms of a geometry change); only the running average of
+        # the noisy products restarts.
+        self.samples = 0
         self._allocate_images()
 
     def _rsm_slot(self, index: int) -> tuple[dict, object]:
