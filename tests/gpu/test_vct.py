@@ -556,3 +556,37 @@ def test_the_worlds_bounce_comes_through_an_opening_as_its_light_does(gl):
     assert np.isfinite(ours).all() and ours.min() >= 0.0
     assert np.sqrt(np.mean((ours - exact) ** 2)) / exact.mean() < 0.4
     assert ours.mean() / exact.mean() == pytest.approx(1.0, abs=0.06)
+
+
+def test_the_filter_leaves_out_glossy_light_where_nothing_is_glossy(gl):
+    # The specular cones write exactly 0 where F0 is 0 (glossy.comp.glsl), so without a glossy lobe in the
+    # scene the glossy image is 0 and the denoise filter leaves it out (VctMethod.known_zero); with one
+    # (F0 0.04 everywhere, a dielectric) it is light, and filtered with the other products.
+    import sys
+    from dataclasses import replace
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "hard"))
+    from hard_scenes import camera, room_with_a_roof_opening
+    from hard_scenes import scene as make_scene
+
+    from addon.engine import methods
+    from addon.engine.config import GIConfig, RsmConfig
+    from addon.engine.world import constant_map
+
+    geometry, _ = room_with_a_roof_opening(0.6)
+    matte = replace(make_scene(geometry, [], camera([0, -0.9, 1.0], [0, 1, -0.5], size=16)),
+                    world_map=constant_map(np.full(3, 2.0, np.float32)))
+    triangles = len(matte.positions_m)
+    glossy = replace(matte, specular=np.full((triangles, 3), 0.04, np.float32),
+                     roughness=np.full(triangles, 0.3, np.float32))
+    for scene, expect_light in ((matte, False), (glossy, True)):
+        method = methods.create(gl, {"gi": GIConfig(method="vct"), "rsm": RsmConfig(resolution=64, sky_directions=16),
+                                     "vct": VctConfig(voxel_cells=32)})
+        method.set_scene(scene)
+        method.run()
+        image = gl.read(method.glossy)[..., :3]
+        assert method.known_zero("glossy") == (not expect_light)
+        assert not method.known_zero("indirect") and not method.known_zero("ao")
+        assert bool(image.max() > 0.0) == expect_light
+        assert np.isfinite(image).all() and image.min() >= 0.0

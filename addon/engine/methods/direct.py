@@ -504,17 +504,22 @@ class DirectMethod:
             else:
                 with self.step(timings, accumulate.DECL):
                     accumulate.run(self.backend, roles["raw"], roles["mean"], 1.0 / self.samples)
-        shown = "mean"
-        if self.gi.denoise and self._noisy:
+        filtered = [name for name in self._noisy if self.gi.denoise and not self.known_zero(name)]
+        if filtered:
             # All noisy products in the same dispatches: their G-buffer weights are computed once.
-            roles = list(self._noisy.values())
+            roles = [self._noisy[name] for name in filtered]
             with self.step(timings, denoise.DECL):
                 denoise.run(self.backend, self.gbuf, [r["mean"] for r in roles], [r["shown"] for r in roles],
                             [r["scratch"] for r in roles], denoise.Params(iterations=iterations))
-            shown = "shown"
         for name, roles in self._noisy.items():
-            self._products[name] = roles[shown]
-            setattr(self, name, roles[shown])
+            shown = roles["shown" if name in filtered else "mean"]
+            self._products[name] = shown
+            setattr(self, name, shown)
+
+    def known_zero(self, product: str) -> bool:
+        """Whether `product` is 0 at every pixel for the current scene, so that filtering it is wasted
+        work (vct's glossy light without glossy materials)."""
+        return False
 
     def refine(self) -> dict[str, float]:
         """One more gather of the noisy products, the next sample (`sample_index`), averaged into them:
