@@ -12,7 +12,8 @@ and 3 warm-up updates, every method's defaults on every scene first, then the ot
 --budget-s it starts none after S seconds:
   wall_total   compute() with method.profile off, then one backend.finish(): what an update costs
   update_ms    updates.update_costs: a geometry change, every light moved 1 cm, the camera moved 1 cm
-  gpu_*        GL timestamp queries (glQueryCounter) around every pass, no waits between passes
+  gpu          GL timestamp queries (glQueryCounter) around every pass, no waits between passes
+  gpu_camera   the same for camera moves alone (the solve kept where the method keeps its light field)
   wall_pass_*  method.profile on: glFinish before and after every pass (stalls; per-pass upper bound)
   voxelize     a full re-voxelization (every layer redrawn: Voxelizer.invalidate, then run), GPU and wall
   *_fed        the voxelization and LPV's propagation with an update's GPU work queued ahead (fed_gpu_ms):
@@ -316,22 +317,31 @@ def time_method(be, method, scene, warmup: int, repeat: int, stamps: GpuTimestam
     # the three kinds of update a user makes (a geometry change, lights moved, camera moved), medians
     res["update_ms"] = update_costs(method, repeat)
 
-    # 2. GPU timestamps per pass (no waits between passes)
+    # 2. GPU timestamps per pass (no waits between passes): a whole update, and a camera move alone (the
+    # camera moved 1 cm and back, as update_costs moves it), so a camera update's passes are known too
     if stamps.available:
         method.profile = True
         method.timed = stamps.timed  # instance attribute shadows DirectMethod.timed
+        camera = scene.camera
+        view = camera.view.copy()
+        view[0, 3] -= 0.01
+        moved = dataclasses.replace(camera, view=view)
         try:
-            runs = []
-            for i in range(warmup + repeat):
-                stamps.begin_update()
-                method.compute(solve=True)
-                be.finish()
-                r = stamps.end_update()
-                if i >= warmup:
-                    runs.append(r)
-            res["gpu"] = per_pass(runs)
+            for name, update in (("gpu", lambda i: method.compute(solve=True)),
+                                 ("gpu_camera", lambda i: (method.set_camera(moved if i % 2 == 0 else camera),
+                                                           method.compute()))):
+                runs = []
+                for i in range(warmup + repeat):
+                    stamps.begin_update()
+                    update(i)
+                    be.finish()
+                    r = stamps.end_update()
+                    if i >= warmup:
+                        runs.append(r)
+                res[name] = per_pass(runs)
         finally:
             del method.timed
+            method.set_camera(camera)
 
     # 3. method.profile: glFinish around every pass
     method.profile = True
@@ -534,6 +544,8 @@ def markdown(report: dict) -> str:
             passes = list(dict.fromkeys([*gpu, *wall]))
             lines.append(f"**{scene} / {label}**: " + ", ".join(
                 f"{p} {_fmt(gpu.get(p))} | {_fmt(wall.get(p))}" for p in passes))
+            if "gpu_camera" in r:
+                lines.append("camera move, GPU: " + ", ".join(f"{p} {_fmt(v)}" for p, v in r["gpu_camera"].items()))
             lines.append("")
     return "\n".join(lines) + "\n"
 
