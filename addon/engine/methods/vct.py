@@ -177,8 +177,8 @@ class VctMethod(OneBounceMethod):
             self._flush_light()
 
     def known_zero(self, product: str) -> bool:
-        # The specular cones write 0 where F0 is 0; the filter then skips the glossy image (at 1080p on a
-        # GPU a third of the filter's per-product work).
+        # The specular cones write 0 where F0 is 0, so without a glossy lobe the filter's dispatches read
+        # two images instead of three.
         return product == "glossy" and not bool(np.any(self.scene.specular_f0() > 0))
 
     def gather_pixels(self, timings: dict[str, float]) -> None:
