@@ -21,13 +21,9 @@ and 3 warm-up updates, every method's defaults on every scene first, then the ot
 It writes timings.json after every (scene, config) and timings.md at the end; `markdown JSON` rebuilds
 the .md of a run cut short.
 
-On the lent GPU machine (no moderngl there): carry .whl (cp312 wheels of moderngl 5.13.0 and glcontext
-3.1.0), .gl (glvnd debs: libegl1 libglvnd0 libopengl0 libgl1 libglx0 libgles2) and .gpubench, then
-    for f in .gl/*.deb; do dpkg -x $f /; done; ldconfig;
-    export __EGL_VENDOR_LIBRARY_FILENAMES=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json;
-    python3 -m pip install -q --no-index --no-deps --target /tmp/site .whl/*.whl;
-    PYTHONPATH=/tmp/site:$PWD python3 tools/gpu_timing.py run --scenes .gpubench --out $OUT --repeat 10 --budget-s 320
-(327 s on an H200: every method's defaults on the four scenes and some rows.) Raster passes (gbuffer,
+On a lent GPU machine (no moderngl, no GL loader there), after `tools/gpu_timing.py prepare` here:
+the device tool's run with command `bash tools/gpu_device.sh` and carry [".gl", ".whl", ".gpubench"]
+(its timing part took 327 s on an H200: every method's defaults on the four scenes, then some rows). Raster passes (gbuffer,
 rsm, the injections, voxelize) are far slower on a compute GPU (H100, H200) than on a graphics GPU: few
 of its units run vertex/fragment work. Its compute-pass figures are the meaningful ones. The backend's
 GL context is made current once and kept current (a standalone process), so no eglMakeCurrent per
@@ -550,9 +546,41 @@ def markdown(report: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+# What the GPU machine lacks, fetched here by `prepare` by name from Debian's archive and PyPI: glvnd's
+# EGL/GL loaders (the machine has NVIDIA's driver but no loader) and moderngl for its Python 3.12.
+GL_DEBS = ("libegl1", "libglvnd0", "libopengl0", "libgl1", "libglx0", "libgles2")
+WHEELS = ("moderngl==5.13.0", "glcontext==3.1.0")
+WHEEL_PLATFORMS = ("manylinux_2_28_x86_64", "manylinux_2_27_x86_64", "manylinux_2_17_x86_64", "manylinux2014_x86_64",
+                   "manylinux1_x86_64")
+
+
+def prepare() -> None:
+    """.gl (the loaders' .deb files), .whl (cp312 wheels) and .gpubench (the scenes), each listed in
+    .git/info/exclude so they travel only where `carry` names them (tools/gpu_device.sh)."""
+    import subprocess
+
+    exclude = ROOT / ".git" / "info" / "exclude"
+    if exclude.parent.is_dir():
+        listed = exclude.read_text().split() if exclude.is_file() else []
+        with exclude.open("a") as f:
+            f.writelines(f"{p}\n" for p in ("/.gl/", "/.whl/", "/.gpubench/") if p not in listed)
+    lists = Path("/tmp/bounce-amd64-lists")
+    (lists / "partial").mkdir(parents=True, exist_ok=True)
+    apt = ["apt-get", "-oAPT::Architecture=amd64", "-oAPT::Architectures=amd64", f"-oDir::State::Lists={lists}"]
+    subprocess.run([*apt, "update"], check=True, stdout=subprocess.DEVNULL)
+    (ROOT / ".gl").mkdir(exist_ok=True)
+    subprocess.run([*apt, "download", *GL_DEBS], check=True, cwd=ROOT / ".gl")
+    subprocess.run([sys.executable, "-m", "pip", "download", "-q", "--no-deps", "--only-binary=:all:",
+                    "--python-version", "3.12", "--implementation", "cp",
+                    *(a for p in WHEEL_PLATFORMS for a in ("--platform", p)), "-d", str(ROOT / ".whl"), *WHEELS],
+                   check=True)
+    export(ROOT / ".gpubench", list(SCENES))
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
+    sub.add_parser("prepare", help="here, before a GPU run: .gl, .whl and .gpubench for tools/gpu_device.sh")
     ex = sub.add_parser("export", help="capture the scenes (needs bpy)")
     ex.add_argument("--out", type=Path, default=Path(".gpubench"))
     ex.add_argument("--scenes", nargs="*", default=list(SCENES))
@@ -568,6 +596,9 @@ def main(argv: list[str] | None = None) -> int:
     md.add_argument("json", type=Path)
     rn.add_argument("--budget-s", type=float, help="start no new (scene, config) after this many seconds")
     args = ap.parse_args(argv)
+    if args.cmd == "prepare":
+        prepare()
+        return 0
     if args.cmd == "export":
         export(args.out, args.scenes)
         return 0
