@@ -23,11 +23,11 @@ the .md of a run cut short.
 
 On a lent GPU machine (no moderngl, no GL loader there), after `tools/gpu_timing.py prepare` here:
 the device tool's run with command `bash tools/gpu_device.sh` and carry [".gl", ".whl", ".gpubench"]
-(its timing part took 327 s on an H200: every method's defaults on the four scenes, then some rows). Raster passes (gbuffer,
-rsm, the injections, voxelize) are far slower on a compute GPU (H100, H200) than on a graphics GPU: few
-of its units run vertex/fragment work. Its compute-pass figures are the meaningful ones. The backend's
-GL context is made current once and kept current (a standalone process), so no eglMakeCurrent per
-backend call is counted.
+(its timing part took 327 s on an H200: every method's defaults on the four scenes, then some rows).
+Raster passes (gbuffer, rsm, the injections, voxelize) are far slower on a compute GPU (H100, H200) than
+on a graphics GPU: few of its units run vertex/fragment work. Its compute-pass figures are the
+meaningful ones. The backend's GL context is made current once and kept current (a standalone
+process), so no eglMakeCurrent per backend call is counted.
 """
 
 from __future__ import annotations
@@ -403,6 +403,14 @@ def fed_gpu_ms(be, stamps: GpuTimestamps, method, fn, warmup: int, repeat: int) 
     return {"gpu": summary(gpu), "submit_ms": summary(submit), "ahead_gpu_ms": summary(ahead)}
 
 
+def run_order(scenes: list[str], rows: list[tuple[str, dict]]) -> list[tuple[str, tuple[str, dict]]]:
+    """(scene, row) pairs: every method's defaults on every scene first, then the other rows, so a run cut
+    short by its budget still holds each method's default figures."""
+    defaults = [row for row in rows if "-" not in row[0]]  # row_label of a method's defaults: its name alone
+    others = [row for row in rows if "-" in row[0]]
+    return [(n, row) for row in defaults for n in scenes] + [(n, row) for row in others for n in scenes]
+
+
 def run(scenes_dir: Path, out: Path, size: tuple[int, int], repeat: int, warmup: int,
         only_scenes: list[str] | None, only_configs: list[str] | None, budget_s: float | None = None) -> dict:
     from addon.engine.backends.moderngl_backend import ModernGLBackend
@@ -440,11 +448,7 @@ def run(scenes_dir: Path, out: Path, size: tuple[int, int], repeat: int, warmup:
                                   "lights": [light.kind for light in scene.lights], "configs": {}}
     rows = [(label, settings) for label, settings in configs(max(size))
             if not only_configs or label in only_configs]
-    # Every method's defaults on every scene first, then the other rows: a run cut short by its budget
-    # still holds each method's default figures.
-    defaults = [row for row in rows if "-" not in row[0]]  # row_label of a method's defaults: its name alone
-    others = [row for row in rows if "-" in row[0]]
-    order = [(n, row) for row in defaults for n in scenes] + [(n, row) for row in others for n in scenes]
+    order = run_order(list(scenes), rows)
     start = time.perf_counter()
     for name, (label, settings) in order:
         if budget_s is not None and time.perf_counter() - start > budget_s:

@@ -76,3 +76,31 @@ def test_configs_are_every_registry_row_and_the_gpu_extras():
     for label, settings in rows:
         assert label.split("-")[0] == settings["gi"].method and settings["gi"].resolution == 360
     assert "vct-voxel_cells64-diffuse_cones6-gather_scale2" in labels
+
+
+def test_a_world_map_round_trips(tmp_path):
+    # A sky-lit scene is timed with its radiance map: save_scene keeps it (float32), and a scene without
+    # one loads without one.
+    from dataclasses import replace
+
+    sky = np.random.default_rng(0).uniform(0.0, 3.0, (8, 16, 3)).astype(np.float32)
+    gpu_timing.save_scene(replace(_scene(), world_map=sky), tmp_path / "sky")
+    gpu_timing.save_scene(_scene(), tmp_path / "plain")
+    np.testing.assert_array_equal(gpu_timing.load_scene(tmp_path / "sky").world_map, sky)
+    assert gpu_timing.load_scene(tmp_path / "plain").world_map is None
+
+
+def test_every_methods_defaults_come_before_other_rows():
+    rows = [(label, {}) for label in ("direct", "direct-resolution256", "rsm", "rsm-vpl_samples64")]
+    order = [(scene, label) for scene, (label, _) in gpu_timing.run_order(["a", "b"], rows)]
+    assert order == [("a", "direct"), ("b", "direct"), ("a", "rsm"), ("b", "rsm"), ("a", "direct-resolution256"),
+                     ("b", "direct-resolution256"), ("a", "rsm-vpl_samples64"), ("b", "rsm-vpl_samples64")]
+
+
+def test_a_spent_budget_starts_nothing_and_still_writes_the_tables(tmp_path):
+    gpu_timing.save_scene(_scene(), tmp_path / "s")
+    report = gpu_timing.run(tmp_path, tmp_path / "out", (32, 18), repeat=1, warmup=0, only_scenes=None,
+                            only_configs=["direct-resolution256", "direct"], budget_s=0.0)
+    assert report["skipped_for_budget"] == 2
+    assert all(not entry["configs"] for entry in report["scenes"].values())
+    assert (tmp_path / "out" / "timings.json").is_file() and (tmp_path / "out" / "timings.md").is_file()
