@@ -64,6 +64,7 @@ class VctMethod(OneBounceMethod):
         super().set_scene(scene)
         be, cfg = self.backend, self.vct_config
         self._albedo_max = float(self.scene.albedo.max()) if len(self.scene.albedo) else 0.0
+        self._glossy_anywhere = bool(np.any(self.scene.specular_f0() > 0))  # known_zero, once per geometry
         grid = Grid.fit(*self.bounds_m, max_cells=cfg.voxel_cells)
         if grid.same_cells(self.grid):
             self.voxelizer.update(self.scene)
@@ -179,7 +180,7 @@ class VctMethod(OneBounceMethod):
     def known_zero(self, product: str) -> bool:
         # The specular cones write 0 where F0 is 0, so without a glossy lobe the filter's dispatches read
         # two images instead of three.
-        return product == "glossy" and not bool(np.any(self.scene.specular_f0() > 0))
+        return product == "glossy" and not self._glossy_anywhere
 
     def gather_pixels(self, timings: dict[str, float]) -> None:
         with self.step(timings, vct_gather.PIXELS_DECL):
