@@ -292,14 +292,17 @@ def main(argv=None) -> int:
     args = p.parse_args(argv)
     runs = [json.loads(path.read_text()) for path in args.results]
     results = runs[0]
-    if any((r["res"], r["ref_spp"], r["bounces"]) != (results["res"], results["ref_spp"], results["bounces"])
-           for r in runs):
-        raise SystemExit("the results differ in resolution, reference spp or bounces: errors would not compare")
+    def judged_by(r):  # what the errors were measured against
+        return r["res"], r["ref_spp"], r.get("ref_noise"), r["bounces"]
+
+    if any(judged_by(r) != judged_by(results) for r in runs):
+        raise SystemExit("the results differ in resolution, references or bounces: errors would not compare")
     records = [rec for r in runs for rec in records_of(r)]
     features = scene_features(args.cache, sorted({r["scene"] for r in records}), results["bounces"], results["res"])
     models = held_out(records, features, args.ridge)
     judged = judge(models, features)
-    ref_glob = f"*-r{results['res']}-spp{results['ref_spp']}-b{results['bounces']}-seed0"
+    # the reference gives only the mask of judged pixels (its geometry and albedo), the same at any spp
+    ref_glob = f"*-r{results['res']}-spp*-b{results['bounces']}-seed0"
     judged["agreement"] = agreement(records, features, args.cache, args.ridge, ref_glob)
     judged["verified"] = verified(models, features, judged["agreement"])
     summ = summary(judged)

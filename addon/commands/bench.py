@@ -1,6 +1,6 @@
 """`python -m addon bench [--scenes a,b] [--methods direct,rsm] [--settings-filter all|default] [--quick]
-[--no-update-costs] [--anchors oidn,eevee] [--res N] [--ref-spp N] [--out DIR]`: speed against error for every
-method x setting on every scene, with each setting's update costs, against raw Cycles and the anchors
+[--no-update-costs] [--anchors oidn,eevee] [--res N] [--ref-spp N] [--ref-noise X] [--out DIR]`: speed against
+error for every method x setting on every scene, with each setting's update costs, against raw Cycles and the anchors
 (see addon/bridge/bench.py and addon/bridge/anchors.py).
 
 Writes DIR/REPORT.md (the generated block between its markers; text outside them is kept),
@@ -51,6 +51,9 @@ def add_arguments(p) -> None:
                    help="CI size: reference 128 spp, Cycles curve 1/4/16 spp, 2 timed runs")
     add_field_flag(p, GIConfig, "resolution", "--res", default=128, doc="long side in pixels")
     p.add_argument("--ref-spp", type=int, help="reference samples per pixel (default 1024; --quick: 128)")
+    p.add_argument("--ref-noise", type=float,
+                   help="raise each scene's reference spp (by powers of 2, at most 8192) until the rel_rmse_8 "
+                        "between two seeds' references is at most this (default: off, every scene at --ref-spp)")
     add_field_flag(p, GIConfig, "bounces")
     p.add_argument("--out", default="benchmarks", help="report directory (default benchmarks)")
     p.add_argument("--cache", default="out/bench", help="scenes, references and runs cache (default out/bench)")
@@ -76,15 +79,17 @@ def run(args) -> int:
     anchors = bench.resolve_anchors(_names(args.anchors))
     ref_spp = args.ref_spp
     check_settings(ref_spp or bench.REF_SPP, args.bounces, args.res)  # before bpy is imported
+    if args.ref_noise is not None and not 0 < args.ref_noise < 1:
+        raise ConfigError(f"--ref-noise must be in (0, 1): {args.ref_noise}")
     for m in methods or ():
         bench.settings_for(m)
     update_costs = not args.no_update_costs
     opt = bench.Options(
-        scenes=scenes, methods=methods, quick=args.quick, res=args.res, ref_spp=ref_spp, bounces=args.bounces,
-        update_costs=update_costs, row_filter=args.settings_filter, anchors=anchors, out=output_dir(args.out),
-        cache=Path(args.cache),
+        scenes=scenes, methods=methods, quick=args.quick, res=args.res, ref_spp=ref_spp, ref_noise=args.ref_noise,
+        bounces=args.bounces, update_costs=update_costs, row_filter=args.settings_filter, anchors=anchors,
+        out=output_dir(args.out), cache=Path(args.cache),
         command=bench.command_line(scenes, methods, args.quick, args.res, ref_spp, args.bounces, args.out,
-                                   args.cache, update_costs, args.settings_filter, anchors),
+                                   args.cache, update_costs, args.settings_filter, anchors, args.ref_noise),
     )
     with _quiet_stderr(args.quiet):
         result = bench.run_bench(opt)

@@ -62,6 +62,46 @@ def test_curve_spp_and_measured_product():
         bench.measured_product(("albedo",))
 
 
+def test_raised_spp_brings_the_noise_floor_to_the_target():
+    # A path tracer's noise falls as 1 / sqrt(spp): 0.169 needs (0.169 / 0.03)^2 = 31.7x, the next power
+    # of 2 is 32x (0.169 / sqrt(32) = 0.0299 <= 0.03; 16x leaves 0.042).
+    assert bench.raised_spp(128, 0.169, 0.03) == 4096
+    assert bench.raised_spp(128, 0.06, 0.03) == 512  # exactly 2x the target: 4x the samples
+    assert bench.raised_spp(128, 0.03, 0.03) == 128  # met: nothing to raise
+    assert bench.raised_spp(128, 0.5, 0.03) == bench.REF_SPP_MAX  # 278x wanted, capped
+    assert bench.raised_spp(16384, 0.5, 0.03) == 16384  # never below what was asked
+    assert bench.raised_spp(128, 0.2, None) == bench.raised_spp(128, None, 0.03) == 128
+
+
+def test_scene_references_raise_the_spp_until_two_seeds_agree(monkeypatch, tmp_path):
+    """Each raise renders both seeds again and measures their difference again: here a noise floor of
+    0.2 x sqrt(128 / spp) (a path tracer's) on indirect, 0 on direct (its worst product counts)."""
+    rendered = []
+
+    def fake_reference(blend, key, spp, bounces, res, seed, cache):
+        rendered.append((spp, seed))
+        d = tmp_path / f"spp{spp}-seed{seed}"
+        return d, {"spp": spp}
+
+    def fake_compare(test_exr, ref_exr):
+        spp = int(ref_exr.parent.name.split("-")[0][3:])
+        floor = 0.2 * math.sqrt(128 / spp) if ref_exr.name == "indirect.exr" else 0.0
+        return {"rel_rmse": floor, "rel_rmse_8": floor, "bias": 1.0}
+
+    monkeypatch.setattr(bench, "_reference", fake_reference)
+    monkeypatch.setattr(bench, "_compare", fake_compare)
+    opt = bench.Options(ref_noise=0.03, cache=tmp_path)
+    ref_dir, ref, spp, noise = bench.scene_references(tmp_path / "s.blend", "s-0", 128, opt, ["direct", "indirect"])
+    # (0.2 / 0.03)^2 = 44.4 -> 64x: 8192 spp, floor 0.025
+    assert spp == 8192 and ref == {"spp": 8192} and ref_dir.name == "spp8192-seed0"
+    assert noise["indirect"]["rel_rmse_8"] == pytest.approx(0.025) and noise["direct"]["rel_rmse_8"] == 0
+    assert rendered == [(128, 0), (128, 1), (8192, 0), (8192, 1)]
+    rendered.clear()
+    assert bench.scene_references(tmp_path / "s.blend", "s-0", 128, bench.Options(cache=tmp_path), ["indirect"])[2] \
+        == 128  # without --ref-noise: the spp asked, one pair of renders
+    assert rendered == [(128, 0), (128, 1)]
+
+
 def test_format_speedup_shows_the_bound():
     assert bench.format_speedup({"cycles_time_s": 0.5, "speedup": 50.0, "bound": "="}) == ("500.0 ms", "50x")
     assert bench.format_speedup({"cycles_time_s": 2.0, "speedup": 0.5, "bound": "<"}) == ("<= 2.00 s", "<= 0.5x")
@@ -176,6 +216,7 @@ def test_anchors_resolve_and_spell():
     assert "--anchors" not in bench.command_line(*base)  # the default
     spelled = bench.command_line(*base, anchors=("oidn", "eevee"))
     assert spelled.endswith("--quick --anchors oidn,eevee --res 48 --out o")
+    assert bench.command_line(*base, ref_noise=0.03).endswith("--quick --res 48 --ref-noise 0.03 --out o")
 
 
 def test_default_filter_keeps_the_row_at_the_defaults():
@@ -346,7 +387,7 @@ def test_quick_bench_on_cornell(tmp_path):
 
     # results.json: one record per run, the report's numbers, update costs timed by default
     results = json.loads((out / "results.json").read_text())
-    assert results["schema"] == bench.RESULTS_SCHEMA == 3 and results["command"] == result["command"]
+    assert results["schema"] == bench.RESULTS_SCHEMA == 4 and results["command"] == result["command"]
     assert set(results["machine"]) >= {"cpu", "bounce_renderer", "blender", "date", "commit", "dirty",
                                           "load_average_1min"}
     assert [(r["scene"], r["method"], r["setting"], r["default"]) for r in results["records"]] == \
@@ -363,6 +404,21 @@ def test_quick_bench_on_cornell(tmp_path):
         assert set(rec["update_ms"]) == {"full", "lights", "camera"}
         assert all(math.isfinite(ms) and ms > 0 for ms in rec["update_ms"].values()), rec["update_ms"]
     assert all(sc["noise_floor"]["direct"][k] is not None for k in ("rel_rmse", "rel_rmse_8", "bias"))
+    assert results["ref_noise"] is None and results["rescored"] is None
+
+    # rescore: against the run's own references it measures from the cached images exactly what the
+    # run measured; with a target below the floor it renders references of more samples and judges by
+    # them (the floor falls as 1 / sqrt(spp), estimated again at each raise).
+    import copy
+
+    again = bench.rescore(copy.deepcopy(result), cache, None)
+    assert [r["metrics"] for r in again["scenes"][0]["runs"]] == [r["metrics"] for r in sc["runs"]]
+    assert again["scenes"][0]["curve"] == sc["curve"] and again["scenes"][0]["noise_floor"] == sc["noise_floor"]
+    floor = sc["noise_floor"]["direct"]["rel_rmse_8"]
+    raised = bench.rescore(copy.deepcopy(result), cache, floor / 2)["scenes"][0]
+    assert raised["ref_spp"] >= 4 * bench.QUICK_REF_SPP
+    assert raised["noise_floor"]["direct"]["rel_rmse_8"] <= floor / 2 or raised["ref_spp"] == bench.REF_SPP_MAX
+    assert "Errors measured again" in bench.format_report(bench.rescore(copy.deepcopy(result), cache, None))
 
     # bench's own curve (all products from one render per spp) agrees with reference.cycles_curve on
     # the indirect pass it measures: same seed rule, same comparison
