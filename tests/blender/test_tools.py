@@ -53,7 +53,8 @@ def test_fit_choice_fits_judges_and_writes(tmp_path):
     records = [{"scene": s, "method": m, "setting": st, "product": "indirect", "rel_rmse_8": e, "total_ms": t}
                for s in scenes for m, st, e, t in rows]
     results = tmp_path / "results.json"
-    results.write_text(json.dumps({"res": 32, "ref_spp": 16, "bounces": 1, "records": records}))
+    refs = [{"name": s, "ref_spp": 32 if s == "cornell-sun" else 16} for s in scenes]  # as --ref-noise raises them
+    results.write_text(json.dumps({"res": 32, "ref_spp": 16, "bounces": 1, "records": records, "scenes": refs}))
     model, out = tmp_path / "model.json", tmp_path / "report"
     summary = json.loads(tool("tools/fit_choice.py", str(results), "--cache", str(cache), "--out", str(out),
                               "--model", str(model)).strip().splitlines()[-1])
@@ -63,7 +64,9 @@ def test_fit_choice_fits_judges_and_writes(tmp_path):
                               "self_check_within_1.5x": 0, "verified_met": 3, "verified_within_2x": 3,
                               "verified_mean_tries": 0.0, "verified_estimate_within_1.5x": 3}
     assert summary["0.3"]["met"] == 3 and summary["0.3"]["within_2x"] == 3
-    assert "| 0.2 | 3 | 3 | 3 | 3 | 3 | 0 | 3 | 3 | 0.0 | 3 |" in (out / "REPORT.md").read_text()
+    text = (out / "REPORT.md").read_text()
+    assert "| 0.2 | 3 | 3 | 3 | 3 | 3 | 0 | 3 | 3 | 0.0 | 3 |" in text
+    assert "Errors against Cycles references of (spp): cornell 16, cornell-point 16, cornell-sun 32." in text
     from addon.engine import choice
 
     fitted = choice.Model.from_json(json.loads(model.read_text()))
