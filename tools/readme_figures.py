@@ -57,6 +57,15 @@ def _produced_by(results: dict) -> str:
             f"start / end; {m['bounce_renderer']}; Blender {m['blender']}).")
 
 
+def _spp(results: dict) -> str:
+    """The run's reference samples: one count, or with `--ref-noise` each scene's range and the floor."""
+    if results.get("ref_noise") is None:
+        return f"{results['ref_spp']} spp"
+    spps = sorted({sc["ref_spp"] for sc in results["scenes"]})
+    return (f"{spps[0]}-{spps[-1]} spp (raised per scene until two seeds differ by rel_rmse_8 <= "
+            f"{results['ref_noise']:g})")
+
+
 def _default_records(results: dict) -> list[dict]:
     """Each method's record at its default settings, in the run's order."""
     return [r for r in results["records"] if r["default"]]
@@ -119,7 +128,7 @@ def accuracy_block(results: dict) -> str:
     by_key = {(r["scene"], r["method"]): r for r in records}
     oidn = any(r.get("speedup_oidn") for r in records)
     lines = ["**Accuracy against Cycles** of each method at its default settings.", "",
-             _produced_by(results) + f" {results['res']} px long side, Cycles reference {results['ref_spp']} spp; "
+             _produced_by(results) + f" {results['res']} px long side, Cycles reference {_spp(results)}; "
              "cells: rel_rmse_8 / bias" + (" / speed-up against Cycles + OIDN" if oidn else "")
              + " (direct against Cycles' Diffuse Direct, the others against Diffuse Indirect"
              + ("; speed-up = the time Cycles with Open Image Denoise needs for the same rel_rmse_8 / ours, <= and "
@@ -196,7 +205,7 @@ def headline_block(results: dict, eevee_results: dict) -> str:
              "anchors need to match it.", "",
              "Ours and Cycles (raw, and with Open Image Denoise: the time Cycles needs for the same rel_rmse_8 along "
              "its curve of the same run; <= where our error is above its fastest point). " + _produced_by(results)
-             + f" {results['res']} px long side, indirect light against Cycles at {results['ref_spp']} spp.", "",
+             + f" {results['res']} px long side, indirect light against Cycles at {_spp(results)}.", "",
              "EEVEE (one render at its best GI setting: its time and rel_rmse_8; EEVEE / ours = its time over ours "
              "where our error is at most its own). " + _produced_by(eevee_results), "",
              "| scene | method | rel_rmse_8 | ours | Cycles | Cycles + OIDN | EEVEE | EEVEE / ours |",
@@ -251,7 +260,7 @@ def octree_block(results: dict) -> str:
 
     scenes = list(dict.fromkeys(r["scene"] for r in lpv))
     lines = ["**lpv: the octree against the far field and one grid.**", "",
-             _produced_by(results) + f" {results['res']} px long side, Cycles reference {results['ref_spp']} spp, "
+             _produced_by(results) + f" {results['res']} px long side, Cycles reference {_spp(results)}, "
              f"one bounce. Cells: rel_rmse_8 / bias, propagation ms (the passes {', '.join(PROPAGATION_PASSES)}; "
              f"medians of {results['repeat']} updates), cell-steps in thousands (cells x steps over every grid "
              "and level).", "",
@@ -302,7 +311,7 @@ def diffusion_block(*runs: dict) -> str:
     paper's cone transfer's error against the default directional one's."""
     lines = ["**diffusion beside lpv, grids of 16, 32 and 64 cells.**", ""]
     lines += [_produced_by(run) + f" {run['res']} px long side, {run['bounces']} bounce(s), Cycles reference "
-              f"{run['ref_spp']} spp." for run in runs]
+              f"{_spp(run)}." for run in runs]
     lines += ["", "Cells: rel_rmse_8 against Cycles' Diffuse Indirect, the benchmark's time (ms: the median of its "
               "updates after a warm-up; both on the run's machine, ratios only).", "",
               "| scene | bounces | " + " | ".join(f"{m} {c}" for m, _, c in GRID_COLUMNS) + " |",
@@ -352,7 +361,7 @@ def encodings_block(results: dict) -> str:
     irradiance = {"probes.encoding": "irradiance"}
     lines = ["**probes: the two encodings.**", "",
              _produced_by(results) + f" {results['res']} px long side, {results['bounces']} bounce(s), Cycles "
-             f"reference {results['ref_spp']} spp. Cells: rel_rmse_8 / bias against Cycles' Diffuse Indirect, "
+             f"reference {_spp(results)}. Cells: rel_rmse_8 / bias against Cycles' Diffuse Indirect, "
              "the benchmark's time (ms: the median of its updates after a warm-up, on the run's machine).", "",
              "| scene | SH (default) | irradiance |", "| --- | --- | --- |"]
     better = total = 0

@@ -153,3 +153,11 @@ def test_headline_block():
     assert rows == ["| cornell | vct | 0.130 | 750 ms | 210 ms | 105 ms | 75.0 s at 0.680 | 100x |",
                     "| window-sky | rsm | 0.900 | 100 ms | <= 40 ms | <= 20 ms | 60.0 s at 0.500 | "
                     "error above EEVEE's |"]
+
+
+def test_reference_samples_name_the_raised_range():
+    results = _results([])
+    assert readme_figures._spp(results) == "128 spp"
+    results.update(ref_noise=0.03, scenes=[{"ref_spp": 4096}, {"ref_spp": 128}, {"ref_spp": 256}])
+    assert readme_figures._spp(results) == \
+        "128-4096 spp (raised per scene until two seeds differ by rel_rmse_8 <= 0.03)"
