@@ -122,7 +122,7 @@ def run_image(cache: Path, scene: str, method: str, setting: dict) -> Path:
     return cache / "runs" / scene / f"{method}-{label.replace(' ', '').replace(',', '_')}" / "indirect.exr"
 
 
-def agreement(records: list[dict], features: dict, cache: Path, ridge: float, ref_glob: str) -> list[dict]:
+def agreement(records: list[dict], features: dict, cache: Path, ridge: float, ref_glob: dict[str, str]) -> list[dict]:
     """The run-time estimate judged: for every held-out scene and row R, the rel_rmse_8 between R's
     image and the image of the row of another method the model (fitted without the scene) expects to
     be most accurate, B; and the estimates built from it: `agree` = that difference, `blend` = the
@@ -135,7 +135,7 @@ def agreement(records: list[dict], features: dict, cache: Path, ridge: float, re
         model = choice.fit([r for r in records if r["scene"] != held],
                            {s: f for s, f in features.items() if s != held}, ridge)
         rows = [r for r in records if r["scene"] == held and choice.row_key(r["method"], r["setting"]) in model.rows]
-        refs = [d for d in sorted((cache / "refs").glob(f"{held}-{ref_glob}"))
+        refs = [d for d in sorted((cache / "refs").glob(f"{held}-{ref_glob[held]}"))
                 if re.fullmatch(rf"{re.escape(held)}-[0-9a-f]{{12}}-.*", d.name)]  # not cornell-sun for cornell
         if not rows or not refs:
             continue
@@ -312,8 +312,11 @@ def main(argv=None) -> int:
     features = scene_features(args.cache, sorted({r["scene"] for r in records}), results["bounces"], results["res"])
     models = held_out(records, features, args.ridge)
     judged = judge(models, features)
-    # the reference gives only the mask of judged pixels (its geometry and albedo), the same at any spp
-    ref_glob = f"*-r{results['res']}-spp*-b{results['bounces']}-seed0"
+    # the reference each scene's errors were measured against (its spp: bench --ref-noise raises it per
+    # scene); it gives the mask of judged pixels (its geometry and albedo)
+    spp = {sc["name"]: sc["ref_spp"] for r in runs for sc in r.get("scenes", ())}
+    ref_glob = {s: f"*-r{results['res']}-spp{spp.get(s, results['ref_spp'])}-b{results['bounces']}-seed0"
+                for s in features}
     judged["agreement"] = agreement(records, features, args.cache, args.ridge, ref_glob)
     judged["verified"] = verified(models, features, judged["agreement"])
     summ = summary(judged)
