@@ -330,8 +330,9 @@ def test_cli_rejects_bad_input_before_rendering(capsys):
     assert cli.main(["bench", "--methods", ","]) == 2
     assert cli.main(["bench", "--settings-filter", "first"]) == 2
     assert cli.main(["bench", "--anchors", "oidn,denoiser"]) == 2
+    assert cli.main(["bench", "--ref-noise", "0"]) == 2  # no reference reaches a floor of 0
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 5 and all(line.startswith("error: ") for line in err)
+    assert len(err) == 6 and all(line.startswith("error: ") for line in err)
 
 
 # ------------------------------------------------------------------------------ quick bench, e2e
