@@ -420,7 +420,7 @@ def decide(scene: Scene, settings: dict, pixels: int, error_budget: float | None
         info.update(estimated_rel_rmse_8=None,
                     estimate_note="the choice model has no benchmark row with these settings")
     else:
-        info.update(estimated_rel_rmse_8=model.predict(key, feats)[0], estimate_row=key)
+        info.update(estimated_rel_rmse_8=model.predict(key, feats)[0], estimate_row=key, estimate_source="model")
     return settings, info
 
 

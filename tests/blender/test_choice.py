@@ -42,6 +42,7 @@ def test_a_render_at_a_benchmarked_setting_carries_the_estimate(cornell_blend, t
                  "--repeat", "1", "--quiet"]) == 0
     stats = json.loads((out / "stats.json").read_text())
     assert 0 < stats["estimated_rel_rmse_8"] < 2 and stats["estimate_row"].startswith("rsm")
+    assert stats["estimate_source"] == "model"
     odd = tmp_path / "odd"
     assert main(["render", str(cornell_blend), "--out", str(odd), "--method", "rsm", "--vpl-samples", "100",
                  "--res", "32", "--repeat", "1", "--quiet"]) == 0
@@ -75,6 +76,7 @@ def test_render_verify_runs_a_row_whose_estimate_is_within_the_budget(cornell_bl
     assert tried[-1]["row"] == accepted == c["row"] and tried[-1]["estimated_rel_rmse_8"] <= 0.3
     assert all(t["estimated_rel_rmse_8"] > 0.3 for t in tried[:-1])
     assert stats["estimated_rel_rmse_8"] == pytest.approx(tried[-1]["estimated_rel_rmse_8"])
+    assert stats["estimate_source"] == "self-check"
     assert stats["method"] == c["method"]
 
 
@@ -156,3 +158,7 @@ def test_self_check_compares_with_another_method(cornell_blend, tmp_path):
     a, b = images.read_exr(ours / "indirect.exr"), images.read_exr(theirs / "indirect.exr")
     assert check["rel_rmse_8_between"] == pytest.approx(rel_rmse_8(a[..., :3], b[..., :3], a[..., 3] > 0.5), rel=1e-5)
     assert check["estimated_rel_rmse_8"] == check["rel_rmse_8_between"]
+    # the run-time estimate is the one reported; the model's stays beside it
+    assert stats["estimated_rel_rmse_8"] == check["estimated_rel_rmse_8"] and stats["estimate_source"] == "self-check"
+    assert stats["model_estimated_rel_rmse_8"] == pytest.approx(
+        choice.load().predict(stats["estimate_row"], stats["scene_features"])[0])
