@@ -16,7 +16,7 @@ import os
 from pathlib import Path
 
 from ..bridge.anchors import ANCHORS, DEFAULT_ANCHORS
-from ..bridge.bench import ROW_FILTERS  # bridge/bench.py imports without bpy
+from ..bridge.bench import REF_SPP_MAX, ROW_FILTERS  # bridge/bench.py imports without bpy
 from ..engine.config import GIConfig
 from ..engine.errors import ConfigError
 from ._args import add_quiet, output_dir
@@ -52,8 +52,9 @@ def add_arguments(p) -> None:
     add_field_flag(p, GIConfig, "resolution", "--res", default=128, doc="long side in pixels")
     p.add_argument("--ref-spp", type=int, help="reference samples per pixel (default 1024; --quick: 128)")
     p.add_argument("--ref-noise", type=float,
-                   help="raise each scene's reference spp (by powers of 2, at most 8192) until the rel_rmse_8 "
-                        "between two seeds' references is at most this (default: off, every scene at --ref-spp)")
+                   help=f"raise each scene's reference spp (by powers of 2, at most {REF_SPP_MAX}) until the "
+                        "rel_rmse_8 between two seeds' references is at most this (default: off, every scene at "
+                        "--ref-spp)")
     add_field_flag(p, GIConfig, "bounces")
     p.add_argument("--out", default="benchmarks", help="report directory (default benchmarks)")
     p.add_argument("--cache", default="out/bench", help="scenes, references and runs cache (default out/bench)")
