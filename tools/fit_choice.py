@@ -117,9 +117,10 @@ def judge(models: dict, features: dict) -> dict:
 
 
 def run_image(cache: Path, scene: str, method: str, setting: dict) -> Path:
-    """Where bench left a row's indirect image (bench._run_row's run directory)."""
-    label = ", ".join(f"{k.split('.', 1)[1]} {v}" for k, v in setting.items()) or "defaults"
-    return cache / "runs" / scene / f"{method}-{label.replace(' ', '').replace(',', '_')}" / "indirect.exr"
+    """Where bench left a row's indirect image (its run directory)."""
+    from addon.bridge import bench
+
+    return bench.row_dir(cache, scene, method, bench.setting_label(setting)) / "indirect.exr"
 
 
 def agreement(records: list[dict], features: dict, cache: Path, ridge: float, ref_glob: dict[str, str]) -> list[dict]:

@@ -610,7 +610,7 @@ def eevee_anchor(blend: Path, res: int, ref_dir: Path, work: Path) -> dict:
     return {**ev, "product": "indirect", "metrics": _compare(work / "indirect.exr", ref_dir / "indirect.exr")}
 
 
-def _run_dir(cache: Path, scene: str, method: str, label: str) -> Path:
+def row_dir(cache: Path, scene: str, method: str, label: str) -> Path:
     """Where a row's images are cached (the latest run of that scene, method and setting)."""
     return cache / "runs" / scene / f"{method}-{label.replace(' ', '').replace(',', '_')}"
 
@@ -624,7 +624,7 @@ def _run_row(opt: Options, blend: Path, scene: str, method: str, setting: dict, 
     from .pipeline import render_file
 
     label = setting_label(setting)
-    run_dir = _run_dir(opt.cache, scene, method, label)
+    run_dir = row_dir(opt.cache, scene, method, label)
     run_dir.mkdir(parents=True, exist_ok=True)
     settings = make_configs(method, setting, opt.res, opt.bounces)
     st = render_file(blend, run_dir, settings, repeat=repeat)
@@ -819,7 +819,7 @@ def rescore(result: dict, cache: Path, ref_noise: float | None) -> dict:
         if sc.get("eevee"):
             sc["eevee"]["metrics"] = _compare(cache / "eevee" / key / "indirect.exr", ref_dir / "indirect.exr")
         for r in sc["runs"]:
-            run_dir, product, our_s = _run_dir(cache, sc["name"], r["method"], r["setting"]), r["product"], \
+            run_dir, product, our_s = row_dir(cache, sc["name"], r["method"], r["setting"]), r["product"], \
                 r["total_ms"] / 1000
             m = r["metrics"] = _compare(run_dir / f"{product}.exr", ref_dir / f"{product}.exr")
             r["speedup"] = speedup_along(m["rel_rmse_8"], our_s, sc["curve"][product])
