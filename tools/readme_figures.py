@@ -27,7 +27,8 @@ LPV_DOC = ROOT / "docs" / "LPV.md"
 OCTREE_JSON = ROOT / "benchmarks" / "octree" / "results.json"
 DIFFUSION_DOC = ROOT / "docs" / "DIFFUSION.md"
 PROBES_DOC = ROOT / "docs" / "PROBES.md"
-PROBES_JSON = ROOT / "benchmarks" / "probes" / "results.json"
+# every probes row ran in the choice model's run (all methods' registry rows on all 15 scenes)
+PROBES_JSON = ROOT / "benchmarks" / "choice" / "rows" / "results.json"
 # The GPU runs (tools/gpu_timing.py on a lent GPU; benchmarks/gpu/REPORT.md), in order: a later run's
 # figure for a (scene, setting) replaces an earlier one's.
 GPU_JSON = tuple(ROOT / "benchmarks" / "gpu" / f"h200-{run}.json" for run in ("timings", "rows", "denoise"))
@@ -52,9 +53,13 @@ def _produced_by(results: dict) -> str:
     m = results["machine"]
     code = f"commit {m['commit'][:12]}" + (" with uncommitted changes" if m["dirty"] else "")
     start, end = m["load_average_1min"]  # timings shared the cores with whatever else ran
+    rescored = results.get("rescored")
+    again = (f" Errors measured again from its cached images by `{rescored['command']}` on {rescored['date']} "
+             f"(commit {rescored['commit'][:12]}{' with uncommitted changes' if rescored['dirty'] else ''}).") \
+        if rescored else ""
     return (f"Produced by `{results['command']}`\n"
             f"on {m['date']} ({code}; {m['cpu']}, {m['cores']} cores, load average {start:.1f} / {end:.1f} at the "
-            f"start / end; {m['bounce_renderer']}; Blender {m['blender']}).")
+            f"start / end; {m['bounce_renderer']}; Blender {m['blender']}).{again}")
 
 
 def _spp(results: dict) -> str:

@@ -161,3 +161,13 @@ def test_reference_samples_name_the_raised_range():
     results.update(ref_noise=0.03, scenes=[{"ref_spp": 4096}, {"ref_spp": 128}, {"ref_spp": 256}])
     assert readme_figures._spp(results) == \
         "128-4096 spp (raised per scene until two seeds differ by rel_rmse_8 <= 0.03)"
+
+
+def test_produced_by_says_when_errors_were_measured_again():
+    results = _results([])
+    assert "measured again" not in readme_figures._produced_by(results)
+    results["rescored"] = {"command": "tools/bench_rescore.py --cache C --ref-noise 0.03 --out O", "date": "2026-12-04",
+                           "commit": "fedcba9876543210" * 2 + "01234567", "dirty": True}
+    assert readme_figures._produced_by(results).endswith(
+        " Errors measured again from its cached images by `tools/bench_rescore.py --cache C --ref-noise 0.03 --out O`"
+        " on 2026-12-04 (commit fedcba987654 with uncommitted changes).")
