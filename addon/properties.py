@@ -64,25 +64,28 @@ def _group(attr: str, cls) -> type:
 _GROUPS = {attr: _group(attr, cls) for attr, cls in CONFIGS.items()}
 
 
-# Quality presets: RSM side and VPLs per pixel. The labels say what they cost and gain; figures in
-# benchmarks/REPORT.md (see panels/viewport.py for where each comes from).
-# (RSM resolution, VPLs per pixel, VPL visibility); the labels quote method rsm on the Cornell box from
-# benchmarks/REPORT.md (128 px, one bounce, vs Cycles 512 spp; times on the CPU rasteriser llvmpipe,
-# a GPU is far faster): update them when the report changes.
+# Quality presets: RSM side, VPLs per pixel, their visibility and the sky's exact rays. The labels say
+# what they cost and gain; figures in benchmarks/REPORT.md (see panels/viewport.py for where each comes
+# from). (RSM resolution, VPLs per pixel, VPL visibility, sky rays); the labels quote method rsm on the
+# Cornell box from benchmarks/REPORT.md (128 px, one bounce, vs Cycles 512 spp; times on the CPU
+# rasteriser llvmpipe, a GPU is far faster) and the direct light of window-sky (docs/DIRECT.md, "Exact
+# rays"): update them when the report changes.
 QUALITY_PRESETS = {
-    "DRAFT": (256, 64, "none"),
-    "BALANCED": (256, 256, "none"),  # = RsmConfig's defaults
-    "HIGH": (256, 256, "voxel"),
+    "DRAFT": (256, 64, "none", 0),
+    "BALANCED": (256, 256, "none", 0),  # = RsmConfig's defaults
+    "HIGH": (256, 256, "voxel", 8),
 }
 QUALITY_LABELS = {
     "DRAFT": ("Draft", "64 VPLs, no visibility: Cornell rel_rmse_8 0.19, noisier, about a third of Balanced's time"),
     "BALANCED": ("Balanced", "256 VPLs, no visibility (the defaults): Cornell rel_rmse_8 0.19"),
-    "HIGH": ("High", "256 VPLs, voxel visibility: Cornell rel_rmse_8 0.073, about 9x Balanced's time"),
+    "HIGH": ("High", "256 VPLs, voxel visibility: Cornell rel_rmse_8 0.073, about 9x Balanced's time; the sky's "
+             "shadows from exact rays: a window's sky light 0.028 from 0.073, its pass 28-150x dearer"),
 }
 
 
 def _apply_quality(self, _context):
-    self.rsm.resolution, self.rsm.vpl_samples, self.rsm.visibility = QUALITY_PRESETS[self.quality]
+    (self.rsm.resolution, self.rsm.vpl_samples, self.rsm.visibility,
+     self.rsm.sky_rays) = QUALITY_PRESETS[self.quality]
 
 
 def _enabled_changed(self, _context):

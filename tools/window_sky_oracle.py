@@ -15,9 +15,8 @@ world is the map Bounce captures (bridge/world_capture.py), each texel sampled a
   its sun (|V_R| along V_R) times the share of its light the point sees, that share exact: the sky
   pass's model with a perfect shadow filter;
 - regions, hard: each region's light from its one direction, visibility exact there;
-- regions, T taps: each region split again by power (world._split, the largest part first) into at
-  most T parts, its visible share the parts' power-weighted exact visibility along their directions:
-  how far a pass that tests a few rays per region could go.
+- regions, T taps: each region's visible share from T exact rays over it (world.region_taps), as the
+  sky pass estimates it.
 The suns (the scene's SUN lamps, the sky's captured disc) are added with exact visibility to each.
 """
 
@@ -97,28 +96,6 @@ def sub_directions(h: int, w: int):
     return towards.reshape(-1, 3)[keep], omega.ravel()[keep], texel.ravel()[keep]
 
 
-def region_taps(radiance: np.ndarray, power: np.ndarray, rect, taps: int) -> list[tuple[np.ndarray, float]]:
-    """Region `rect` split into at most `taps` parts, the part of largest power first, at its power
-    median (world._split): per part that carries light, its direction (luminance-weighted vector
-    irradiance) and its share of those parts' power."""
-    parts = [rect]
-    while len(parts) < taps:
-        order = sorted(range(len(parts)), key=lambda i: -float(power[parts[i]].sum()))
-        split = next(((i, halves) for i in order if (halves := world._split(power, parts[i])) is not None), None)
-        if split is None:
-            break  # every part is one texel, or dark
-        i, halves = split
-        parts[i:i + 1] = list(halves)
-    vectors = world.texel_vectors(*power.shape)
-    out = []
-    for part in parts:
-        vec = world.LUMA @ np.einsum("ijc,ijk->ck", radiance[part], vectors[part])
-        if np.linalg.norm(vec) > 0:
-            out.append((vec / np.linalg.norm(vec), float(power[part].sum())))
-    total = sum(w for _, w in out)
-    return [(d, w / total) for d, w in out]
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("blend")
@@ -194,8 +171,8 @@ def main() -> None:
             tap_e = np.zeros((len(points), 3))
             for sun, k in zip(suns_r, lit, strict=True):
                 light = np.maximum(normals @ -sun.direction, 0)[:, None] * (sun.color * sun.sun_strength)
-                parts = region_taps(radiance, power, rects[k], taps)
-                share = sum(sees_sky(points, toward[None], tunnel)[:, 0] * w for toward, w in parts)
+                parts = world.region_taps(radiance, power, world.texel_vectors(h, w), rects[k], taps)
+                share = sees_sky(points, parts[:, :3], tunnel) @ parts[:, 3]
                 tap_e += light * share[:, None]
             report(f"{count} regions, {taps} taps each", tap_e)
 

@@ -97,6 +97,12 @@ class RsmConfig(_Validated):
                                "for all (fewer when the world gives less of the light)")
     sky_texels: int = _num(64, 16, 1024, "shadow map side in texels of each sky direction (at most what keeps "
                                          "their atlas 2048 texels a side)")
+    # The sky's shadows at the camera's pixels (and a bake's texels): with this many rays per region,
+    # each tested exactly against the triangles (bvh.py), in place of the shadow maps' soft-shadow
+    # filter. Window-sky's direct light 0.073 -> 0.028 at 8, the sky pass 28-150x dearer on llvmpipe
+    # (docs/DIRECT.md, "Exact rays"): the High preset's, not the viewport's default.
+    sky_rays: int = _num(0, 0, 16, "rays per sky region tested exactly against the triangles for the sky's "
+                                   "shadows (0: the shadow maps' filter, fast)")
 
 
 @dataclass(frozen=True)

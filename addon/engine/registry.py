@@ -52,14 +52,16 @@ class MethodSpec:
 SHARED_GROUPS = ("gi", "rsm")  # every method is configured through these; the others are methods' own
 
 _IMAGE = ("gi.method", "gi.resolution")     # every method makes an image of this size
-_LIGHT_VIEWS = ("rsm.resolution", "rsm.shadow_bias_texels")  # every method's shadow maps
+# Every method's shadow maps, and the sky's shadows at its pixels (direct light is every method's).
+_LIGHT_VIEWS = ("rsm.resolution", "rsm.shadow_bias_texels", "rsm.sky_rays")
 
 METHODS: tuple[MethodSpec, ...] = (
     MethodSpec(
         name="direct", summary="RSM-shadowed direct light only: the radiometry check against Cycles",
         module="direct", class_name="DirectMethod", products=("direct", "albedo"), max_bounces=1,
         reads=(*_IMAGE, *_LIGHT_VIEWS),
-        bench=({"rsm.resolution": 256}, {"rsm.resolution": 512})),
+        # The sky's exact rays (RsmConfig.sky_rays) beside the filter: only a world's light changes.
+        bench=({"rsm.resolution": 256}, {"rsm.resolution": 512}, {"rsm.sky_rays": 8})),
     MethodSpec(
         name="rsm", summary="one bounce gathered from the shadow maps' VPLs, optionally with voxel visibility",
         module="rsm", class_name="RsmMethod", products=("direct", "indirect", "albedo"), max_bounces=1,

@@ -78,3 +78,40 @@ def run_sh_eval(backend: Backend, dirs: np.ndarray, coeffs: np.ndarray) -> dict[
     backend.dispatch(prog, group_count((n, 1), SH_EVAL.local_size),
                      samplers={"dirs": tex_dirs, "coeffs": tex_coeffs}, images=outs)
     return {name: backend.read(tex).reshape(n, 4) for name, tex in outs.items()}
+
+
+def _bvh_occluded_spec() -> ShaderSpec:
+    from . import bvh
+    from .passes import rsm
+
+    return ShaderSpec(
+        name="selftest_bvh_occluded",
+        compute="selftest/bvh_occluded.comp.glsl",
+        local_size=(8, 8, 1),
+        samplers=(Sampler("origins", "2D"), Sampler("directions", "2D"), Sampler("bvh_nodes", "2D"),
+                  Sampler("bvh_triangles", "2D")),
+        images=(Image("hit_out", "2D", "RGBA32F", "write"),),
+        uniforms=(Var("bvh_leaves", "int"),),
+        defines=(("NODE_ROW", str(bvh.NODE_ROW)), ("OCCLUDER_ROW", str(rsm.OCCLUDER_ROW)),
+                 ("LEAF_TRIANGLES", str(bvh.LEAF_TRIANGLES))),
+    )
+
+
+def run_bvh_occluded(backend: Backend, triangles_m: np.ndarray, origins: np.ndarray, directions: np.ndarray,
+                     s_min: float) -> np.ndarray:
+    """common/bvh.glsl's bvh_occluded on the GPU for n rays (origins, directions (n, 3)) against the
+    triangles (t, 3, 3): (n,) booleans."""
+    from .passes.sky_light import BvhTextures
+
+    n = len(origins)
+    tree = BvhTextures.upload(backend, triangles_m)
+    packed = np.zeros((2, n, 4), np.float32)
+    packed[0, :, :3], packed[0, :, 3], packed[1, :, :3] = origins, s_min, directions
+    textures = [backend.texture((n, 1), "RGBA32F", packed[i].reshape(1, n, 4)) for i in range(2)]
+    out = backend.texture((n, 1), "RGBA32F")
+    spec = _bvh_occluded_spec()
+    backend.dispatch(backend.program(spec), group_count((n, 1), spec.local_size),
+                     samplers={"origins": textures[0], "directions": textures[1], "bvh_nodes": tree.nodes,
+                               "bvh_triangles": tree.triangles},
+                     images={"hit_out": out}, uniforms={"bvh_leaves": tree.leaves})
+    return backend.read(out).reshape(n, 4)[:, 0] > 0.5

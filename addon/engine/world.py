@@ -132,11 +132,23 @@ def world_suns(world_map: np.ndarray, count: int, by_width: bool = False) -> lis
     """The map's light as at most `count` suns (module docstring): each region's vector irradiance V_c
     per colour; the sun shines along -(luminance-weighted direction), strength |V| along it. by_width:
     regions split by power x angular width (`regions`), as the sky's shadowed directions want."""
+    return sky_regions(world_map, count, 0, by_width)[0]
+
+
+def sky_regions(world_map: np.ndarray, count: int, taps: int,
+                by_width: bool = True) -> tuple[list[Light], np.ndarray]:
+    """world_suns, and per sun `taps` rays over its region with their shares of its light (suns,
+    (len(suns), taps, 4): xyz the unit direction towards the sky, w the share; region_taps).
+
+    Why: a region's shadow is the share of its light a point sees, and a region is not a disc: a strip
+    of sky just above a window's horizon lights a patch of wall as narrow as the strip. Visibility
+    tested exactly along 8 such rays per region, window-sky's direct light is within 0.028 of Cycles
+    at 186 regions (0.121 from each region's one direction; tools/window_sky_oracle.py)."""
     radiance = np.asarray(world_map, np.float64)
     _, solid_angle = directions(*radiance.shape[:2])
     vectors = texel_vectors(*radiance.shape[:2])
     power = (radiance @ LUMA) * solid_angle
-    suns = []
+    suns, tap_rows = [], []
     for rect in regions(power, count, solid_angle if by_width else None):
         vec = np.einsum("ijc,ijk->ck", radiance[rect], vectors[rect])  # (3 colours, xyz): V per colour
         luma_vec = LUMA @ vec
@@ -153,7 +165,34 @@ def world_suns(world_map: np.ndarray, count: int, by_width: bool = False) -> lis
         angle = 2.0 * float(np.arccos(np.clip(1.0 - omega / (2.0 * np.pi), -1.0, 1.0)))
         suns.append(Light("SUN", toward * 1e3, -toward, strength / peak, sun_strength=peak, sun_angle_rad=angle,
                           name="world"))
-    return suns
+        if taps:
+            tap_rows.append(region_taps(radiance, power, vectors, rect, taps))
+    return suns, np.array(tap_rows, np.float64).reshape(len(suns), taps, 4) if taps else np.zeros((len(suns), 0, 4))
+
+
+def region_taps(radiance: np.ndarray, power: np.ndarray, vectors: np.ndarray, rect: tuple[slice, slice],
+                taps: int) -> np.ndarray:
+    """(taps, 4): region `rect` of the map split into at most `taps` parts, the part of largest power
+    split first, at its power median (`_split`); per part its direction towards the sky (its
+    luminance-weighted vector irradiance, `vectors` = texel_vectors) and its share of the power of the
+    parts that carry light. Parts that carry none, and taps beyond the parts, are 0."""
+    parts = [rect]
+    while len(parts) < taps:
+        order = sorted(range(len(parts)), key=lambda i: -float(power[parts[i]].sum()))
+        split = next(((i, halves) for i in order if (halves := _split(power, parts[i])) is not None), None)
+        if split is None:
+            break  # every part is one texel, or dark
+        i, halves = split
+        parts[i:i + 1] = list(halves)
+    out = np.zeros((taps, 4))
+    for j, part in enumerate(parts):
+        vec = LUMA @ np.einsum("ijc,ijk->ck", radiance[part], vectors[part])
+        norm = float(np.linalg.norm(vec))
+        if norm > 0:
+            out[j] = (*(vec / norm), float(power[part].sum()))
+    total = out[:, 3].sum()
+    out[:, 3] = out[:, 3] / total if total > 0 else 0.0
+    return out
 
 
 AXES = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], np.float64)

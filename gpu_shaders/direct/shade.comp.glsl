@@ -8,6 +8,7 @@
 #include "common/texel_list.glsl"
 #include "common/polygon.glsl"
 #include "common/receiver_plane.glsl"
+#include "common/ray_triangle.glsl"
 
 const float PI = 3.14159265;
 
@@ -88,22 +89,10 @@ vec3 occluder_corner(int t, int k) {
     return texelFetch(occluders, ivec2(3 * (t % OCCLUDER_ROW) + k, t / OCCLUDER_ROW), 0).xyz;
 }
 
-// Whether q + s w crosses triangle t (either side) for s_min < s < s_max (Moller and Trumbore's test).
+// Whether q + s w crosses triangle t (either side) for s_min < s < s_max.
 bool segment_crosses(int t, vec3 q, vec3 w, float s_min, float s_max) {
-    vec3 a = occluder_corner(t, 0);
-    vec3 e1 = occluder_corner(t, 1) - a;
-    vec3 e2 = occluder_corner(t, 2) - a;
-    vec3 h = cross(w, e2);
-    float det = dot(e1, h);
-    if (abs(det) <= 1e-7 * length(e1) * length(e2)) {
-        return false;  // the segment runs along the triangle's plane (or it has no area): no crossing
-    }
-    vec3 from_a = q - a;
-    float u = dot(from_a, h) / det;
-    vec3 g = cross(from_a, e1);
-    float v = dot(w, g) / det;
-    float s_hit = dot(e2, g) / det;
-    return u >= 0.0 && v >= 0.0 && u + v <= 1.0 && s_hit > s_min && s_hit < s_max;
+    return ray_crosses_triangle(occluder_corner(t, 0), occluder_corner(t, 1), occluder_corner(t, 2), q, w, s_min,
+                                s_max);
 }
 
 // How far x lies from the light along its rays: a sun's depth along them, a lamp's distance.

@@ -5,9 +5,40 @@
 //
 // sky_table, one row per direction: texels 0-3 the rows of its orthographic view-projection, texel 4
 // (axis the light travels along, texel size in m), texel 5 (irradiance normal to it, W/m^2 per colour;
-// w: the tangent of the region's angular radius, its shadows' penumbra).
+// w: the tangent of the region's angular radius, its shadows' penumbra); with SKY_RAYS, texels 6 on the
+// region's `sky_rays` rays (xyz towards the sky, w: the share of the region's light each stands for;
+// world.region_taps).
+//
+// Compiled two ways (passes/sky_light.py): the shadow maps' percentage-closer soft shadows (the
+// viewport's), or with SKY_RAYS each region's rays tested exactly against the triangles wherever the
+// depth bounds do not show the receiver in front of everything (renders and bakes that ask for it,
+// RsmConfig.sky_rays; docs/DIRECT.md, "Exact rays").
 #include "common/texel_list.glsl"
 #include "common/receiver_plane.glsl"
+#ifdef SKY_RAYS
+#include "common/bvh.glsl"
+
+// The rays start this many texels of the direction's tile off the receiver's surface, far above fp32's
+// rounding of a position and far below a pixel; crossings nearer than RAY_NEAR_TEXELS do not count (a
+// floor point the G-buffer keeps a hair beyond a wall's plane would cross the wall at once). As the
+// direct pass's exact shadows (EXACT_LIFT_TEXELS, EXACT_NEAR_TEXELS in direct/shade.comp.glsl).
+const float RAY_LIFT_TEXELS = 0.02;
+const float RAY_NEAR_TEXELS = 0.05;
+
+// The share of direction k's region that receiver p (normal n) sees: its rays, each tested exactly
+// against the triangles (common/bvh.glsl), weighted by the share of the light each stands for.
+float ray_share(int k, vec3 p, vec3 n, float texel_m) {
+    vec3 q = p + n * (RAY_LIFT_TEXELS * texel_m);
+    float lit = 0.0;
+    for (int j = 0; j < sky_rays; ++j) {
+        vec4 ray = texelFetch(sky_table, ivec2(6 + j, k), 0);
+        if (ray.w > 0.0 && !bvh_occluded(q, ray.xyz, RAY_NEAR_TEXELS * texel_m, 1e30)) {
+            lit += ray.w;
+        }
+    }
+    return lit;
+}
+#endif
 
 const float PI = 3.14159265;
 // The receiver is lifted half a texel along its normal, for its own texel's depth, and each tap is
@@ -53,7 +84,7 @@ void main() {
     vec3 p = pos.xyz;
     vec3 n = texelFetch(gbuf_normal, px, 0).xyz;
     vec3 sum = vec3(0.0);
-    for (int k = 0; k < sky_count; ++k) {
+    for (int k = sky_first; k < min(sky_first + sky_chunk, sky_count); ++k) {
         vec4 axis_texel = texelFetch(sky_table, ivec2(4, k), 0);
         float cos_n = -dot(n, axis_texel.xyz);
         if (cos_n <= 0.0) {
@@ -88,6 +119,14 @@ void main() {
             sum += light_texel.rgb * cos_n;
             continue;
         }
+#ifdef SKY_RAYS
+        // Behind everything there does not settle a region for its rays: rays slanted across it escape
+        // beside what stands over the receiver (taken as blocked, window-sky read 0.065 / 0.964 against
+        // 0.028 / 0.996); nor does the filter below, either way (0.043 trusting its fully lit, 0.056 its
+        // fully blocked).
+        sum += light_texel.rgb * (cos_n * ray_share(k, p, n, texel_m));
+        continue;
+#endif
         if (receiver > bounds.y) {
             continue;
         }

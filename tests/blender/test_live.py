@@ -207,10 +207,11 @@ def test_quality_preset_sets_rsm_settings(bounce, fresh_blend):
     bounce.register()
     try:
         settings = bpy.context.scene.bounce
+        rsm = settings.rsm
         settings.quality = "HIGH"
-        assert (settings.rsm.resolution, settings.rsm.vpl_samples, settings.rsm.visibility) == (256, 256, "voxel")
+        assert (rsm.resolution, rsm.vpl_samples, rsm.visibility, rsm.sky_rays) == (256, 256, "voxel", 8)
         settings.quality = "DRAFT"
-        assert (settings.rsm.resolution, settings.rsm.vpl_samples, settings.rsm.visibility) == (256, 64, "none")
+        assert (rsm.resolution, rsm.vpl_samples, rsm.visibility, rsm.sky_rays) == (256, 64, "none", 0)
     finally:
         bounce.unregister()
 

@@ -35,6 +35,14 @@ def open_floor():
     return replace(sc, world_map=constant_map(RADIANCE))
 
 
+def closed_box(wall_m: float):
+    """A closed 2 m box with walls `wall_m` thick under a sky 1000 times RADIANCE, seen from inside."""
+    outer = box([-1 - wall_m, -1 - wall_m, -wall_m], [1 + wall_m, 1 + wall_m, 2 + wall_m], inward=False)
+    inner = box([-1, -1, 0], [1, 1, 2], inward=True)
+    sc = make_scene(parts((*outer, 0.5), (*inner, 0.5)), [], camera([0.5, 0.5, 1.5], [-1, -1, -0.7], size=32))
+    return replace(sc, world_map=constant_map(RADIANCE * 1e3))
+
+
 @pytest.mark.parametrize(("count", "rtol"), [(16, 0.015), (128, 1e-3)])
 def test_open_floor_under_a_uniform_sky_gets_its_radiance(gl, count, rtol):
     # E = pi L on a floor under a uniform sky, so Diffuse Direct = E / pi = L exactly: the regions'
@@ -58,13 +66,53 @@ def test_closed_box_under_a_sky_stays_dark(gl, wall_m):
     # past the roof's silhouette to surfaces deeper than the receiver (one depth layer cannot tell them
     # from the floor seen through an opening); measured 85 of 1024 pixels at most 0.37 % of the open
     # floor's light, 0.008 % on average: bounded at 1 % and 0.03 %.
-    outer = box([-1 - wall_m, -1 - wall_m, -wall_m], [1 + wall_m, 1 + wall_m, 2 + wall_m], inward=False)
-    inner = box([-1, -1, 0], [1, 1, 2], inward=True)
-    sc = make_scene(parts((*outer, 0.5), (*inner, 0.5)), [], camera([0.5, 0.5, 1.5], [-1, -1, -0.7], size=32))
-    img = direct(gl, replace(sc, world_map=constant_map(RADIANCE * 1e3)), sky_texels=64)
+    img = direct(gl, closed_box(wall_m), sky_texels=64)
     assert np.isfinite(img).all() and img.min() >= 0.0
     share = img[..., :3] / (RADIANCE * 1e3)  # of what the open floor gets
     if wall_m >= 0.4:
         assert share.max() == 0.0
     else:
         assert share.max() < 0.01 and share.mean() < 3e-4
+
+
+@pytest.mark.parametrize("count", [16, 128])
+def test_open_floor_with_exact_rays_gets_its_radiance(gl, count):
+    # With RsmConfig.sky_rays nothing is estimated where nothing blocks: the depth bounds show the floor
+    # in front of everything, or its rays cross no triangle but its own (which they start off). Exact up
+    # to fp32 sums (1e-3, as at 128 directions above), at 16 wide directions too.
+    img = direct(gl, open_floor(), sky_directions=count, sky_rays=8)
+    centre = img[8:24, 8:24, :3].reshape(-1, 3)
+    np.testing.assert_allclose(centre, np.broadcast_to(RADIANCE, centre.shape), rtol=1e-3)
+
+
+@pytest.mark.parametrize("wall_m", [0.1, 0.4])
+def test_closed_box_with_exact_rays_stays_dark(gl, wall_m):
+    # Every ray from the inside crosses a wall's triangles: exactly 0, the thin walls too (the filter
+    # lets 0.37 % through them at most, above).
+    img = direct(gl, closed_box(wall_m), sky_rays=8)
+    assert np.isfinite(img).all()
+    assert img[..., :3].max() == 0.0
+
+
+def test_a_skylight_with_exact_rays_lets_in_its_share(gl):
+    # A closed 6 m room 1 m high whose flat roof has one square opening of half-side a = 0.5 m above the
+    # floor's centre, under a uniform sky: the centre sees the sky through the opening only, so its
+    # Diffuse Direct is L times the opening's form factor, exactly. For a parallel rectangle with a corner
+    # above the point, F = (X / sqrt(1 + X^2) atan(Y / sqrt(1 + X^2)) + Y / sqrt(1 + Y^2) atan(X / sqrt(1
+    # + X^2))) / (2 pi), X, Y its sides over the height; the opening is four such quarters (F = 0.2395,
+    # checked against a numerical integral). The rays are a quadrature of the opening: at one point, on
+    # a 64 x 128 map, 512 regions of 8 rays read 1.006 F, 128 of 16 0.968, 128 of 8 0.944 (the filter
+    # 1.13); bounded at 2 % for 512 of 8.
+    a, h, r = 0.5, 1.0, 3.0
+    roof = [rect([-r, -r, h], [r - a, 0, 0], [0, 2 * r, 0]), rect([a, -r, h], [r - a, 0, 0], [0, 2 * r, 0]),
+            rect([-a, -r, h], [2 * a, 0, 0], [0, r - a, 0]), rect([-a, a, h], [2 * a, 0, 0], [0, r - a, 0])]
+    walls = [rect([-r, -r, 0], [2 * r, 0, 0], [0, 0, h]), rect([-r, r, 0], [2 * r, 0, 0], [0, 0, h]),
+             rect([-r, -r, 0], [0, 2 * r, 0], [0, 0, h]), rect([r, -r, 0], [0, 2 * r, 0], [0, 0, h])]
+    floor = rect([-r, -r, 0], [2 * r, 0, 0], [0, 2 * r, 0])
+    sc = make_scene(parts(*[(*piece, 0.5) for piece in (*roof, *walls, floor)]), [],
+                    camera([0, -0.01, 0.6], [0, 0.01, -1], size=32, fov_deg=20))
+    img = direct(gl, replace(sc, world_map=constant_map(RADIANCE, 64, 128)), sky_directions=512, sky_rays=8)
+    x = a / h
+    quarter = 2 * x / np.sqrt(1 + x * x) * np.arctan(x / np.sqrt(1 + x * x)) / (2 * np.pi)
+    centre = img[14:18, 14:18, :3].reshape(-1, 3)
+    np.testing.assert_allclose(centre.mean(axis=0), RADIANCE * 4 * quarter, rtol=0.02)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from addon.engine.world import constant_map, directions, regions, texel_vectors, world_suns
+from addon.engine.world import constant_map, directions, regions, sky_regions, texel_vectors, world_suns
 
 
 def irradiance(suns, n):
@@ -139,3 +139,23 @@ def test_the_sky_atlas_keeps_within_its_widest_side():
     for count in (1, 2, 17, 189, 256, 1024):
         for texels in (16, 64, 300, 1024):
             assert max(SkyLayout.of(count, texels).size) <= ATLAS_MAX_TEXELS
+
+
+def test_sky_regions_rays_split_each_region_by_its_light():
+    # A map with one bright texel: the region holding it gets rays whose shares follow power, each ray a
+    # unit vector within its region, the shares summing to 1; one ray per region is the region's own
+    # direction (its sun's); no rays: an empty (suns, 0, 4).
+    radiance = constant_map(np.array([1.0, 1.0, 1.0]), 16, 32)
+    radiance[3, 5] = 50.0
+    suns, rays = sky_regions(radiance, 8, 8)
+    assert rays.shape == (len(suns), 8, 4)
+    np.testing.assert_allclose(rays[..., 3].sum(axis=1), 1.0, rtol=1e-12)
+    used = rays[..., 3] > 0
+    np.testing.assert_allclose(np.linalg.norm(rays[used][:, :3], axis=1), 1.0, rtol=1e-12)
+    for sun, own in zip(suns, rays, strict=True):  # every ray within 90 degrees of its region's direction
+        assert np.all(own[own[:, 3] > 0, :3] @ -sun.direction > 0)
+    suns1, one = sky_regions(radiance, 8, 1)
+    np.testing.assert_allclose(one[:, 0, :3], [-s.direction for s in suns1], atol=1e-12)
+    np.testing.assert_allclose(one[:, 0, 3], 1.0)
+    assert sky_regions(radiance, 8, 0)[1].shape == (len(suns), 0, 4)
+    assert [s.sun_strength for s in suns] == [s.sun_strength for s in world_suns(radiance, 8, by_width=True)]

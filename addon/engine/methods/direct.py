@@ -174,6 +174,8 @@ class DirectMethod:
         # The RSM's triangles by the index its texels name (rsm.frag.glsl): the direct pass's exact shadows.
         table = rsm.occluder_table(self.scene.positions_m[not_emitting])
         self.occluders = be.texture((table.shape[1], table.shape[0]), data=table)
+        self._not_emitting = not_emitting
+        self._bvh = None  # the same triangles' hierarchy (RsmConfig.sky_rays), made on first use
         n = self.rsm_config.resolution
         self._rsm_slots: list[tuple[dict, object]] = []  # (textures, target) per kept face, made on use
         self._kept_faces = max(1, RSM_KEEP_BYTES // (RSM_BYTES_PER_TEXEL * n * n))
@@ -266,12 +268,13 @@ class DirectMethod:
         lo, hi = self.bounds_m
         count = world.sky_direction_count(suns, [*self.source.lights, *self.emissive], most, least,
                                           0.5 * float(np.linalg.norm(hi - lo)))
-        key = (self._world_key, count)
+        rays = self.rsm_config.sky_rays
+        key = (self._world_key, count, rays)
         shadows = next((s for s in self._skies.values() if s.key == key), None)  # another call's: drawn once
         if shadows is None:
             shadows = self._skies.setdefault((most, least), sky_light.SkyShadows())
-            shadows.update(self.backend, key, world.world_suns(self._world_map, count, by_width=True), self.bounds_m,
-                           self.rsm_config.sky_texels)
+            suns, taps = world.sky_regions(self._world_map, count, rays)
+            shadows.update(self.backend, key, suns, taps, self.bounds_m, self.rsm_config.sky_texels)
         return shadows if shadows.layout is not None else None
 
     def skies(self) -> list[sky_light.SkyShadows]:
@@ -463,18 +466,23 @@ class DirectMethod:
         self.shade_sky(timings, sky_light.DIRECT_DECL, self.gbuf["position"], self.gbuf["normal"], self.direct)
 
     def shade_sky(self, timings: dict[str, float], decl, position, normal, out, accumulate: bool = True,
-                  most: int | None = None, texel_lists=(None,)) -> bool:
+                  most: int | None = None, texel_lists=(None,), rays: bool = True) -> bool:
         """The sky's direct light (`sky(most)`) at the surfaces `position` / `normal` hold, into `out`
         (added, or replacing at those that hold one), timed as `decl`; False (nothing written) without a
-        world. texel_lists: the texels to shade, as lists (probe_capture.texel_lists); None: every one."""
+        world. texel_lists: the texels to shade, as lists (probe_capture.texel_lists); None: every one.
+        rays: shadows from RsmConfig.sky_rays' exact rays when it asks for them (else, and with False,
+        the shadow maps' filter)."""
         sky = self.sky(most)
         if sky is None:
             return False
+        count = self.rsm_config.sky_rays if rays else 0
+        if count and self._bvh is None:  # made on first use: only exact rays need it
+            self._bvh = sky_light.BvhTextures.upload(self.backend, self.scene.positions_m[self._not_emitting])
         with self.step(timings, decl):
             diagonal_m = float(np.linalg.norm(self.bounds_m[1] - self.bounds_m[0]))
             for texel_list in texel_lists:
                 sky_light.direct(self.backend, position, normal, sky.atlas, sky.bounds, sky.table, out, sky.layout,
-                                 diagonal_m, accumulate, texel_list)
+                                 diagonal_m, accumulate, texel_list, rays=count, tree=self._bvh)
         return True
 
     def _gather(self, views: list[LightView], timings: dict[str, float], slots, first: bool = True) -> None:

@@ -130,7 +130,7 @@ class ProbesMethod(OneBounceMethod):
                 zero.images(self.backend, [self.atlas_sky])  # texels that see no geometry stay 0
             self.shade_sky(timings, probe_project.SKY_DECL, self.atlas["position"], self.atlas["normal"],
                            self.atlas_sky, accumulate=False, most=self.probes_config.atlas_sky_directions,
-                           texel_lists=tuple(self.texel_lists.values()))
+                           texel_lists=tuple(self.texel_lists.values()), rays=False)
             self._atlas_sky_for = (id(sky), sky.key)
         with self.step(timings, probe_project.SKY_COPY_DECL):
             copy.run(self.backend, self.atlas_sky, self.atlas_direct)

@@ -74,6 +74,8 @@ LIGHT_VIEWS = Port("scene", "light_views", "uniforms", "scene",
 
 OCCLUDERS = Port("scene", "occluders", "RGBA32F", "table",
                  "the corners (m) of the triangles the RSMs draw, OCCLUDER_ROW triangles of 3 texels per row")
+BVH = Port("scene", "bvh", "RGBA32F", "table",
+           "bvh.py's hierarchy over the occluders: node bounds (m) in heap order, triangles in leaf order")
 EMITTERS = Port("scene", "emitters", "RGBA32F", "table",
                 "per polygon of an emitter with its shape: vertices (m), radiance (W/m^2/sr), sidedness")
 

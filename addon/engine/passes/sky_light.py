@@ -26,14 +26,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import bvh
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..scene import Light
 from ..world import power_shares
 from . import rsm
-from .declare import DIRECT, GBUF_NORMAL, GBUF_POSITION, TRIANGLES, PassDecl, Port
+from .declare import BVH, DIRECT, GBUF_NORMAL, GBUF_POSITION, TRIANGLES, PassDecl, Port
 from .light_views import views_for
 
-TABLE_TEXELS = 6
+TABLE_TEXELS = 6  # then RsmConfig.sky_rays texels of rays, when it asks for them
+# Directions per dispatch of the direct pass with rays. llvmpipe caps the iterations of all the loops
+# inside a shader's outermost loop together at 65535 and then leaves that loop: over 165 directions of 8
+# rays each the hierarchy's steps passed it, and window-sky's floor summed only the first 71.
+RAY_DIRECTIONS_PER_DISPATCH = 8
 
 SHADOW_SPEC = ShaderSpec(
     name="sky_shadow",
@@ -59,27 +64,34 @@ BOUNDS_SPEC = ShaderSpec(
     defines=(("BLOCK", str(BLOCK_TEXELS)),),
 )
 
-def _direct_spec(listed: bool) -> ShaderSpec:
+def _direct_spec(listed: bool, rays: bool) -> ShaderSpec:
     """listed: one invocation per texel of a list (`texel_list`, probe_capture.texel_lists) instead of
-    per pixel: the probe atlas's texels that see geometry, so that the others cost no invocation."""
+    per pixel: the probe atlas's texels that see geometry, so that the others cost no invocation.
+    rays: each region's rays tested exactly against the triangles (bvh.py) instead of the shadow maps'
+    soft-shadow filter."""
     return ShaderSpec(
-        name="sky_direct" + ("_listed" if listed else ""),
+        name="sky_direct" + ("_listed" if listed else "") + ("_rays" if rays else ""),
         compute="sky/direct.comp.glsl",
         local_size=(8, 8, 1),
-        defines=(("BLOCK", str(BLOCK_TEXELS)),) + ((("TEXEL_LIST", "1"),) if listed else ()),
+        defines=(("BLOCK", str(BLOCK_TEXELS)),) + ((("TEXEL_LIST", "1"),) if listed else ())
+        + ((("SKY_RAYS", "1"), ("NODE_ROW", str(bvh.NODE_ROW)), ("OCCLUDER_ROW", str(rsm.OCCLUDER_ROW)),
+            ("LEAF_TRIANGLES", str(bvh.LEAF_TRIANGLES))) if rays else ()),
         samplers=(Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("sky_depth_atlas", "2D"),
                   Sampler("sky_bounds", "2D"), Sampler("sky_table", "2D"))
-        + ((Sampler("texel_list", "2D"),) if listed else ()),
+        + ((Sampler("texel_list", "2D"),) if listed else ())
+        + ((Sampler("bvh_nodes", "2D"), Sampler("bvh_triangles", "2D")) if rays else ()),
         images=(Image("direct", "2D", "RGBA32F", "read_write"),),
-        uniforms=(Var("sky_count", "int"), Var("tiles_x", "int"), Var("tile_texels", "int"),
-                  Var("scene_diagonal_m", "float"), Var("accumulate", "int")),
+        uniforms=(Var("sky_count", "int"), Var("sky_first", "int"), Var("sky_chunk", "int"), Var("tiles_x", "int"),
+                  Var("tile_texels", "int"), Var("scene_diagonal_m", "float"), Var("accumulate", "int"))
+        + ((Var("sky_rays", "int"), Var("bvh_leaves", "int")) if rays else ()),
     )
 
 
-DIRECT_SPECS = {listed: _direct_spec(listed) for listed in (False, True)}
+DIRECT_SPECS = {(listed, rays): _direct_spec(listed, rays) for listed in (False, True) for rays in (False, True)}
 
 SKY_TABLE = Port("scene", "sky_table", "RGBA32F", "table",
-                 "per sky direction: view-projection rows, axis and texel size (m), irradiance (W/m^2)")
+                 "per sky direction: view-projection rows, axis and texel size (m), irradiance (W/m^2), its "
+                 "region's rays (unit directions, shares of its light)")
 SKY_DEPTH = Port("sky", "depth", "RGBA32F", "sky_atlas",
                  "per sky direction's tile: depth along its axis (m), w = 1 where geometry")
 
@@ -97,8 +109,9 @@ BOUNDS_DECL = PassDecl("sky_bounds", "solve", (SKY_DEPTH,), (SKY_BOUNDS,),
                        "the atlas's depth bounds per block: most directions settled in one fetch")
 RSM_DECL = PassDecl("sky_rsm", "solve", (TRIANGLES, SKY_TABLE), SKY_RSM,
                     "every sky direction's RSM into its tile: the world's VPLs (vct)")
-DIRECT_DECL = PassDecl("sky_direct", "gather", (GBUF_POSITION, GBUF_NORMAL, SKY_DEPTH, SKY_BOUNDS, SKY_TABLE),
-                       (DIRECT,), "the sky's shadowed direct light of every direction, in one pass, added")
+DIRECT_DECL = PassDecl("sky_direct", "gather", (GBUF_POSITION, GBUF_NORMAL, SKY_DEPTH, SKY_BOUNDS, SKY_TABLE, BVH),
+                       (DIRECT,), "the sky's shadowed direct light of every direction, in one pass (with rays: "
+                       "one pass per RAY_DIRECTIONS_PER_DISPATCH), added")
 
 
 # The atlas's widest side: 64 MB of RGBA32F, and as much again per RSM tile texture vct adds. 1024 directions
@@ -151,15 +164,16 @@ class SkyShadows:
         self.layout: SkyLayout | None = None
         self.rsm = None  # (textures, target) of the directions' RSM tiles, rsm_target()
 
-    def update(self, backend: Backend, key, suns: list[Light], bounds: tuple[np.ndarray, np.ndarray],
-               texels: int) -> None:
-        """Make the table and draws of `suns` (their tiles `texels` a side), remembered as `key`; no suns
-        (a world whose regions all carry no light): no layout, nothing to draw."""
+    def update(self, backend: Backend, key, suns: list[Light], taps: np.ndarray,
+               bounds: tuple[np.ndarray, np.ndarray], texels: int) -> None:
+        """Make the table and draws of `suns` (their tiles `texels` a side) and their regions' rays `taps`
+        (world.sky_regions; (len(suns), 0, 4) for none), remembered as `key`; no suns (a world whose
+        regions all carry no light): no layout, nothing to draw."""
         if not suns:
             self.layout, self.key = None, key
             return
         layout = SkyLayout.of(len(suns), texels)
-        rows, self.views = table(suns, bounds, layout.tile_texels)
+        rows, self.views = table(suns, taps, bounds, layout.tile_texels)
         if layout != self.layout:
             self.atlas = backend.texture(layout.size)
             self.bounds = backend.texture(layout.blocks)
@@ -178,10 +192,12 @@ class SkyShadows:
         return self.rsm
 
 
-def table(suns: list[Light], bounds: tuple[np.ndarray, np.ndarray], tile_texels: int) -> tuple[np.ndarray, list]:
+def table(suns: list[Light], taps: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
+          tile_texels: int) -> tuple[np.ndarray, list]:
     """The sky table (rows, TABLE_TEXELS, 4) float32 and each direction's LightView: a sun's RSM view
-    (light_views._sun_view) at the tile's size, what its shadow draw (and its RSM tile) use."""
-    rows = np.zeros((len(suns), TABLE_TEXELS, 4), np.float32)
+    (light_views._sun_view) at the tile's size, what its shadow draw (and its RSM tile) use. `taps`
+    (len(suns), rays, 4): each region's rays and their shares (world.region_taps), texels 6 on."""
+    rows = np.zeros((len(suns), TABLE_TEXELS + taps.shape[1], 4), np.float32)
     views = []
     # A tile's RSM (rsm_tiles) weighs its surfels' areas by its share of the sky's power: vct caps all the
     # tiles' VPLs as one light, against their lit cross-section, which a surface every direction lights
@@ -193,6 +209,7 @@ def table(suns: list[Light], bounds: tuple[np.ndarray, np.ndarray], tile_texels:
         rows[k, :4] = view.view_projection
         rows[k, 4] = (*view.face_axis, math.sqrt(view.texel_scale))
         rows[k, 5] = (*(sun.color * sun.sun_strength), math.tan(sun.sun_angle_rad / 2.0))
+        rows[k, TABLE_TEXELS:] = taps[k]
         views.append(view)
     return rows, views
 
@@ -225,19 +242,45 @@ def bounds(backend: Backend, atlas, out, layout: SkyLayout) -> None:
                      images={"sky_bounds": out})
 
 
+@dataclass
+class BvhTextures:
+    """bvh.py's hierarchy on the GPU (BVH): `nodes` (bvh.node_table), `triangles` (leaf order,
+    rsm.occluder_table's layout) and the leaf count."""
+
+    nodes: object
+    triangles: object
+    leaves: int
+
+    @classmethod
+    def upload(cls, backend: Backend, triangles_m: np.ndarray) -> BvhTextures:
+        tree = bvh.build(triangles_m)
+        nodes = bvh.node_table(tree)
+        leaf_order = rsm.occluder_table(bvh.leaf_triangles(tree, triangles_m))
+        return cls(backend.texture((nodes.shape[1], nodes.shape[0]), data=nodes),
+                   backend.texture((leaf_order.shape[1], leaf_order.shape[0]), data=leaf_order), tree.leaves)
+
+
 def direct(backend: Backend, gbuf_position, gbuf_normal, atlas, sky_bounds, sky_table, out, layout: SkyLayout,
-           scene_diagonal_m: float, accumulate: bool = True, texel_list=None) -> None:
+           scene_diagonal_m: float, accumulate: bool = True, texel_list=None, rays: int = 0,
+           tree: BvhTextures | None = None) -> None:
     """`scene_diagonal_m`: the bounds' diagonal, the farthest a blocker can be from its receiver (it
     sizes the blocker search: the widest penumbra). accumulate: add to `out`; False: replace its pixels
     that see geometry (those that see none are not written). texel_list: shade only the texels it
-    lists (probe_capture.texel_list) instead of every pixel."""
-    spec = DIRECT_SPECS[texel_list is not None]
+    lists (probe_capture.texel_list) instead of every pixel. rays: the rays per region the table holds,
+    tested against `tree` (the triangles the shadow maps draw); 0: the shadow maps' filter."""
+    spec = DIRECT_SPECS[texel_list is not None, rays > 0]
     samplers = {"gbuf_position": gbuf_position, "gbuf_normal": gbuf_normal, "sky_depth_atlas": atlas,
                 "sky_bounds": sky_bounds, "sky_table": sky_table}
+    uniforms = {"sky_count": layout.count, "tiles_x": layout.tiles_x, "tile_texels": layout.tile_texels,
+                "scene_diagonal_m": scene_diagonal_m}
+    if rays:
+        samplers.update(bvh_nodes=tree.nodes, bvh_triangles=tree.triangles)
+        uniforms.update(sky_rays=rays, bvh_leaves=tree.leaves)
     if texel_list is not None:
         samplers["texel_list"] = texel_list
-    backend.dispatch(backend.program(spec), group_count((texel_list or out).size, spec.local_size),
-                     uniforms={"sky_count": layout.count, "tiles_x": layout.tiles_x,
-                               "tile_texels": layout.tile_texels, "scene_diagonal_m": scene_diagonal_m,
-                               "accumulate": int(accumulate)},
-                     samplers=samplers, images={"direct": out})
+    chunk = RAY_DIRECTIONS_PER_DISPATCH if rays else layout.count
+    for first in range(0, layout.count, chunk):
+        backend.dispatch(backend.program(spec), group_count((texel_list or out).size, spec.local_size),
+                         uniforms={**uniforms, "sky_first": first, "sky_chunk": chunk,
+                                   "accumulate": int(accumulate or first > 0)},
+                         samplers=samplers, images={"direct": out})
