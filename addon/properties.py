@@ -79,7 +79,7 @@ QUALITY_LABELS = {
     "DRAFT": ("Draft", "64 VPLs, no visibility: Cornell rel_rmse_8 0.19, noisier, about a third of Balanced's time"),
     "BALANCED": ("Balanced", "256 VPLs, no visibility (the defaults): Cornell rel_rmse_8 0.19"),
     "HIGH": ("High", "256 VPLs, voxel visibility: Cornell rel_rmse_8 0.073, about 9x Balanced's time; the sky's "
-             "shadows from exact rays: a window's sky light 0.028 from 0.073, its pass 28-150x dearer"),
+             "shadows from exact rays: a window's sky light 0.028 from 0.073, its pass 18-200x dearer"),
 }
 
 

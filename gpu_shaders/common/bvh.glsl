@@ -12,7 +12,13 @@ vec3 bvh_corner(int t, int k) {
 // Whether q + s w crosses any triangle for s_min < s < s_max. The tree is complete and in heap order, so
 // the traversal needs no stack: from a node the ray misses (or a leaf it has tested) it climbs while the
 // node is a right child (even index), then moves to the right sibling; back at the root it is done.
-bool bvh_occluded(vec3 q, vec3 w, float s_min, float s_max) {
+// `hint`: a triangle (leaf-order index) tried first, -1 for none; set to the one crossed. Neighbouring
+// rays are mostly blocked by the same triangle (a room's ceiling), which then costs no traversal.
+bool bvh_occluded(vec3 q, vec3 w, float s_min, float s_max, inout int hint) {
+    if (hint >= 0 && ray_crosses_triangle(bvh_corner(hint, 0), bvh_corner(hint, 1), bvh_corner(hint, 2), q, w, s_min,
+                                          s_max)) {
+        return true;
+    }
     vec3 inv = 1.0 / mix(w, vec3(1e-30), lessThan(abs(w), vec3(1e-30)));
     int first_leaf = bvh_leaves - 1;
     int i = 0;
@@ -38,6 +44,7 @@ bool bvh_occluded(vec3 q, vec3 w, float s_min, float s_max) {
                 for (int j = first; j < first + LEAF_TRIANGLES && !hit; ++j) {
                     hit = ray_crosses_triangle(bvh_corner(j, 0), bvh_corner(j, 1), bvh_corner(j, 2), q, w, s_min,
                                                s_max);
+                    hint = hit ? j : hint;
                 }
             }
             while (i > 0 && i % 2 == 0) {

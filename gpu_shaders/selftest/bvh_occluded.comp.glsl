@@ -9,5 +9,6 @@ void main() {
     }
     vec4 o = texelFetch(origins, p, 0);
     vec3 w = texelFetch(directions, p, 0).xyz;
-    imageStore(hit_out, p, vec4(bvh_occluded(o.xyz, w, o.w, 1e30) ? 1.0 : 0.0, 0.0, 0.0, 0.0));
+    int hint = -1;
+    imageStore(hit_out, p, vec4(bvh_occluded(o.xyz, w, o.w, 1e30, hint) ? 1.0 : 0.0, 0.0, 0.0, 0.0));
 }

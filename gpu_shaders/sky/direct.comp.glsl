@@ -27,12 +27,13 @@ const float RAY_NEAR_TEXELS = 0.05;
 
 // The share of direction k's region that receiver p (normal n) sees: its rays, each tested exactly
 // against the triangles (common/bvh.glsl), weighted by the share of the light each stands for.
-float ray_share(int k, vec3 p, vec3 n, float texel_m) {
+// `hint`: the triangle the last blocked ray crossed (bvh_occluded), carried from region to region.
+float ray_share(int k, vec3 p, vec3 n, float texel_m, inout int hint) {
     vec3 q = p + n * (RAY_LIFT_TEXELS * texel_m);
     float lit = 0.0;
     for (int j = 0; j < sky_rays; ++j) {
         vec4 ray = texelFetch(sky_table, ivec2(6 + j, k), 0);
-        if (ray.w > 0.0 && !bvh_occluded(q, ray.xyz, RAY_NEAR_TEXELS * texel_m, 1e30)) {
+        if (ray.w > 0.0 && !bvh_occluded(q, ray.xyz, RAY_NEAR_TEXELS * texel_m, 1e30, hint)) {
             lit += ray.w;
         }
     }
@@ -84,6 +85,9 @@ void main() {
     vec3 p = pos.xyz;
     vec3 n = texelFetch(gbuf_normal, px, 0).xyz;
     vec3 sum = vec3(0.0);
+#ifdef SKY_RAYS
+    int hint = -1;
+#endif
     for (int k = sky_first; k < min(sky_first + sky_chunk, sky_count); ++k) {
         vec4 axis_texel = texelFetch(sky_table, ivec2(4, k), 0);
         float cos_n = -dot(n, axis_texel.xyz);
@@ -124,7 +128,7 @@ void main() {
         // beside what stands over the receiver (taken as blocked, window-sky read 0.065 / 0.964 against
         // 0.028 / 0.996); nor does the filter below, either way (0.043 trusting its fully lit, 0.056 its
         // fully blocked).
-        sum += light_texel.rgb * (cos_n * ray_share(k, p, n, texel_m));
+        sum += light_texel.rgb * (cos_n * ray_share(k, p, n, texel_m, hint));
         continue;
 #endif
         if (receiver > bounds.y) {

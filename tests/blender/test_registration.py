@@ -222,7 +222,7 @@ def test_panel_draws_what_the_method_reads(registered):
                   if spec.reads_setting(group, name)}
     # Written out for one case: `direct` has no VPL gather, so no VPL samples and no LPV or VCT group.
     bpy.context.scene.bounce.gi.method = "direct"
-    assert drawn_settings() == ["enabled", "method", "resolution", "resolution", "shadow_bias_texels",
+    assert drawn_settings() == ["enabled", "method", "resolution", "resolution", "shadow_bias_texels", "sky_rays",
                                 "error_budget", "bounce.choose", "bounce.report_renderer", "bounce.bake"]
     # Every setting is shown under some method: none is unreachable from the UI (the command line's
     # flags: tests/unit/test_cli_flags.py; the defaults: test_properties_mirror_every_config_field).
