@@ -12,11 +12,15 @@ drawn into tile k = (k % tiles_x, k // tiles_x) of `tile_texels`^2 texels; each 
 along the direction's axis (m), w = 1 where geometry.
 bounds (solve half): per block of BLOCK_TEXELS^2 texels, the least and greatest depth of the 3 x 3
 blocks around it: a receiver in front of all of them is lit, behind all of them shadowed, in one fetch.
-direct (gather half): per G-buffer pixel, sum over directions of E_k max(0, n . l_k) x the bilinear
-percentage-closer visibility of its tile, / pi, added to `direct`. The probes run it in their solve
-on their atlas G-buffer (probe_project.SKY_DECL), with a set of directions of its own (SkyShadows).
-The table (one row per direction, `TABLE_TEXELS` RGBA32F texels): the view-projection's rows, the axis
-with the texel size (m), the irradiance normal to the axis (W/m^2 per colour).
+direct (gather half): per G-buffer pixel, sum over directions of E_k max(0, n . l_k) x the
+percentage-closer soft-shadow visibility of its tile, / pi, added to `direct`; with RsmConfig.sky_rays,
+the visibility is the share of the region's rays that cross no triangle (bvh.py, BvhTextures), tested
+wherever the bounds do not show the receiver in front of everything (docs/DIRECT.md, "Exact rays").
+The probes run it in their solve on their atlas G-buffer (probe_project.SKY_DECL), with a set of
+directions of its own (SkyShadows), always with the filter.
+The table (one row per direction, `TABLE_TEXELS` RGBA32F texels, then one per ray): the
+view-projection's rows, the axis with the texel size (m), the irradiance normal to the axis (W/m^2 per
+colour) with the tangent of the region's angular radius, then each ray's direction and share.
 """
 
 from __future__ import annotations
