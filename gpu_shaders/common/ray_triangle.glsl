@@ -1,3 +1,13 @@
+// The exact shadow tests' margins (direct/shade.comp.glsl, sky/direct.comp.glsl), in texels of the shadow
+// map the test belongs to. How far the segment starts off the receiver's surface: far above fp32's
+// rounding of a position (1e-7 of the scene's size, against 2e-5 for a sun's 1024-texel map), far below
+// a pixel.
+const float EXACT_LIFT_TEXELS = 0.02;
+// Crossings nearer the start than this many texels do not shadow. Where two surfaces meet (a floor and
+// a wall) the G-buffer's depth test may keep a floor point a hair beyond the wall's plane, and its
+// segment would cross the wall at once: cornell's floor-wall seam read 0 over 14 pixels with no margin.
+const float EXACT_NEAR_TEXELS = 0.05;
+
 // Whether q + s w crosses the triangle (a, b, c), either side, for s_min < s < s_max (Moller and
 // Trumbore's test).
 bool ray_crosses_triangle(vec3 a, vec3 b, vec3 c, vec3 q, vec3 w, float s_min, float s_max) {

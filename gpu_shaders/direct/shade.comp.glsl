@@ -72,13 +72,6 @@ bool in_front_of(vec3 p, vec4 occ_position, vec3 occ_normal, float texel_m) {
 // lamp's is a perspective from its centre), and whatever crosses it first from the light covers that
 // point, so the nearest texels see it unless it is thinner than a texel and hidden there behind a
 // surface nearer the light (docs/DIRECT.md, "The shadow test").
-// How far the segment starts off the receiver's surface, in shadow-map texels: far above fp32's rounding
-// of a position (1e-7 of the scene's size, against 2e-5 for a sun's 1024-texel map), far below a pixel.
-const float EXACT_LIFT_TEXELS = 0.02;
-// Crossings nearer the start than this many texels do not shadow. Where two surfaces meet (a floor and
-// a wall) the G-buffer's depth test may keep a floor point a hair beyond the wall's plane, and its
-// segment would cross the wall at once: cornell's floor-wall seam read 0 over 14 pixels with no margin.
-const float EXACT_NEAR_TEXELS = 0.05;
 
 ivec2 shadow_texel(vec3 q, ivec2 size) {
     vec4 clip = light_view_projection * vec4(q, 1.0);

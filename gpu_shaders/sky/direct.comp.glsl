@@ -18,22 +18,17 @@
 #ifdef SKY_RAYS
 #include "common/bvh.glsl"
 
-// The rays start this many texels of the direction's tile off the receiver's surface, far above fp32's
-// rounding of a position and far below a pixel; crossings nearer than RAY_NEAR_TEXELS do not count (a
-// floor point the G-buffer keeps a hair beyond a wall's plane would cross the wall at once). As the
-// direct pass's exact shadows (EXACT_LIFT_TEXELS, EXACT_NEAR_TEXELS in direct/shade.comp.glsl).
-const float RAY_LIFT_TEXELS = 0.02;
-const float RAY_NEAR_TEXELS = 0.05;
-
 // The share of direction k's region that receiver p (normal n) sees: its rays, each tested exactly
-// against the triangles (common/bvh.glsl), weighted by the share of the light each stands for.
+// against the triangles (common/bvh.glsl), weighted by the share of the light each stands for; they start
+// off the surface and skip near crossings as the direct pass's exact shadows do (common/ray_triangle.glsl),
+// in texels of the direction's tile.
 // `hint`: the triangle the last blocked ray crossed (bvh_occluded), carried from region to region.
 float ray_share(int k, vec3 p, vec3 n, float texel_m, inout int hint) {
-    vec3 q = p + n * (RAY_LIFT_TEXELS * texel_m);
+    vec3 q = p + n * (EXACT_LIFT_TEXELS * texel_m);
     float lit = 0.0;
     for (int j = 0; j < sky_rays; ++j) {
         vec4 ray = texelFetch(sky_table, ivec2(6 + j, k), 0);
-        if (ray.w > 0.0 && !bvh_occluded(q, ray.xyz, RAY_NEAR_TEXELS * texel_m, 1e30, hint)) {
+        if (ray.w > 0.0 && !bvh_occluded(q, ray.xyz, EXACT_NEAR_TEXELS * texel_m, 1e30, hint)) {
             lit += ray.w;
         }
     }
@@ -129,8 +124,7 @@ void main() {
         // 0.028 / 0.996); nor does the filter below, either way (0.043 trusting its fully lit, 0.056 its
         // fully blocked).
         sum += light_texel.rgb * (cos_n * ray_share(k, p, n, texel_m, hint));
-        continue;
-#endif
+#else
         if (receiver > bounds.y) {
             continue;
         }
@@ -164,6 +158,7 @@ void main() {
             lit /= float(FILTER_TAPS);
         }
         sum += light_texel.rgb * (cos_n * lit);
+#endif
     }
     vec4 acc = accumulate != 0 ? imageLoad(direct, px) : vec4(0.0);
     imageStore(direct, px, acc + vec4(sum / PI, 0.0));
