@@ -16,7 +16,10 @@ world is the map Bounce captures (bridge/world_capture.py), each texel sampled a
   pass's model with a perfect shadow filter;
 - regions, hard: each region's light from its one direction, visibility exact there;
 - regions, T taps: each region's visible share from T exact rays over it (world.region_taps), as the
-  sky pass estimates it.
+  sky pass estimates it;
+- with --jitter, regions, T parts jittered: each of a region's T parts (world.region_parts) from one
+  direction per pixel drawn uniformly over it, with that direction's radiance, cosine and visibility
+  (an unbiased estimate), at seeds 0 and 1: its error and its noise between the seeds.
 The suns (the scene's SUN lamps, the sky's captured disc) are added with exact visibility to each.
 """
 
@@ -76,15 +79,42 @@ def window_tunnel(scene) -> tuple[float, float, tuple, tuple]:
 
 def sees_sky(points: np.ndarray, towards: np.ndarray, tunnel) -> np.ndarray:
     """(points, directions) booleans: the ray leaves the room through both ends of the window's tunnel."""
+    return leaves_room(points[:, None, :], towards[None, :, :], tunnel)
+
+
+def leaves_room(points: np.ndarray, towards: np.ndarray, tunnel) -> np.ndarray:
+    """Booleans over the broadcast shape of points and towards (..., 3): each ray passes both ends of
+    the window's tunnel."""
     y_in, y_out, (x0, x1), (z0, z1) = tunnel
-    out = np.ones((len(points), len(towards)), bool)
-    dy = np.where(towards[:, 1] > 1e-9, towards[:, 1], np.nan)
+    dy = np.where(towards[..., 1] > 1e-9, towards[..., 1], np.nan)
+    out = np.ones(np.broadcast_shapes(points.shape, towards.shape)[:-1], bool)
     for y in (y_in, y_out):
-        t = (y - points[:, 1:2]) / dy[None, :]
-        x = points[:, 0:1] + t * towards[None, :, 0]
-        z = points[:, 2:3] + t * towards[None, :, 2]
+        t = (y - points[..., 1]) / dy
+        x = points[..., 0] + t * towards[..., 0]
+        z = points[..., 2] + t * towards[..., 2]
         out &= (t > 0) & (x >= x0) & (x <= x1) & (z >= z0) & (z <= z1)
     return out
+
+
+def jittered_sky(points, normals, radiance, parts, tunnel, seed: int) -> np.ndarray:
+    """(points, 3) irradiance from one direction per pixel and part, uniform in solid angle over the
+    part's rectangle of the map (independent per pixel), weighted by its texel's radiance, its own
+    cosine and exact visibility: an unbiased estimate of int L cos V dw over the parts."""
+    h, w = radiance.shape[:2]
+    rng = np.random.default_rng(seed)
+    e = np.zeros((len(points), 3))
+    for rows, cols in parts:
+        z_lo, z_hi = np.sin(np.pi / 2 - np.pi * rows.stop / h), np.sin(np.pi / 2 - np.pi * rows.start / h)
+        lon_lo, lon_hi = 2 * np.pi * cols.start / w - np.pi, 2 * np.pi * cols.stop / w - np.pi
+        u = rng.random((len(points), 2))
+        z, lon = z_lo + u[:, 0] * (z_hi - z_lo), lon_lo + u[:, 1] * (lon_hi - lon_lo)
+        ring = np.sqrt(np.maximum(1 - z * z, 0))
+        toward = np.stack([ring * np.cos(lon), ring * np.sin(lon), z], axis=1)
+        row = np.clip(((np.pi / 2 - np.arcsin(z)) / np.pi * h).astype(int), rows.start, rows.stop - 1)
+        col = np.clip(((lon + np.pi) / (2 * np.pi) * w).astype(int), cols.start, cols.stop - 1)
+        weight = (z_hi - z_lo) * (lon_hi - lon_lo) * np.maximum(np.sum(normals * toward, axis=1), 0)
+        e += radiance[row, col] * (weight * leaves_room(points, toward, tunnel))[:, None]
+    return e
 
 
 def sub_directions(h: int, w: int):
@@ -103,6 +133,8 @@ def main() -> None:
     ap.add_argument("--res", type=int, default=128)
     ap.add_argument("--counts", type=int, nargs="+", default=[186, 744])
     ap.add_argument("--taps", type=int, nargs="*", default=[4, 8, 16])
+    ap.add_argument("--jitter", action="store_true",
+                    help="also each region's T parts from one jittered direction per pixel (seeds 0 and 1)")
     args = ap.parse_args()
 
     import bpy
@@ -133,10 +165,12 @@ def main() -> None:
 
     reference = read_exr(Path(args.reference) / "direct.exr")[..., :3]
 
+    def image(sky_e: np.ndarray) -> np.ndarray:
+        return ((sky_e + sun_e) / np.pi).reshape(*size, 3)
+
     def report(label: str, sky_e: np.ndarray) -> None:
-        image = ((sky_e + sun_e) / np.pi).reshape(*size, 3)
-        print(f"{label}: rel_rmse_8 {metrics.rel_rmse_8(image, reference):.4f}, "
-              f"bias {metrics.bias(image, reference):.4f}")
+        print(f"{label}: rel_rmse_8 {metrics.rel_rmse_8(image(sky_e), reference):.4f}, "
+              f"bias {metrics.bias(image(sky_e), reference):.4f}")
 
     exact = np.zeros((len(points), 3))
     for a in range(0, len(points), PIXEL_CHUNK):
@@ -175,6 +209,13 @@ def main() -> None:
                 share = sees_sky(points, parts[:, :3], tunnel) @ parts[:, 3]
                 tap_e += light * share[:, None]
             report(f"{count} regions, {taps} taps each", tap_e)
+            if args.jitter:
+                parts = [p for k in lit for p in world.region_parts(power, rects[k], taps) if power[p].sum() > 0]
+                seeds = [jittered_sky(points, normals, radiance, parts, tunnel, seed) for seed in (0, 1)]
+                report(f"{count} regions, {taps} parts each, jittered per pixel (seed 0)", seeds[0])
+                a, b = image(seeds[0]), image(seeds[1])
+                print(f"  noise between seeds 0 and 1: per pixel {metrics.rel_rmse(b, a):.4f}, "
+                      f"rel_rmse_8 {metrics.rel_rmse_8(b, a):.4f}")
 
 
 if __name__ == "__main__":

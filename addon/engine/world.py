@@ -170,12 +170,9 @@ def sky_regions(world_map: np.ndarray, count: int, taps: int,
     return suns, np.array(tap_rows, np.float64).reshape(len(suns), taps, 4) if taps else np.zeros((len(suns), 0, 4))
 
 
-def region_taps(radiance: np.ndarray, power: np.ndarray, vectors: np.ndarray, rect: tuple[slice, slice],
-                taps: int) -> np.ndarray:
-    """(taps, 4): region `rect` of the map split into at most `taps` parts, the part of largest power
-    split first, at its power median (`_split`); per part its direction towards the sky (its
-    luminance-weighted vector irradiance, `vectors` = texel_vectors) and its share of the power of the
-    parts that carry light. Parts that carry none, and taps beyond the parts, are 0."""
+def region_parts(power: np.ndarray, rect: tuple[slice, slice], taps: int) -> list[tuple[slice, slice]]:
+    """Region `rect` of the map split into at most `taps` rectangles: the part of largest power split
+    first, at its power median (`_split`), until there are `taps` or none splits further."""
     parts = [rect]
     while len(parts) < taps:
         order = sorted(range(len(parts)), key=lambda i: -float(power[parts[i]].sum()))
@@ -184,8 +181,16 @@ def region_taps(radiance: np.ndarray, power: np.ndarray, vectors: np.ndarray, re
             break  # every part is one texel, or dark
         i, halves = split
         parts[i:i + 1] = list(halves)
+    return parts
+
+
+def region_taps(radiance: np.ndarray, power: np.ndarray, vectors: np.ndarray, rect: tuple[slice, slice],
+                taps: int) -> np.ndarray:
+    """(taps, 4): per part of `region_parts` its direction towards the sky (its luminance-weighted
+    vector irradiance, `vectors` = texel_vectors) and its share of the power of the parts that carry
+    light. Parts that carry none, and taps beyond the parts, are 0."""
     out = np.zeros((taps, 4))
-    for j, part in enumerate(parts):
+    for j, part in enumerate(region_parts(power, rect, taps)):
         vec = LUMA @ np.einsum("ijc,ijk->ck", radiance[part], vectors[part])
         norm = float(np.linalg.norm(vec))
         if norm > 0:
