@@ -72,12 +72,13 @@ _GROUPS = {attr: _group(attr, cls) for attr, cls in CONFIGS.items()}
 # rays"): update them when the report changes.
 QUALITY_PRESETS = {
     "DRAFT": (256, 64, "none", 0),
-    "BALANCED": (256, 256, "none", 0),  # = RsmConfig's defaults
+    "BALANCED": (256, 256, "none", -1),  # = RsmConfig's defaults
     "HIGH": (256, 256, "voxel", 8),
 }
 QUALITY_LABELS = {
     "DRAFT": ("Draft", "64 VPLs, no visibility: Cornell rel_rmse_8 0.19, noisier, about a third of Balanced's time"),
-    "BALANCED": ("Balanced", "256 VPLs, no visibility (the defaults): Cornell rel_rmse_8 0.19"),
+    "BALANCED": ("Balanced", "256 VPLs, no visibility (the defaults): Cornell rel_rmse_8 0.19; the sky's shadows "
+                 "from exact rays in renders and bakes where the sky gives most of the light"),
     "HIGH": ("High", "256 VPLs, voxel visibility: Cornell rel_rmse_8 0.073, about 9x Balanced's time; the sky's "
              "shadows from exact rays: a window's sky light 0.028 from 0.073, its pass 18-200x dearer"),
 }

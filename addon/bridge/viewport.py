@@ -30,6 +30,7 @@ import numpy as np
 
 from ..engine import methods
 from ..engine.backends.base import Sampler, ShaderSpec, Var
+from ..engine.passes import sky_light
 from ..engine.scene import Camera
 from ..properties import to_config
 from . import live
@@ -239,6 +240,7 @@ def _draw(context, settings) -> None:
         live.touch()  # navigating is interaction too: preview now, full quality once it stops
     quality = "preview" if moved or state.quality == "preview" else "full"
     configs = to_config(settings)
+    configs["rsm"] = dataclasses.replace(configs["rsm"], sky_rays=sky_light.viewport_rays(configs["rsm"].sky_rays))
     gi, rsm_config = configs["gi"], configs["rsm"]
     if quality == "preview":
         vpls = max(1, rsm_config.vpl_samples // PREVIEW_VPL_DIVISOR)

@@ -100,9 +100,11 @@ class RsmConfig(_Validated):
     # The sky's shadows at the camera's pixels (and a bake's texels): with this many rays per region,
     # each tested exactly against the triangles (bvh.py), in place of the shadow maps' soft-shadow
     # filter. Window-sky's direct light 0.073 -> 0.028 at 8, the sky pass 18-200x dearer on llvmpipe
-    # (docs/DIRECT.md, "Exact rays"): the High preset's, not the viewport's default.
-    sky_rays: int = _num(0, 0, 16, "rays per sky region tested exactly against the triangles for the sky's "
-                                   "shadows (0: the shadow maps' filter, fast)")
+    # (docs/DIRECT.md, "Exact rays"). -1 (auto, the default): 8 where the world gives at least 30 % of
+    # the direct light, else the filter (sky_light.rays_for); the viewport takes the filter.
+    sky_rays: int = _num(-1, -1, 16, "rays per sky region tested exactly against the triangles for the sky's "
+                                     "shadows (0: the shadow maps' filter, fast; -1: auto, 8 in renders and bakes "
+                                     "where the world gives at least 30 % of the direct light)")
 
 
 @dataclass(frozen=True)

@@ -60,8 +60,9 @@ METHODS: tuple[MethodSpec, ...] = (
         name="direct", summary="RSM-shadowed direct light only: the radiometry check against Cycles",
         module="direct", class_name="DirectMethod", products=("direct", "albedo"), max_bounces=1,
         reads=(*_IMAGE, *_LIGHT_VIEWS),
-        # The sky's exact rays (RsmConfig.sky_rays) beside the filter: only a world's light changes.
-        bench=({"rsm.resolution": 256}, {"rsm.resolution": 512}, {"rsm.sky_rays": 8})),
+        # The sky's shadows (RsmConfig.sky_rays) by the filter and by exact rays, beside the default (auto:
+        # rays where the world gives most of the light): only a world's light changes.
+        bench=({"rsm.resolution": 256}, {"rsm.resolution": 512}, {"rsm.sky_rays": 0}, {"rsm.sky_rays": 8})),
     MethodSpec(
         name="rsm", summary="one bounce gathered from the shadow maps' VPLs, optionally with voxel visibility",
         module="rsm", class_name="RsmMethod", products=("direct", "indirect", "albedo"), max_bounces=1,

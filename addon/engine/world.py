@@ -215,17 +215,13 @@ def power_shares(suns: list[Light]) -> np.ndarray:
     return strengths / total if total > 0 else np.full(len(suns), 1.0 / max(len(suns), 1))
 
 
-def sky_direction_count(world_lights: list[Light], lamps: list[Light], most: int, least: int,
-                        scene_radius_m: float) -> int:
-    """How many directions the sky's direct light gets: `most` times the world's share of the scene's
-    direct light, at least `least`. The share is E_world / (E_world + sum E_lamp), in luminance: E_world
-    the irradiance of the best-lit axis-facing surface under the world's suns (pi L for a floor under a
-    uniform sky), E_lamp a sun's strength, or a lamp's power / (4 pi r^2) at the scene's radius r. A
-    world that gives a small part of the light (Sponza's grey world beside its sun: 2.5 %) needs few
-    directions for the same error in the image; a sky lighting a room through its window, most of them.
-    """
+def world_share(world_lights: list[Light], lamps: list[Light], scene_radius_m: float) -> float:
+    """The world's share of the scene's direct light, E_world / (E_world + sum E_lamp), in luminance:
+    E_world the irradiance of the best-lit axis-facing surface under the world's suns (pi L for a floor
+    under a uniform sky), E_lamp a sun's strength, or a lamp's power / (4 pi r^2) at the scene's radius
+    r. 0 without world light."""
     if not world_lights:
-        return 0
+        return 0.0
     toward = np.array([-s.direction for s in world_lights])
     world_e = float(np.max(np.maximum(AXES @ toward.T, 0.0) @ sun_strengths(world_lights)))
     lamps_e = 0.0
@@ -234,5 +230,16 @@ def sky_direction_count(world_lights: list[Light], lamps: list[Light], most: int
             lamps_e += lamp.sun_strength * float(lamp.color @ LUMA)
         else:
             lamps_e += lamp.power_w * float(lamp.color @ LUMA) / (4.0 * np.pi * max(scene_radius_m, 1e-9) ** 2)
-    share = world_e / (world_e + lamps_e) if world_e > 0 else 0.0
+    return world_e / (world_e + lamps_e) if world_e > 0 else 0.0
+
+
+def sky_direction_count(world_lights: list[Light], lamps: list[Light], most: int, least: int,
+                        scene_radius_m: float) -> int:
+    """How many directions the sky's direct light gets: `most` times the world's share of the scene's
+    direct light (`world_share`), at least `least`; 0 without world light. A world that gives a small
+    part of the light (Sponza's grey world beside its sun: 2.5 %) needs few directions for the same
+    error in the image; a sky lighting a room through its window, most of them."""
+    if not world_lights:
+        return 0
+    share = world_share(world_lights, lamps, scene_radius_m)
     return int(min(most, max(least, round(most * share))))

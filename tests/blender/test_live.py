@@ -20,6 +20,8 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from test_viewport import captured, draw_offscreen, view_context  # noqa: E402
 
+from addon.engine.config import RsmConfig  # noqa: E402
+
 
 @pytest.fixture
 def live_cornell(bounce, fresh_blend, monkeypatch):
@@ -212,6 +214,10 @@ def test_quality_preset_sets_rsm_settings(bounce, fresh_blend):
         assert (rsm.resolution, rsm.vpl_samples, rsm.visibility, rsm.sky_rays) == (256, 256, "voxel", 8)
         settings.quality = "DRAFT"
         assert (rsm.resolution, rsm.vpl_samples, rsm.visibility, rsm.sky_rays) == (256, 64, "none", 0)
+        settings.quality = "BALANCED"  # RsmConfig's defaults: sky rays auto (-1)
+        default = RsmConfig()
+        assert (rsm.resolution, rsm.vpl_samples, rsm.visibility, rsm.sky_rays) == (
+            default.resolution, default.vpl_samples, default.visibility, default.sky_rays) == (256, 256, "none", -1)
     finally:
         bounce.unregister()
 

@@ -354,3 +354,33 @@ def test_excluded_light_is_left_out(bounce, fresh_blend):
     capture.define_light_switch()  # what the CLI does: the saved value is readable again
     assert capture.light_included(bpy.data.lights["Spot"]) is False
     del bpy.types.Light.bounce_include
+
+
+def test_the_viewport_keeps_the_sky_filter_for_auto_rays(bounce, fresh_blend):
+    # RsmConfig.sky_rays' default, auto (-1), traces rays in renders and bakes where the world gives
+    # most of the light (sky_light.rays_for; here all of it: the grey-world box without its spot); the
+    # live viewport runs the filter instead (sky_light.viewport_rays), and a number set by hand is kept.
+    from bounce.addon.bridge import live, scenes, viewport
+
+    bounce.register()
+    try:
+        scenes.build("cornell-grey-world")
+        for obj in [o for o in bpy.context.scene.objects if o.type == "LIGHT"]:
+            bpy.data.objects.remove(obj)
+        settings = bpy.context.scene.bounce
+        settings.gi.method = "direct"
+        settings.gi.resolution = max(W, H)
+        settings.enabled = True
+        ctx = view_context(bpy.context.scene)
+        captured(live)
+        assert settings.rsm.sky_rays == -1
+        draw_offscreen(viewport, ctx)
+        assert live.STATE.error is None
+        method = viewport.overlay_for(1, "full").method
+        assert method.rsm_config.sky_rays == 0 and method.sky().rays == 0
+        settings.rsm.sky_rays = 8
+        draw_offscreen(viewport, ctx)
+        method = viewport.overlay_for(1, "full").method
+        assert method.rsm_config.sky_rays == 8 and method.sky().rays == 8
+    finally:
+        bounce.unregister()

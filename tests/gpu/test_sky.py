@@ -24,6 +24,9 @@ RADIANCE = np.array([0.5, 1.0, 2.0], np.float32)  # W/m^2/sr per colour
 
 
 def direct(gl, sc, **rsm) -> np.ndarray:
+    """The direct light of `sc` at 32 px; the shadow maps' filter unless `rsm` sets sky_rays (its default,
+    auto, takes rays under a world that gives most of the light, as every scene here has)."""
+    rsm = {"sky_rays": 0, **rsm}
     method = methods.create(gl, {"gi": GIConfig(method="direct", resolution=32), "rsm": RsmConfig(**rsm)})
     method.set_scene(sc)
     return method.run().images["direct"]
@@ -116,3 +119,21 @@ def test_a_skylight_with_exact_rays_lets_in_its_share(gl):
     quarter = 2 * x / np.sqrt(1 + x * x) * np.arctan(x / np.sqrt(1 + x * x)) / (2 * np.pi)
     centre = img[14:18, 14:18, :3].reshape(-1, 3)
     np.testing.assert_allclose(centre.mean(axis=0), RADIANCE * 4 * quarter, rtol=0.02)
+
+
+def test_auto_sky_rays_trace_where_the_world_gives_the_light(gl):
+    # RsmConfig's default sky_rays (auto, sky_light.rays_for): under a sky that is all the light, the
+    # closed box's thin walls are tested by 8 exact rays a region (exactly 0 inside, where the filter lets
+    # up to 0.37 % through: above); with a lamp that gives most of the light, the filter (no rays).
+    from addon.engine.scene import Light
+
+    sc = closed_box(0.1)
+    method = methods.create(gl, {"gi": GIConfig(method="direct", resolution=32), "rsm": RsmConfig()})
+    method.set_scene(sc)
+    img = method.run().images["direct"]
+    assert method.sky().rays == 8
+    assert img[..., :3].max() == 0.0
+    lamp = Light("POINT", [0.0, 0.0, 1.0], [0, 0, -1], [1, 1, 1], power_w=1e7)
+    method.set_lights([lamp])
+    method.run()
+    assert method.sky().rays == 0

@@ -83,6 +83,30 @@ def test_sky_direction_count_follows_the_worlds_share():
     assert sky_direction_count([], [sun], 256, 16, 5.0) == 0  # no world, no directions
 
 
+def test_auto_sky_rays_follow_the_worlds_share():
+    # RsmConfig.sky_rays = -1 (auto): 8 rays a region where the world gives at least 30 % of the direct
+    # light (world_share, as sky_direction_count weighs it), else the filter (0); a number set by hand
+    # stays. The world alone: share 1; beside a sun of 3 pi W/m^2, pi / (pi + 3 pi) = 0.25 (filter); of
+    # 2 pi, 1 / 3 (rays). The viewport takes the filter for auto and keeps a number set by hand.
+    from addon.engine.passes.sky_light import AUTO, rays_for, viewport_rays
+    from addon.engine.scene import Light
+    from addon.engine.world import world_share
+
+    sky = world_suns(constant_map([1.0] * 3), 16)
+    strong = Light("SUN", [0, 0, 10], [0, 0, -1], [1, 1, 1], sun_strength=3 * np.pi)
+    weaker = Light("SUN", [0, 0, 10], [0, 0, -1], [1, 1, 1], sun_strength=2 * np.pi)
+    assert world_share(sky, [], 5.0) == 1.0
+    assert np.isclose(world_share(sky, [strong], 5.0), 0.25)
+    assert np.isclose(world_share(sky, [weaker], 5.0), 1 / 3)
+    assert world_share([], [strong], 5.0) == 0.0
+    assert rays_for(AUTO, world_share(sky, [], 5.0)) == 8
+    assert rays_for(AUTO, world_share(sky, [weaker], 5.0)) == 8
+    assert rays_for(AUTO, world_share(sky, [strong], 5.0)) == 0
+    assert rays_for(AUTO, 0.0) == 0
+    assert rays_for(0, 1.0) == 0 and rays_for(5, 0.0) == 5  # set by hand: kept, whatever the share
+    assert viewport_rays(AUTO) == 0 and viewport_rays(8) == 8 and viewport_rays(0) == 0
+
+
 def test_downsample_keeps_each_texels_light():
     # A texel of the coarse map is its fine texels' mean by solid angle, so int L dw over it is the
     # fine texels' sum (to fp64 rounding), and a uniform map stays uniform.

@@ -266,9 +266,9 @@ class DirectMethod:
         most = self.rsm_config.sky_directions if most is None else most
         least = sky_directions_least(self.scene.triangle_count, most) if least is None else min(least, most)
         lo, hi = self.bounds_m
-        count = world.sky_direction_count(suns, [*self.source.lights, *self.emissive], most, least,
-                                          0.5 * float(np.linalg.norm(hi - lo)))
-        rays = self.rsm_config.sky_rays
+        lamps, radius_m = [*self.source.lights, *self.emissive], 0.5 * float(np.linalg.norm(hi - lo))
+        count = world.sky_direction_count(suns, lamps, most, least, radius_m)
+        rays = sky_light.rays_for(self.rsm_config.sky_rays, world.world_share(suns, lamps, radius_m))
         key = (self._world_key, count, rays)
         shadows = next((s for s in self._skies.values() if s.key == key), None)  # another call's: drawn once
         if shadows is None:
@@ -470,12 +470,12 @@ class DirectMethod:
         """The sky's direct light (`sky(most)`) at the surfaces `position` / `normal` hold, into `out`
         (added, or replacing at those that hold one), timed as `decl`; False (nothing written) without a
         world. texel_lists: the texels to shade, as lists (probe_capture.texel_lists); None: every one.
-        rays: shadows from RsmConfig.sky_rays' exact rays when it asks for them (else, and with False,
-        the shadow maps' filter)."""
+        rays: shadows from exact rays where RsmConfig.sky_rays asks for them (sky_light.rays_for; else,
+        and with False, the shadow maps' filter)."""
         sky = self.sky(most)
         if sky is None:
             return False
-        count = self.rsm_config.sky_rays if rays else 0
+        count = sky.rays if rays else 0
         if count and self._bvh is None:  # made on first use: only exact rays need it
             self._bvh = sky_light.BvhTextures.upload(self.backend, self.scene.positions_m[self._not_emitting])
         with self.step(timings, decl):

@@ -44,6 +44,32 @@ TABLE_TEXELS = 6  # then RsmConfig.sky_rays texels of rays, when it asks for the
 # rays each the hierarchy's steps passed it, and window-sky's floor summed only the first 71.
 RAY_DIRECTIONS_PER_DISPATCH = 8
 
+# RsmConfig.sky_rays = AUTO: exact rays where the world gives enough of the direct light that the
+# filter's error on it shows. On window-sky (world share 0.74, `world.world_share`) the filter errs by
+# 0.073 of the direct light, ~0.10 of the sky's own part; a sky that gives a share s of the light then
+# adds ~0.10 s, past the direct light's 0.03 target from s = 0.3 (window-sky-sun, 0.09: 0.027 with the
+# filter). 8 rays a region: window-sky 0.028 (docs/DIRECT.md, "Exact rays"). The viewport does not ask
+# (bridge/viewport.py): the rays cost tens of times the filter's pass.
+AUTO = -1
+AUTO_RAYS = 8
+AUTO_WORLD_SHARE = 0.3
+
+
+def rays_for(setting: int, share: float) -> int:
+    """Rays per sky region for RsmConfig.sky_rays = `setting` when the world gives `share` of the
+    direct light: the setting itself, or for AUTO, AUTO_RAYS from AUTO_WORLD_SHARE on and 0 (the filter)
+    below."""
+    if setting != AUTO:
+        return setting
+    return AUTO_RAYS if share >= AUTO_WORLD_SHARE else 0
+
+
+def viewport_rays(setting: int) -> int:
+    """RsmConfig.sky_rays as the live viewport runs it: AUTO takes the filter there (it redraws on
+    every change, and the rays cost tens of times its pass); a number set by hand, or by the High
+    preset, is kept."""
+    return 0 if setting == AUTO else setting
+
 SHADOW_SPEC = ShaderSpec(
     name="sky_shadow",
     vertex="sky/shadow.vert.glsl",
@@ -166,6 +192,7 @@ class SkyShadows:
         self.key = None  # what the directions were made from (the world and their count)
         self.drawn_key = None  # the key the shadow atlas was last drawn for (it holds until the key changes)
         self.layout: SkyLayout | None = None
+        self.rays = 0  # rays per direction in the table (rays_for), 0: the filter
         self.rsm = None  # (textures, target) of the directions' RSM tiles, rsm_target()
 
     def update(self, backend: Backend, key, suns: list[Light], taps: np.ndarray,
@@ -173,6 +200,7 @@ class SkyShadows:
         """Make the table and draws of `suns` (their tiles `texels` a side) and their regions' rays `taps`
         (world.sky_regions; (len(suns), 0, 4) for none), remembered as `key`; no suns (a world whose
         regions all carry no light): no layout, nothing to draw."""
+        self.rays = taps.shape[1]
         if not suns:
             self.layout, self.key = None, key
             return
