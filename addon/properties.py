@@ -80,7 +80,7 @@ QUALITY_LABELS = {
     "BALANCED": ("Balanced", "256 VPLs, no visibility (the defaults): Cornell rel_rmse_8 0.19; the sky's shadows "
                  "from exact rays in renders and bakes where the sky gives most of the light"),
     "HIGH": ("High", "256 VPLs, voxel visibility: Cornell rel_rmse_8 0.073, about 9x Balanced's time; the sky's "
-             "shadows from exact rays: a window's sky light 0.028 from 0.073, its pass 18-200x dearer"),
+             "shadows from exact rays: a window's sky light 0.028 from 0.073, its pass 19-200x dearer"),
 }
 
 

@@ -99,7 +99,7 @@ class RsmConfig(_Validated):
                                          "their atlas 2048 texels a side)")
     # The sky's shadows at the camera's pixels (and a bake's texels): with this many rays per region,
     # each tested exactly against the triangles (bvh.py), in place of the shadow maps' soft-shadow
-    # filter. Window-sky's direct light 0.073 -> 0.028 at 8, the sky pass 18-200x dearer on llvmpipe
+    # filter. Window-sky's direct light 0.073 -> 0.028 at 8, the sky pass 19-200x dearer on llvmpipe
     # (docs/DIRECT.md, "Exact rays"). -1 (auto, the default): 8 where the world gives at least 30 % of
     # the direct light, else the filter (sky_light.rays_for); the viewport takes the filter.
     sky_rays: int = _num(-1, -1, 16, "rays per sky region tested exactly against the triangles for the sky's "
