@@ -1,12 +1,14 @@
 """Bounce's bake against Cycles' bake curve: texel-space error vs time, and the Cycles-equivalent
-speed-up (time Cycles' bake needs to reach our rel_rmse_8 / our bake time), on the Cornell box.
+speed-up (time Cycles' bake needs to reach our rel_rmse_8 / our bake time), on a procedural scene (the
+Cornell box by default).
 
-    .venv/bin/python tools/bake_speedup.py [--size 64] [--method rsm|lpv|vct] [--emitter-classes] > table.md
+    .venv/bin/python tools/bake_speedup.py [--scene cornell] [--objects Floor BackWall] [--size 64] \
+        [--pass indirect|direct] [--method rsm|lpv|vct|...] [--emitter-classes] [--sky-rays N] > table.md
 
 Reference: a Cycles bake at --ref-spp (seed 0); Cycles' curve: bakes at increasing spp with seed 1;
-Bounce: --method (rsm with voxel visibility by default; lpv and vct at their defaults), per object
-(setup = capture, upload and voxelization, once per file, reported apart). Prints a Markdown table for
-benchmarks/REPORT.md.
+Bounce: --method (rsm with voxel visibility by default; the others at their defaults; `direct` for
+--pass direct), per object (setup = capture, upload and voxelization, once per file, reported apart).
+Prints a Markdown table for benchmarks/REPORT.md.
 """
 
 from __future__ import annotations
@@ -14,24 +16,30 @@ from __future__ import annotations
 import argparse
 import sys
 import tempfile
+from dataclasses import replace
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-OBJECTS = ("Floor", "BackWall")
+OBJECTS = ("Floor", "BackWall")  # the Cornell box's
 
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scene", default="cornell", help="a procedural scene (python -m addon scene --list)")
+    ap.add_argument("--objects", nargs="+", default=list(OBJECTS), help="the scene's objects to bake")
     ap.add_argument("--size", type=int, default=64)
     ap.add_argument("--ref-spp", type=int, default=1024)
+    ap.add_argument("--pass", dest="pass_name", default="indirect", choices=("indirect", "direct"))
     from addon.engine import registry
 
-    indirect = [m.name for m in registry.METHODS if "indirect" in m.products]
-    ap.add_argument("--method", default="rsm", choices=indirect)
+    ap.add_argument("--method", default="rsm", choices=[m.name for m in registry.METHODS])
     ap.add_argument("--emitter-classes", action="store_true", help="lpv: LpvConfig.emitter_classes")
+    ap.add_argument("--sky-rays", type=int, default=None, help="RsmConfig.sky_rays (default: its default)")
     args = ap.parse_args()
+    if args.pass_name not in registry.get(args.method).products:
+        ap.error(f"--method {args.method} does not compute --pass {args.pass_name}")
 
     import bpy
 
@@ -43,20 +51,24 @@ def main() -> int:
 
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
-        blend = Path(tmp) / "cornell.blend"
-        scenes.save("cornell", blend)
+        blend = Path(tmp) / f"{args.scene}.blend"
+        scenes.save(args.scene, blend)
         rsm = RsmConfig(visibility="voxel") if args.method == "rsm" else RsmConfig()
+        if args.sky_rays is not None:
+            rsm = replace(rsm, sky_rays=args.sky_rays)
         settings = {"gi": GIConfig(method=args.method), "rsm": rsm,
                     "lpv": LpvConfig(emitter_classes=args.emitter_classes)}
-        summary = bake_file(blend, Path(tmp) / "ours", list(OBJECTS), args.size, settings, "indirect", progress=False)
+        summary = bake_file(blend, Path(tmp) / "ours", args.objects, args.size, settings, args.pass_name,
+                            progress=False)
         bpy.ops.wm.open_mainfile(filepath=str(blend))
-        for name in OBJECTS:
-            ours = images.read_exr(Path(tmp) / "ours" / f"{name}_indirect.exr")
-            ref, ref_s = cycles_bake(name, {"INDIRECT"}, args.ref_spp, seed=0, size=args.size)
+        cycles_pass = {args.pass_name.upper()}
+        for name in args.objects:
+            ours = images.read_exr(Path(tmp) / "ours" / f"{name}_{args.pass_name}.exr")
+            ref, ref_s = cycles_bake(name, cycles_pass, args.ref_spp, seed=0, size=args.size)
             mask = (ref[..., 3] > 0.5) & (ours[..., 3] > 0.5)
             curve = []
             for spp in (4, 16, 64, 256):
-                img, seconds = cycles_bake(name, {"INDIRECT"}, spp, seed=1, size=args.size)
+                img, seconds = cycles_bake(name, cycles_pass, spp, seed=1, size=args.size)
                 err = metrics.compare(img[..., :3], ref[..., :3], mask)
                 curve.append({"spp": spp, "time_s": seconds, **err})
             err = metrics.compare(ours[..., :3], ref[..., :3], mask)
@@ -68,8 +80,9 @@ def main() -> int:
                         + ", ".join(f"{c['spp']} spp {c['time_s']:.2f} s / {c['rel_rmse_8']:.3f}" for c in curve)
                         + f" | {bound}{up['speedup']:.2f}x |")
     classes = ", emitter classes" if args.emitter_classes and args.method == "lpv" else ""
-    print(f"Cornell box, indirect, method {args.method}{classes}, {args.size} x {args.size} texels; reference: "
-          f"Cycles bake {args.ref_spp} spp.\n")
+    rays = "" if args.sky_rays is None else f", sky rays {args.sky_rays}"
+    print(f"{args.scene}, {args.pass_name}, method {args.method}{classes}{rays}, {args.size} x {args.size} texels; "
+          f"reference: Cycles bake {args.ref_spp} spp.\n")
     print("| object | rel_rmse_8 | bias | Bounce bake | Cycles bake: spp, time / rel_rmse_8 | speed-up |")
     print("| --- | --- | --- | --- | --- | --- |")
     print("\n".join(rows))
