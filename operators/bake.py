@@ -14,6 +14,7 @@ from bpy.props import EnumProperty, IntProperty
 
 from ..addon.engine import registry
 from ..addon.engine.errors import BounceError
+from ..addon.engine.lightmap import SUPERSAMPLE_MAX, check_supersample
 
 _PASSES = [("indirect", "Indirect", "indirect diffuse light (Cycles' Diffuse Indirect units)"),
            ("direct", "Direct", "direct diffuse light (Cycles' Diffuse Direct units)"),
@@ -42,6 +43,9 @@ class BOUNCE_OT_bake(bpy.types.Operator):
     pass_name: EnumProperty(name="Pass", items=_PASSES, default="indirect")
     target: EnumProperty(name="Target", items=_TARGETS, default="image")
     margin: IntProperty(name="Margin", description="texels of seam dilation", default=16, min=0, max=1024)
+    supersample: IntProperty(name="Supersample", description="sub-texels per texel side (images): each texel the "
+                             "mean light over its footprint, as Cycles' bake; N x N times the work", default=1,
+                             min=1, max=SUPERSAMPLE_MAX)
 
     @classmethod
     def poll(cls, context):
@@ -90,6 +94,8 @@ class BOUNCE_OT_bake(bpy.types.Operator):
             method = settings["gi"].method
             if self.pass_name != "direct" and "indirect" not in registry.get(method).products:
                 raise BounceError(f"pass {self.pass_name} needs an indirect method: set Bounce > GI > Method to rsm")
+            if self.target == "image":
+                check_supersample(self.supersample, self.size)
             self._baker = bake.Baker(_backend(), context.evaluated_depsgraph_get(), settings, self.size)
         except BounceError as exc:
             self.report({"ERROR"}, str(exc))
@@ -106,7 +112,7 @@ class BOUNCE_OT_bake(bpy.types.Operator):
 
         try:
             if self.target == "image":
-                values, notes = self._baker.bake_image(obj, self.size, self.pass_name, self.margin)
+                values, notes = self._baker.bake_image(obj, self.size, self.pass_name, self.margin, self.supersample)
                 bake.store_image(bake.image_name(obj.name, self.pass_name), values)
             else:
                 values, notes = self._baker.bake_vertex_colors(obj, self.pass_name)

@@ -3,7 +3,8 @@ speed-up (time Cycles' bake needs to reach our rel_rmse_8 / our bake time), on a
 Cornell box by default).
 
     .venv/bin/python tools/bake_speedup.py [--scene cornell] [--objects Floor BackWall] [--size 64] \
-        [--pass indirect|direct] [--method rsm|lpv|vct|...] [--emitter-classes] [--sky-rays N] > table.md
+        [--pass indirect|direct] [--method rsm|lpv|vct|...] [--emitter-classes] [--sky-rays N] \\
+        [--supersample K] > table.md
 
 Reference: a Cycles bake at --ref-spp (seed 0); Cycles' curve: bakes at increasing spp with seed 1;
 Bounce: --method (rsm with voxel visibility by default; the others at their defaults; `direct` for
@@ -37,6 +38,7 @@ def main() -> int:
     ap.add_argument("--method", default="rsm", choices=[m.name for m in registry.METHODS])
     ap.add_argument("--emitter-classes", action="store_true", help="lpv: LpvConfig.emitter_classes")
     ap.add_argument("--sky-rays", type=int, default=None, help="RsmConfig.sky_rays (default: its default)")
+    ap.add_argument("--supersample", type=int, default=1, help="sub-texels per texel side (bake --supersample)")
     args = ap.parse_args()
     if args.pass_name not in registry.get(args.method).products:
         ap.error(f"--method {args.method} does not compute --pass {args.pass_name}")
@@ -59,7 +61,7 @@ def main() -> int:
         settings = {"gi": GIConfig(method=args.method), "rsm": rsm,
                     "lpv": LpvConfig(emitter_classes=args.emitter_classes)}
         summary = bake_file(blend, Path(tmp) / "ours", args.objects, args.size, settings, args.pass_name,
-                            progress=False)
+                            progress=False, supersample=args.supersample)
         bpy.ops.wm.open_mainfile(filepath=str(blend))
         cycles_pass = {args.pass_name.upper()}
         for name in args.objects:
@@ -81,6 +83,7 @@ def main() -> int:
                         + f" | {bound}{up['speedup']:.2f}x |")
     classes = ", emitter classes" if args.emitter_classes and args.method == "lpv" else ""
     rays = "" if args.sky_rays is None else f", sky rays {args.sky_rays}"
+    rays += "" if args.supersample == 1 else f", supersample {args.supersample}"
     print(f"{args.scene}, {args.pass_name}, method {args.method}{classes}{rays}, {args.size} x {args.size} texels; "
           f"reference: Cycles bake {args.ref_spp} spp.\n")
     print("| object | rel_rmse_8 | bias | Bounce bake | Cycles bake: spp, time / rel_rmse_8 | speed-up |")

@@ -28,10 +28,13 @@ from ..engine import choice, methods
 from ..engine.config import settings as complete_settings
 from ..engine.errors import ConfigError, SceneError
 from ..engine.lightmap import (
+    IMAGE_SIZE_TEXELS,
     PASSES,
     TARGETS,
     VOLUME_TARGETS,
+    block_mean,
     check_choice,
+    check_supersample,
     dilate,
     output_path,
     safe_name,
@@ -196,15 +199,18 @@ class Baker:
         self.texels = TexelBaker(self.method)
         self.setup_ms = (time.perf_counter() - t0) * 1e3
 
-    def bake_image(self, obj, size: int, pass_name: str, margin: int = 16) -> tuple[np.ndarray, list[str]]:
-        """(h, w, 4) float32, row 0 = top, alpha = coverage, and warnings."""
+    def bake_image(self, obj, size: int, pass_name: str, margin: int = 16,
+                   supersample: int = 1) -> tuple[np.ndarray, list[str]]:
+        """(h, w, 4) float32, row 0 = top, alpha = coverage, and warnings. supersample: sub-texels per
+        texel side, each texel the mean of its covered ones (lightmap.block_mean)."""
         tri = object_triangles(obj, self.depsgraph)
         notes = uv_problems(tri["uv"], tri["positions"])
         args = (tri["uv"], tri["positions"], tri["normals"], tri["albedo"])
         overlap = self.texels.overlap(*args, (size, size))
         if overlap > OVERLAP_WARN:
             notes.append(f"overlapping UVs: {overlap:.1%} of covered texels belong to several triangles")
-        values = pass_values(self.texels.bake_triangles(*args, (size, size)), pass_name)
+        fine = size * supersample
+        values = block_mean(pass_values(self.texels.bake_triangles(*args, (fine, fine)), pass_name), supersample)
         covered = values[..., 3] > 0.5
         if not covered.any():
             notes.append("no texel covered (all UV triangles have zero area or lie outside 0..1)")
@@ -319,19 +325,17 @@ def select_objects(names: list[str] | None, shard_index: int = 0, shard_count: i
     return shard(set(names), shard_index, shard_count)
 
 
-IMAGE_SIZE_TEXELS = 512  # a lightmap's side when none is given
-
-
 def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size: int | None = None,
               settings: dict | None = None, pass_name: str = "indirect",
               target: str = "image", overwrite: bool = False, shard_index: int = 0, shard_count: int = 1,
               save_blend: Path | None = None, margin: int = 16, progress: bool = True, backend=None,
-              budget: dict | None = None) -> dict:
+              budget: dict | None = None, supersample: int = 1) -> dict:
     """Bake the objects of `blend` (see module docstring) into out_dir; returns the summary written to
     out_dir/bake.json. Per-object problems are recorded, never raised; bad arguments raise BounceError.
     size: the lightmap side (IMAGE_SIZE_TEXELS when None). settings: {group: config} (config.settings'
-    form; defaults for missing groups). budget: the method chosen for the scene (Baker). A bake that
-    yields no light is recorded under "warnings" and told on stderr."""
+    form; defaults for missing groups). budget: the method chosen for the scene (Baker). supersample:
+    sub-texels per texel side of --target image (Baker.bake_image). A bake that yields no light is
+    recorded under "warnings" and told on stderr."""
     from .pipeline import backend as default_backend
     from .pipeline import open_blend
 
@@ -342,6 +346,7 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
     size = IMAGE_SIZE_TEXELS if size is None else size
     if not 8 <= size <= 8192:
         raise ConfigError(f"--size must be in 8..8192, got {size}")
+    check_supersample(supersample, size)
     settings = complete_settings(**(settings or {}))
     gi = settings["gi"]
     out_dir = check_output_dir(Path(out_dir))
@@ -358,7 +363,8 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
     say(f"bake: capturing the scene, method {gi.method} setup")
     baker = Baker(be, bpy.context.evaluated_depsgraph_get(), settings, size, budget)
     settings, gi = baker.settings, baker.settings["gi"]
-    results = _bake_objects(baker, names, out_dir, size, pass_name, target, overwrite, margin, progress)
+    results = _bake_objects(baker, names, out_dir, size, pass_name, target, overwrite, margin, progress,
+                            supersample)
     saved = None
     if save_blend is not None and target == "vertex-colors":
         bpy.ops.wm.save_as_mainfile(filepath=str(save_blend), copy=True, compress=False)
@@ -368,6 +374,7 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
         print(f"warning: {Path(blend).name}: {warning}", file=sys.stderr)
     summary = {
         "blend": str(blend), "method": gi.method, "pass": pass_name, "target": target, "size": size,
+        "supersample": supersample,
         "config": {group: config.to_dict() for group, config in settings.items()}, "renderer": be.renderer,
         "setup_ms": round(baker.setup_ms, 2), "total_ms": round((time.perf_counter() - t0) * 1e3, 2),
         "shard": [shard_index, shard_count], "saved_blend": saved, "solves": baker.method.solves,
@@ -387,14 +394,14 @@ def _stderr_lines(enabled: bool):
 
 
 def _bake_objects(baker: Baker, names: list[str], out_dir: Path, size: int, pass_name: str, target: str,
-                  overwrite: bool, margin: int, progress: bool) -> list[ObjectResult]:
+                  overwrite: bool, margin: int, progress: bool, supersample: int = 1) -> list[ObjectResult]:
     from tqdm import tqdm
 
     results, taken = [], set()
     bar = tqdm(names, desc="bake", unit="obj", file=sys.stderr, disable=not progress)
     for name in bar:
         bar.set_postfix_str(name[:30])
-        res = _bake_one(baker, name, out_dir, size, pass_name, target, overwrite, margin, taken)
+        res = _bake_one(baker, name, out_dir, size, pass_name, target, overwrite, margin, taken, supersample)
         results.append(res)
         tqdm.write(res.line(), file=sys.stdout)
     return results
@@ -413,7 +420,7 @@ def _file_warnings(scene, results: list[ObjectResult]) -> list[str]:
 
 
 def _bake_one(baker: Baker, name: str, out_dir: Path, size: int, pass_name: str, target: str, overwrite: bool,
-              margin: int, taken: set[str]) -> ObjectResult:
+              margin: int, taken: set[str], supersample: int = 1) -> ObjectResult:
     res = ObjectResult(name)
     t0 = time.perf_counter()
     try:
@@ -426,7 +433,7 @@ def _bake_one(baker: Baker, name: str, out_dir: Path, size: int, pass_name: str,
             if path.exists() and not overwrite:
                 res.status, res.message = "skipped", "file exists (use --overwrite)"
                 return res
-            values, notes = baker.bake_image(obj, size, pass_name, margin)
+            values, notes = baker.bake_image(obj, size, pass_name, margin, supersample)
             images.write_exr(path, values)
             res.size = [size, size]
         else:

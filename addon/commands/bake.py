@@ -13,7 +13,16 @@ from pathlib import Path
 
 from ..engine.config import GIConfig
 from ..engine.errors import ConfigError, SceneError
-from ..engine.lightmap import PASSES, TARGETS, VOLUME_TARGETS, check_choice, parse_shard, safe_name
+from ..engine.lightmap import (
+    IMAGE_SIZE_TEXELS,
+    PASSES,
+    TARGETS,
+    VOLUME_TARGETS,
+    check_choice,
+    check_supersample,
+    parse_shard,
+    safe_name,
+)
 from ._args import existing_blend
 from ._settings import add_budget_flags, add_config_flags, budget, check_bounces, configs, given
 
@@ -37,6 +46,9 @@ def add_arguments(p) -> None:
     p.add_argument("--shard", default=None, help="i/n: bake every n-th object (sorted names) starting at i")
     p.add_argument("--save-blend", default=None, help="vertex-colors: save a copy of the .blend with the attributes")
     p.add_argument("--margin", type=int, default=16, help="texels of seam dilation around UV islands")
+    p.add_argument("--supersample", type=int, default=1,
+                   help="sub-texels per texel side (--target image): each texel the mean light over its "
+                        "covered sub-texels, as Cycles' bake averages over the texel; N x N times the work")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     add_config_flags(p)
     add_budget_flags(p)
@@ -91,6 +103,9 @@ def run(args) -> int:
         raise ConfigError(f"--size {args.size}: out of range [8, 8192]")
     if not 0 <= args.margin <= 1024:
         raise SceneError(f"--margin must be in 0..1024, got {args.margin}")
+    if args.supersample != 1 and args.target != "image":
+        raise ConfigError(f"--supersample is for --target image (got --target {args.target})")
+    check_supersample(args.supersample, IMAGE_SIZE_TEXELS if args.size is None else args.size)
     blends = [existing_blend(b) for b in args.blend]
     if len(blends) > 1 and args.save_blend:
         raise SceneError("--save-blend takes one input file")
@@ -111,7 +126,7 @@ def run(args) -> int:
             out.mkdir(parents=True, exist_ok=True)
         summary = bake_file(blend, file_out, objects, args.size, settings, args.pass_name, args.target,
                             args.overwrite, index, count, Path(args.save_blend) if args.save_blend else None,
-                            args.margin, progress=not args.quiet, budget=chosen_for)
+                            args.margin, progress=not args.quiet, budget=chosen_for, supersample=args.supersample)
         files[str(blend)] = str(file_out / "bake.json")
         failed += [f"{blend.name}:{n}" for n, r in summary["objects"].items() if r["status"] == "error"]
     if len(blends) > 1:

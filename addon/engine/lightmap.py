@@ -53,6 +53,41 @@ def dilate(image: np.ndarray, covered: np.ndarray, iterations: int = 16) -> tupl
     return img.astype(np.asarray(image).dtype, copy=False), filled
 
 
+IMAGE_SIZE_TEXELS = 512  # a lightmap's side when none is given
+SUPERSAMPLE_MAX = 8  # sub-texels per texel side a bake takes at most (--supersample)
+
+
+def block_mean(values: np.ndarray, factor: int) -> np.ndarray:
+    """(h * factor, w * factor, 4) sub-texels (rgb, alpha = coverage) -> (h, w, 4): per texel the mean of
+    its factor x factor covered sub-texels, alpha 1 where any is covered (0 and rgb 0 where none is).
+
+    Why: Cycles' bake gives a texel the mean light over its footprint (its samples jitter over it); a
+    texel read at its centre alone takes a sharp shadow edge across it as all or nothing. factor 1
+    returns the values as they are."""
+    if factor == 1:
+        return values
+    hf, wf, c = values.shape
+    if hf % factor or wf % factor:
+        raise ValueError(f"a {wf} x {hf} image does not split into {factor} x {factor} blocks")
+    covered = values[..., 3] > 0.5
+    blocks = (hf // factor, factor, wf // factor, factor)
+    total = np.where(covered[..., None], values[..., :3], 0.0).reshape(*blocks, 3).sum(axis=(1, 3))
+    count = covered.reshape(blocks).sum(axis=(1, 3))
+    rgb = total / np.maximum(count, 1)[..., None]
+    return np.concatenate([rgb, (count > 0)[..., None]], axis=2).astype(values.dtype)
+
+
+def check_supersample(factor: int, size: int) -> int:
+    """The sub-texels per texel side, checked: 1..SUPERSAMPLE_MAX, and size x factor within the largest
+    lightmap side (8192)."""
+    if not 1 <= factor <= SUPERSAMPLE_MAX:
+        raise ConfigError(f"--supersample must be in 1..{SUPERSAMPLE_MAX}, got {factor}")
+    if size * factor > 8192:
+        raise ConfigError(f"--size {size} x --supersample {factor} = {size * factor} texels a side: more than "
+                          "8192; lower one of them")
+    return factor
+
+
 _UNSAFE = re.compile(r"[^A-Za-z0-9._-]+")
 
 

@@ -108,6 +108,8 @@ def test_shard_and_vertex_colors_into_a_copy(blend, tmp_path):
     (["{blend}", "--out", "{tmp}", "--pass", "glossy"], "--pass"),
     (["{blend}", "--out", "{tmp}", "--target", "png"], "--target"),
     (["{blend}", "--out", "{tmp}", "--objects", "Nope"], "Nope"),
+    (["{blend}", "--out", "{tmp}", "--supersample", "9"], "--supersample"),
+    (["{blend}", "--out", "{tmp}", "--supersample", "0"], "--supersample"),
 ])
 def test_bad_input_exits_2_with_one_line(blend, tmp_path, args, words):
     r = cli("bake", *[a.format(tmp=tmp_path, blend=blend) for a in args], *FAST)
@@ -163,3 +165,28 @@ def test_a_bake_solves_once_and_gathers_per_object(tmp_path, method_args):
     assert len(objects) == 7 and summary["solves"] == 1
     assert sum(o["solve_ms"] > 0 for o in objects) == 1  # the first object's update solved
     assert all(o["gather_ms"] > 0 for o in objects)
+
+
+def test_a_supersampled_texel_is_the_mean_of_its_covered_sub_texels(blend, tmp_path):
+    # --supersample 2 at 16 texels bakes the same 32 x 32 sub-texels as a plain bake at 32 (the same
+    # G-buffer, the same light) and gives each texel the mean of its covered ones (lightmap.block_mean):
+    # equal to that mean of the 32-texel bake to fp32 rounding, on every texel either covers. The spot's
+    # edge crosses the Floor, so texels between lit and dark take values between.
+    from addon.bridge import images
+    from addon.engine.lightmap import block_mean
+
+    light = ["--rsm-res", "32", "--vpl-samples", "4", "--visibility", "none", "--quiet", "--method", "direct",
+             "--pass", "direct", "--objects", "Floor", "--margin", "0"]
+    for size, factor in ((16, 2), (32, 1)):
+        r = cli("bake", str(blend), "--out", str(tmp_path / f"s{size}"), "--size", str(size), "--supersample",
+                str(factor), *light)
+        assert r.returncode == 0, r.stderr
+    fine = images.read_exr(tmp_path / "s32" / "Floor_direct.exr")
+    coarse = images.read_exr(tmp_path / "s16" / "Floor_direct.exr")
+    expected = block_mean(fine, 2)
+    covered = expected[..., 3] > 0.5
+    assert covered.mean() > 0.5 and (coarse[..., 3] > 0.5).sum() == covered.sum()
+    np.testing.assert_allclose(coarse[covered], expected[covered], rtol=1e-5, atol=1e-6)
+    lit = fine[..., :3].max()
+    between = (coarse[covered][:, :3].max(axis=1) > 0.05 * lit) & (coarse[covered][:, :3].max(axis=1) < 0.95 * lit)
+    assert between.any()

@@ -64,3 +64,33 @@ def test_uv_problems():
     notes = uv_problems(uv, pos)
     assert len(notes) == 1 and "1 of 2 triangles have zero UV area" in notes[0]
     assert "outside 0..1" in uv_problems(uv + 1.5, pos)[-1]
+
+
+def test_block_mean_averages_only_covered_sub_texels():
+    # 4 x 4 sub-texels, factor 2: texel (0, 0) all covered (values 1, 2, 3, 4: mean 2.5), texel (0, 1)
+    # one covered (7), texel (1, 0) none (0, uncovered), texel (1, 1) two covered (2 and 6: 4). An
+    # uncovered sub-texel's value never counts, whatever it holds.
+    from addon.engine.lightmap import block_mean
+
+    v = np.zeros((4, 4, 4))
+    v[0:2, 0:2, 0] = [[1, 2], [3, 4]]
+    v[0:2, 0:2, 3] = 1
+    v[0, 2, 0], v[0, 2, 3], v[1, 3, 0] = 7, 1, 100  # (1, 3) holds 100 but is not covered
+    v[2:4, 0:2, 0] = 50  # none covered
+    v[2, 2, 0], v[3, 3, 0] = 2, 6
+    v[2, 2, 3] = v[3, 3, 3] = 1
+    out = block_mean(v, 2)
+    assert out[..., 0].tolist() == [[2.5, 7.0], [0.0, 4.0]]
+    assert out[..., 3].tolist() == [[1, 1], [0, 1]]
+    assert block_mean(v, 1) is v
+    with pytest.raises(ValueError):
+        block_mean(v[:3], 2)
+
+
+def test_check_supersample_bounds_the_factor_and_the_texels():
+    from addon.engine.lightmap import SUPERSAMPLE_MAX, check_supersample
+
+    assert check_supersample(1, 8192) == 1 and check_supersample(SUPERSAMPLE_MAX, 1024) == SUPERSAMPLE_MAX
+    for factor, size in ((0, 64), (SUPERSAMPLE_MAX + 1, 64), (2, 8192), (4, 4096)):
+        with pytest.raises(ConfigError):
+            check_supersample(factor, size)
