@@ -7,6 +7,7 @@ the relative imports between addon/, operators/ and panels/ resolve and scene.bo
 
 from __future__ import annotations
 
+import contextlib
 import math
 import types
 from pathlib import Path
@@ -73,16 +74,18 @@ def draw_offscreen(viewport, ctx, width=W, height=H) -> np.ndarray:
         offscreen.free()
 
 
-@pytest.fixture
-def cornell(bounce, fresh_blend):
-    """The add-on registered, the Cornell box built, the overlay enabled with method rsm, captured."""
+@contextlib.contextmanager
+def overlay_on(bounce, scene_name: str, method: str, edit=lambda: None):
+    """The add-on registered, procedural scene `scene_name` built (then `edit()`), the overlay enabled
+    with `method` at the region's size, captured: yields the draw context; unregisters after."""
     from bounce.addon.bridge import live, scenes
 
     bounce.register()
     try:
-        scenes.build("cornell")
+        scenes.build(scene_name)
+        edit()
         settings = bpy.context.scene.bounce
-        settings.gi.method = "rsm"
+        settings.gi.method = method
         settings.gi.resolution = max(W, H)
         settings.enabled = True
         ctx = view_context(bpy.context.scene)
@@ -90,6 +93,13 @@ def cornell(bounce, fresh_blend):
         yield ctx
     finally:
         bounce.unregister()
+
+
+@pytest.fixture
+def cornell(bounce, fresh_blend):
+    """The Cornell box with the overlay enabled, method rsm (overlay_on)."""
+    with overlay_on(bounce, "cornell", "rsm") as ctx:
+        yield ctx
 
 
 def _textures(viewport, method) -> dict[str, np.ndarray]:
@@ -360,19 +370,14 @@ def test_the_viewport_keeps_the_sky_filter_for_auto_rays(bounce, fresh_blend):
     # RsmConfig.sky_rays' default, auto (-1), traces rays in renders and bakes where the world gives
     # most of the light (sky_light.rays_for; here all of it: the grey-world box without its spot); the
     # live viewport runs the filter instead (sky_light.viewport_rays), and a number set by hand is kept.
-    from bounce.addon.bridge import live, scenes, viewport
+    from bounce.addon.bridge import live, viewport
 
-    bounce.register()
-    try:
-        scenes.build("cornell-grey-world")
+    def without_lamps():
         for obj in [o for o in bpy.context.scene.objects if o.type == "LIGHT"]:
             bpy.data.objects.remove(obj)
+
+    with overlay_on(bounce, "cornell-grey-world", "direct", without_lamps) as ctx:
         settings = bpy.context.scene.bounce
-        settings.gi.method = "direct"
-        settings.gi.resolution = max(W, H)
-        settings.enabled = True
-        ctx = view_context(bpy.context.scene)
-        captured(live)
         assert settings.rsm.sky_rays == -1
         draw_offscreen(viewport, ctx)
         assert live.STATE.error is None
@@ -382,5 +387,3 @@ def test_the_viewport_keeps_the_sky_filter_for_auto_rays(bounce, fresh_blend):
         draw_offscreen(viewport, ctx)
         method = viewport.overlay_for(1, "full").method
         assert method.rsm_config.sky_rays == 8 and method.sky().rays == 8
-    finally:
-        bounce.unregister()
