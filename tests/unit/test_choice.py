@@ -148,9 +148,11 @@ def test_choose_the_fastest_within_an_error_budget_and_the_best_within_a_time_bu
         choice.choose(model, f, error_budget=0.1, time_budget_ms=10)
 
 
-def test_verify_takes_the_fastest_candidate_whose_estimate_is_within_the_budget():
-    # Rows predicted 0.3 / 0.15 / 0.05 in 10 / 100 / 1000 ms on every scene, margin 1. At E = 0.2 the
-    # candidates are those predicted within VERIFY_LOOSEN x 0.2 = 0.4: all three, fastest first.
+def test_verify_takes_the_fastest_candidate_whose_estimate_is_within_the_budget(monkeypatch):
+    # Rows predicted 0.3 / 0.15 / 0.05 in 10 / 100 / 1000 ms on every scene, margin 1. The mechanism at a
+    # loosening of 2 (VERIFY_LOOSEN itself is swept on the benchmark): at E = 0.2 the candidates are those
+    # predicted within 2 x 0.2 = 0.4, all three, fastest first.
+    monkeypatch.setattr(choice, "VERIFY_LOOSEN", 2.0)
     model, f = three_rows(4)
     asked = []
 
