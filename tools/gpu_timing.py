@@ -254,14 +254,20 @@ def row_label(method: str, row: dict) -> str:
 
 def configs(resolution: int = 1080) -> list[tuple[str, dict]]:
     """(label, {group: config}) of every method at every benchmark row of the registry (each method's
-    defaults included) and EXTRA_ROWS: the same list of methods as everything else."""
+    defaults included) and EXTRA_ROWS: the same list of methods as everything else. The defaults are
+    the viewport's, whose updates these time: the sky's auto rays take the filter there
+    (sky_light.viewport_rays); a row that sets sky_rays keeps it."""
+    from dataclasses import replace
+
     from addon.engine import choice, config, registry
+    from addon.engine.passes import sky_light
 
     out = []
     for spec in registry.METHODS:
         rows = [{}, *(r for r in spec.bench if r), *EXTRA_ROWS.get(spec.name, ())]
         for row in rows:
             base = config.settings(gi=config.GIConfig(method=spec.name, resolution=resolution))
+            base["rsm"] = replace(base["rsm"], sky_rays=sky_light.viewport_rays(base["rsm"].sky_rays))
             out.append((row_label(spec.name, row), choice.apply_row(base, spec.name, row)))
     return list(dict(out).items())  # a row equal to the defaults appears once
 

@@ -76,6 +76,10 @@ def test_configs_are_every_registry_row_and_the_gpu_extras():
     for label, settings in rows:
         assert label.split("-")[0] == settings["gi"].method and settings["gi"].resolution == 360
     assert "vct-voxel_cells64-diffuse_cones6-gather_scale2" in labels
+    # The viewport's defaults: auto sky rays are the filter there; direct's row of 8 rays keeps them.
+    settings = dict(rows)
+    assert all(s["rsm"].sky_rays == 0 for label, s in rows if label != "direct-sky_rays8")
+    assert settings["direct-sky_rays8"]["rsm"].sky_rays == 8
 
 
 def test_a_world_map_round_trips(tmp_path):
