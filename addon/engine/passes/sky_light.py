@@ -70,6 +70,7 @@ def viewport_rays(setting: int) -> int:
     preset, is kept."""
     return 0 if setting == AUTO else setting
 
+
 SHADOW_SPEC = ShaderSpec(
     name="sky_shadow",
     vertex="sky/shadow.vert.glsl",
