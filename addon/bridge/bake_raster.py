@@ -22,6 +22,7 @@ class TexelBaker:
         if method.scene is None:
             raise ValueError("TexelBaker needs a method whose set_scene has run")
         self.method = method
+        method.baking = True  # its G-buffer will hold the baked surfaces' own points
         self.backend = method.backend
         self._target = None
         self._target_key = None

@@ -101,10 +101,10 @@ class RsmConfig(_Validated):
     # each tested exactly against the triangles (bvh.py), in place of the shadow maps' soft-shadow
     # filter. Window-sky's direct light 0.073 -> 0.028 at 8, the sky pass 19-200x dearer on llvmpipe
     # (docs/DIRECT.md, "Exact rays"). -1 (auto, the default): 8 where the world gives at least 30 % of
-    # the direct light, else the filter (sky_light.rays_for); the viewport takes the filter.
+    # the direct light (3 % in bakes), else the filter (sky_light.rays_for); the viewport takes the filter.
     sky_rays: int = _num(-1, -1, 16, "rays per sky region tested exactly against the triangles for the sky's "
-                                     "shadows (0: the shadow maps' filter, fast; -1: auto, 8 in renders and bakes "
-                                     "where the world gives at least 30 % of the direct light)")
+                                     "shadows (0: the shadow maps' filter, fast; -1: auto, 8 where the world "
+                                     "gives at least 30 % of the direct light in renders, 3 % in bakes)")
 
 
 @dataclass(frozen=True)

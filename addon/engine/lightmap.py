@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import ConfigError
+from .passes.bake_gbuffer import CONSERVATIVE_COVERAGE
 
 PASSES = ("indirect", "direct", "combined")
 TARGETS = ("image", "vertex-colors", "volume", "probes")
@@ -58,23 +59,33 @@ SUPERSAMPLE_MAX = 8  # sub-texels per texel side a bake takes at most (--supersa
 
 
 def block_mean(values: np.ndarray, factor: int) -> np.ndarray:
-    """(h * factor, w * factor, 4) sub-texels (rgb, alpha = coverage) -> (h, w, 4): per texel the mean of
-    its factor x factor covered sub-texels, alpha 1 where any is covered (0 and rgb 0 where none is).
+    """(h * factor, w * factor, 4) sub-texels (rgb, alpha = coverage: 1 where the surface covers the
+    sub-texel's centre, CONSERVATIVE_COVERAGE where it only touches its square, 0 elsewhere) -> (h, w, 4):
+    per texel the mean of its factor x factor sub-texels whose centres are covered, else (a texel the
+    surface only grazes) of those it touches; alpha 1, CONSERVATIVE_COVERAGE or 0 (rgb 0) alike.
 
     Why: Cycles' bake gives a texel the mean light over its footprint (its samples jitter over it); a
-    texel read at its centre alone takes a sharp shadow edge across it as all or nothing. factor 1
-    returns the values as they are."""
+    texel read at its centre alone takes a sharp shadow edge across it as all or nothing. A touched
+    sub-texel stands at its surface's very edge (the nearest point to its centre), where the surface
+    meets another or is hidden by it: at the end face of window-sky's SouthWall, pressed against the
+    WestWall, such sub-texels read the sky past that wall's edge (Cycles: 0). factor 1 returns the
+    values as they are."""
     if factor == 1:
         return values
     hf, wf, c = values.shape
     if hf % factor or wf % factor:
         raise ValueError(f"a {wf} x {hf} image does not split into {factor} x {factor} blocks")
-    covered = values[..., 3] > 0.5
     blocks = (hf // factor, factor, wf // factor, factor)
-    total = np.where(covered[..., None], values[..., :3], 0.0).reshape(*blocks, 3).sum(axis=(1, 3))
-    count = covered.reshape(blocks).sum(axis=(1, 3))
+    alpha = values[..., 3].reshape(blocks)
+    centred = alpha > 0.5 * (1.0 + CONSERVATIVE_COVERAGE)
+    touched = alpha > 0.5
+    has_centred = centred.any(axis=(1, 3), keepdims=True)
+    weight = np.where(has_centred, centred, touched)
+    total = np.where(weight[..., None], values[..., :3].reshape(*blocks, 3), 0.0).sum(axis=(1, 3))
+    count = weight.sum(axis=(1, 3))
     rgb = total / np.maximum(count, 1)[..., None]
-    return np.concatenate([rgb, (count > 0)[..., None]], axis=2).astype(values.dtype)
+    cover = np.where(has_centred[:, 0, :, 0], 1.0, np.where(count > 0, CONSERVATIVE_COVERAGE, 0.0))
+    return np.concatenate([rgb, cover[..., None]], axis=2).astype(values.dtype)
 
 
 def check_supersample(factor: int, size: int) -> int:

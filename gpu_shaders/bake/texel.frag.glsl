@@ -1,6 +1,6 @@
 // World position (w = 1: texel covered), the surface's own interpolated normal (not flipped: Cycles
-// bakes the front side) and albedo of the texel centre; see texel.vert.glsl. A centre outside the
-// triangle (conservative coverage) takes the triangle's nearest point in texel space, and its distance
+// bakes the front side) and albedo (w: how it is covered) of the texel centre; see texel.vert.glsl. A
+// centre outside the triangle (conservative coverage) takes the triangle's nearest point in texel space, and its distance
 // in texels becomes the depth, so where several triangles reach a texel the one containing its centre
 // (depth 0), else the nearest, wins.
 
@@ -61,5 +61,8 @@ void main() {
     float len_n = length(n);
     out_position = vec4(l.x * v_p0 + l.y * v_p1 + l.z * v_p2, 1.0);
     out_normal = vec4(len_n > 0.0 ? n / len_n : vec3(0.0, 0.0, 1.0), 0.0);
-    out_albedo = vec4(v_albedo, 1.0);
+    // alpha: covered, by its centre (1) or only touched (CONSERVATIVE_COVERAGE): a supersampled bake
+    // averages the sub-texels whose centres the surface covers (lightmap.block_mean). Undilated, every
+    // fragment's centre is covered (the rasterizer's rule), rounding aside: the count adds 1 per triangle.
+    out_albedo = vec4(v_albedo, dilate > 0.0 && dist > 0.0 ? CONSERVATIVE_COVERAGE : 1.0);
 }

@@ -3,10 +3,8 @@
 // rounding of a position (1e-7 of the scene's size, against 2e-5 for a sun's 1024-texel map), far below
 // a pixel.
 const float EXACT_LIFT_TEXELS = 0.02;
-// Crossings nearer the start than this many texels do not shadow. Where two surfaces meet (a floor and
-// a wall) the G-buffer's depth test may keep a floor point a hair beyond the wall's plane, and its
-// segment would cross the wall at once: cornell's floor-wall seam read 0 over 14 pixels with no margin.
-const float EXACT_NEAR_TEXELS = 0.05;
+// Crossings nearer the start than the uniform `exact_near_texels` (texels) do not shadow: a margin for
+// where the G-buffer's points come from (passes/direct_light.py, NEAR_TEXELS).
 
 // Whether q + s w crosses the triangle (a, b, c), either side, for s_min < s < s_max (Moller and
 // Trumbore's test).

@@ -160,7 +160,7 @@ float soft_sun_visibility(vec2 uv, ivec2 size, float receiver, float bias_m, flo
     float ahead_m = max(receiver - depth_sum / blockers, 0.0);
     vec3 axis_x = normalize(row_x);
     vec3 axis_y = normalize(row_y);
-    float s_min = EXACT_NEAR_TEXELS * texel_m;
+    float s_min = exact_near_texels * texel_m;
     float lit = 0.0;
     for (int i = 0; i < SOFT_TAPS; ++i) {
         vec2 v = vogel(i);
@@ -321,7 +321,7 @@ vec3 face_light(vec3 p, vec3 n) {
 #else
         float reach = light_kind == LIGHT_SUN ? 1e30 : length(light_pos_ws - p_test);
         vec3 w = light_kind == LIGHT_SUN ? to_light : (light_pos_ws - p_test) / reach;
-        lit = exact_visibility(shadow_texel(p_test, size), p_test, w, EXACT_NEAR_TEXELS * texel_m, reach, size,
+        lit = exact_visibility(shadow_texel(p_test, size), p_test, w, exact_near_texels * texel_m, reach, size,
                                texel_m);
 #endif
     }

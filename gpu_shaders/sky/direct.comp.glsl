@@ -28,7 +28,7 @@ float ray_share(int k, vec3 p, vec3 n, float texel_m, inout int hint) {
     float lit = 0.0;
     for (int j = 0; j < sky_rays; ++j) {
         vec4 ray = texelFetch(sky_table, ivec2(6 + j, k), 0);
-        if (ray.w > 0.0 && !bvh_occluded(q, ray.xyz, EXACT_NEAR_TEXELS * texel_m, 1e30, hint)) {
+        if (ray.w > 0.0 && !bvh_occluded(q, ray.xyz, exact_near_texels * texel_m, 1e30, hint)) {
             lit += ray.w;
         }
     }

@@ -68,11 +68,10 @@ def test_bake_matches_cycles_bake(tmp_path):
             print(line)
     # Measured (64 x 64 texels, RSM 256, 1024 VPLs, 128 voxel cells; Cycles CPU 256 spp, seeds 0/1;
     # 2-core CPU, llvmpipe):
-    #   Floor    indirect rel_rmse_8 0.149 bias 0.931 (Cycles noise floor rel_rmse_8 0.008; 0.126 / 0.948
-    #            with the VPL's disc its surfel's alone, 0.208 / 0.900 at 1/4 of its block: rsm/gather.comp.glsl)
-    #            direct   rel_rmse_8 0.023 bias 1.008
-    #   BackWall indirect rel_rmse_8 0.044 bias 0.978 (noise floor 0.026)
-    #            direct   rel_rmse_8 0.070 bias 0.988
+    #   Floor    indirect rel_rmse_8 0.107 bias 0.948 (Cycles noise floor rel_rmse_8 0.008)
+    #            direct   rel_rmse_8 0.008 bias 1.000
+    #   BackWall indirect rel_rmse_8 0.034 bias 0.978 (noise floor 0.026)
+    #            direct   rel_rmse_8 0.011 bias 1.001
     # The Floor's indirect error sits in its first texel row along the back and left walls (ours up to 5x
     # too bright: VPLs 1.5 cm away on the meeting wall, the gather's near-field singularity); the direct
     # error at the spot cone's and the boxes' shadow edges (Cycles jitters samples over each texel, we
@@ -94,10 +93,10 @@ def test_bake_matches_cycles_bake(tmp_path):
 
 
 VCT_BOUNDS = {
-    "Floor": {"indirect_rmse8": 0.18, "bias_min": 0.85},
-    "BackWall": {"indirect_rmse8": 0.28, "bias_min": 0.75},
+    "Floor": {"indirect_rmse8": 0.19, "bias_min": 0.85},
+    "BackWall": {"indirect_rmse8": 0.19, "bias_min": 0.82},
 }
 BOUNDS = {
-    "Floor": {"indirect_rmse8": 0.18, "direct_rmse8": 0.035},
-    "BackWall": {"indirect_rmse8": 0.06, "direct_rmse8": 0.09},
+    "Floor": {"indirect_rmse8": 0.13, "direct_rmse8": 0.010},
+    "BackWall": {"indirect_rmse8": 0.045, "direct_rmse8": 0.014},
 }

@@ -63,6 +63,9 @@ def test_texel_positions_are_the_uv_map_and_edges_are_covered(gl):
     edge = touched & ~inside
     np.testing.assert_allclose(p[edge][:, :3], world_of(uc, vc)[edge], atol=2e-5)
     np.testing.assert_allclose(n[covered][:, :3], np.tile([0.0, 0.0, 1.0], (covered.sum(), 1)), atol=1e-6)
+    # albedo.w tells the two apart (a supersampled bake averages the centre-covered sub-texels).
+    a = gl.read(method.gbuf["albedo"])[..., 3]
+    assert np.all(a[inside] == 1.0) and np.all(a[edge] == bake_gbuffer.CONSERVATIVE_COVERAGE)
 
 
 def test_overlap_count(gl):
@@ -94,6 +97,51 @@ def test_bake_of_a_point_lit_quad_matches_the_closed_form(gl):
     assert covered.sum() == ((cols + 1 > U0 * W) & (cols < U1 * W) & (rows + 1 > (1 - U1) * H)
                              & (rows < (1 - U0) * H)).sum()
     np.testing.assert_allclose(direct[covered][:, 0], expected[covered], rtol=2e-3)
+
+
+def box_triangles(lo, hi):
+    """The 12 triangles of the axis-aligned box [lo, hi] and their outward corner normals."""
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    tris, normals = [], []
+    for axis in range(3):
+        u, v = (axis + 1) % 3, (axis + 2) % 3
+        for side, plane in ((-1.0, lo[axis]), (1.0, hi[axis])):
+            quad = []
+            for a, b in ((0, 0), (1, 0), (1, 1), (0, 1)):
+                p = np.empty(3)
+                p[axis], p[u], p[v] = plane, (lo[u], hi[u])[a], (lo[v], hi[v])[b]
+                quad.append(p)
+            tris += [[quad[0], quad[1], quad[2]], [quad[0], quad[2], quad[3]]]
+            normals += [np.eye(3)[axis] * side] * 2
+    return np.array(tris), np.repeat(np.array(normals)[:, None], 3, axis=1)
+
+
+def test_a_face_hidden_against_a_solid_reads_no_light_up_to_its_edge(gl):
+    """A 1 x 1 m face lies on the +x face of a solid 1 m box, facing into it, flush with the box's edge
+    at y = 1, as a wall's end face pressed against the next wall. A 100 W point light on the face's
+    front side, 2 m past that edge, reaches it only through the box: every texel whose centre the face
+    covers reads exactly 0, the last row's centres 0.02 texels (0.8 mm) from the edge included. A
+    camera's margin for the exact shadow test (direct_light.CAMERA_NEAR_TEXELS: about 4 mm of the
+    light's 64-texel map here) lets those centres' segments leave the box through its y = 1 face
+    unseen; a bake's (SURFACE_NEAR_TEXELS) does not."""
+    box, box_n = box_triangles([0.0, 0.0, 0.0], [1.0, 1.0, 1.0])
+    v0, v1 = 0.1, (28 + 0.5 + 0.02) / 32  # texel row 28's centre lies 0.02 texels inside the face's edge
+    corners = np.array([[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 1.0, 1.0], [1.0, 0.0, 1.0]])  # y = 0 -> 1
+    uv = np.array([[v0, v0], [v0, v1], [v1, v1], [v1, v0]])[:, ::-1]  # u along z, v along y
+    idx = [[0, 1, 2], [0, 2, 3]]
+    face, face_uv, face_n = corners[idx], uv[idx], np.tile([-1.0, 0.0, 0.0], (2, 3, 1))
+    pos = np.concatenate([box, face]).astype(np.float32)
+    nrm = np.concatenate([box_n, face_n]).astype(np.float32)
+    albedo = np.full((len(pos), 3), 0.5, np.float32)
+    light = Light("POINT", np.array([0.5, 3.0, 0.5]), np.array([0, -1.0, 0]), np.ones(3), power_w=100.0)
+    scene = Scene(pos, nrm, albedo, np.zeros_like(albedo), [light], camera=Camera(np.eye(4), np.eye(4), 8, 8))
+    method = DirectMethod(gl, GIConfig(), RsmConfig(resolution=64))
+    method.set_scene(scene)
+    baker = TexelBaker(method)
+    direct = baker.bake_triangles(face_uv, face, face_n, np.full((2, 3), 0.5), (32, 32))["direct"]
+    centred = direct[..., 3] == 1.0
+    assert centred.sum() == 26 * 26  # centres 3.5 .. 28.5 lie in [0.1, 0.8913] x 32 texels = [3.2, 28.52]
+    assert np.all(direct[centred][:, :3] == 0.0), direct[centred][:, :3].max()
 
 
 def test_bake_points_returns_samples_in_order(gl):

@@ -137,3 +137,28 @@ def test_auto_sky_rays_trace_where_the_world_gives_the_light(gl):
     method.set_lights([lamp])
     method.run()
     assert method.sky().rays == 0
+
+
+@pytest.mark.parametrize(("power_w", "rays"), [(1e6, 8), (1e7, 0)])
+def test_a_bake_traces_the_skys_rays_from_a_smaller_share(gl, power_w, rays):
+    # A bake (bake_raster.TexelBaker sets DirectMethod.baking) takes rays from AUTO_BAKE_WORLD_SHARE
+    # (3 %) of the direct light on, a camera from 30 %. The box's sky (1e3 RADIANCE, luminance 966:
+    # E = pi L = 3034 W/m^2) beside a lamp of P W at the scene's radius r = 1.905 m (half its bounds'
+    # diagonal): P / (4 pi r^2) = 21,900 W/m^2 at 1e6 W, a share of 0.122 (bake: rays; camera: the
+    # filter); at 1e7 W 0.0137 (the filter for both).
+    from addon.bridge.bake_raster import TexelBaker
+    from addon.engine import world
+    from addon.engine.scene import Light
+
+    lamp = Light("POINT", [0.0, 0.0, 1.0], [0, 0, -1], [1, 1, 1], power_w=power_w)
+    sc = replace(closed_box(0.1), lights=[lamp])
+    camera = methods.create(gl, {"gi": GIConfig(method="direct", resolution=32), "rsm": RsmConfig()})
+    camera.set_scene(sc)
+    lo, hi = camera.bounds_m
+    share = world.world_share(camera.world_suns(), [lamp], 0.5 * float(np.linalg.norm(hi - lo)))
+    assert share == pytest.approx(0.122 if power_w == 1e6 else 0.0137, rel=0.02)
+    assert camera.sky().rays == 0
+    bake = methods.create(gl, {"gi": GIConfig(method="direct", resolution=32), "rsm": RsmConfig()})
+    bake.set_scene(sc)
+    TexelBaker(bake)
+    assert bake.baking and bake.sky().rays == rays

@@ -87,6 +87,23 @@ def test_block_mean_averages_only_covered_sub_texels():
         block_mean(v[:3], 2)
 
 
+def test_block_mean_prefers_sub_texels_whose_centres_are_covered():
+    # Alpha 1: the surface covers the sub-texel's centre; CONSERVATIVE_COVERAGE: it only touches its
+    # square (the value is the surface's nearest point, at its very edge). Texel (0, 0): centred 2 and 4,
+    # touched 100 -> 3, alpha 1. Texel (0, 1): only touched ones, 5 and 7 -> 6, alpha CONSERVATIVE.
+    from addon.engine.lightmap import block_mean
+    from addon.engine.passes.bake_gbuffer import CONSERVATIVE_COVERAGE as C
+
+    v = np.zeros((2, 4, 4))
+    v[0, 0:2, 0], v[0, 0:2, 3] = [2, 4], 1
+    v[1, 0, 0], v[1, 0, 3] = 100, C
+    v[0, 2, 0], v[1, 3, 0] = 5, 7
+    v[0, 2, 3] = v[1, 3, 3] = C
+    out = block_mean(v, 2)
+    assert out[..., 0].tolist() == [[3.0, 6.0]]
+    assert out[..., 3].tolist() == [[1.0, C]]
+
+
 def test_check_supersample_bounds_the_factor_and_the_texels():
     from addon.engine.lightmap import SUPERSAMPLE_MAX, check_supersample
 

@@ -88,7 +88,8 @@ def test_auto_sky_rays_follow_the_worlds_share():
     # light (world_share, as sky_direction_count weighs it), else the filter (0); a number set by hand
     # stays. The world alone: share 1; beside a sun of 3 pi W/m^2, pi / (pi + 3 pi) = 0.25 (filter); of
     # 2 pi, 1 / 3 (rays). The viewport takes the filter for auto and keeps a number set by hand.
-    from addon.engine.passes.sky_light import AUTO, rays_for, viewport_rays
+    # Bakes trace from 3 %.
+    from addon.engine.passes.sky_light import AUTO, AUTO_BAKE_WORLD_SHARE, rays_for, viewport_rays
     from addon.engine.scene import Light
     from addon.engine.world import world_share
 
@@ -105,6 +106,9 @@ def test_auto_sky_rays_follow_the_worlds_share():
     assert rays_for(AUTO, 0.0) == 0
     assert rays_for(0, 1.0) == 0 and rays_for(5, 0.0) == 5  # set by hand: kept, whatever the share
     assert viewport_rays(AUTO) == 0 and viewport_rays(8) == 8 and viewport_rays(0) == 0
+    # A bake's texels: rays from AUTO_BAKE_WORLD_SHARE (3 %) on.
+    assert rays_for(AUTO, 0.25, AUTO_BAKE_WORLD_SHARE) == 8 and rays_for(AUTO, 0.03, AUTO_BAKE_WORLD_SHARE) == 8
+    assert rays_for(AUTO, 0.029, AUTO_BAKE_WORLD_SHARE) == 0 and rays_for(0, 1.0, AUTO_BAKE_WORLD_SHARE) == 0
 
 
 def test_downsample_keeps_each_texels_light():

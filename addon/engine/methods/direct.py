@@ -189,6 +189,10 @@ class DirectMethod:
         self.vpl_shares: dict[int, float] = {}
         self._solved_for = None  # lights_key of the light field on the GPU; None: none is
         self.solves = 0          # how many updates solved (bakes report it)
+        # Whether the G-buffer holds a bake's texels (bake_raster.TexelBaker sets it): points of the
+        # surfaces themselves, no depth test chose them, and each counts alike (exact_near_texels,
+        # sky_light.AUTO_BAKE_WORLD_SHARE).
+        self.baking = False
         # The camera-sized images stay when the camera's size does (a geometry change rewrites them all;
         # at 1920 x 1080 re-making them cost ~200 ms of a geometry change); only the running average of
         # the noisy products restarts.
@@ -268,7 +272,8 @@ class DirectMethod:
         lo, hi = self.bounds_m
         lamps, radius_m = [*self.source.lights, *self.emissive], 0.5 * float(np.linalg.norm(hi - lo))
         count = world.sky_direction_count(suns, lamps, most, least, radius_m)
-        rays = sky_light.rays_for(self.rsm_config.sky_rays, world.world_share(suns, lamps, radius_m))
+        rays = sky_light.rays_for(self.rsm_config.sky_rays, world.world_share(suns, lamps, radius_m),
+                                  sky_light.AUTO_BAKE_WORLD_SHARE if self.baking else sky_light.AUTO_WORLD_SHARE)
         key = (self._world_key, count, rays)
         shadows = next((s for s in self._skies.values() if s.key == key), None)  # another call's: drawn once
         if shadows is None:
@@ -465,6 +470,10 @@ class DirectMethod:
         """The sky's direct light of every direction, in one pass, into `direct` (gather half)."""
         self.shade_sky(timings, sky_light.DIRECT_DECL, self.gbuf["position"], self.gbuf["normal"], self.direct)
 
+    def exact_near_texels(self) -> float:
+        """The exact shadow tests' margin for where the G-buffer's points come from (direct_light)."""
+        return direct_light.SURFACE_NEAR_TEXELS if self.baking else direct_light.CAMERA_NEAR_TEXELS
+
     def shade_sky(self, timings: dict[str, float], decl, position, normal, out, accumulate: bool = True,
                   most: int | None = None, texel_lists=(None,), rays: bool = True) -> bool:
         """The sky's direct light (`sky(most)`) at the surfaces `position` / `normal` hold, into `out`
@@ -482,7 +491,8 @@ class DirectMethod:
             diagonal_m = float(np.linalg.norm(self.bounds_m[1] - self.bounds_m[0]))
             for texel_list in texel_lists:
                 sky_light.direct(self.backend, position, normal, sky.atlas, sky.bounds, sky.table, out, sky.layout,
-                                 diagonal_m, accumulate, texel_list, rays=count, tree=self._bvh)
+                                 diagonal_m, accumulate, texel_list, rays=count, tree=self._bvh,
+                                 exact_near_texels=self.exact_near_texels())
         return True
 
     def _gather(self, views: list[LightView], timings: dict[str, float], slots, first: bool = True) -> None:
@@ -560,7 +570,8 @@ class DirectMethod:
         with self.step(timings, direct_light.DECL):
             shadow, shadow_view = self.shadow_map(view)
             direct_light.run(self.backend, self.gbuf["position"], self.gbuf["normal"], shadow, self.direct,
-                             shadow_view, self.rsm_config.shadow_bias_texels, self.emitters)
+                             shadow_view, self.rsm_config.shadow_bias_texels, self.emitters,
+                             exact_near_texels=self.exact_near_texels())
         self.gather_view(view, timings)
 
     def read(self) -> dict[str, np.ndarray]:

@@ -7,7 +7,8 @@ Inputs (mesh attributes, one vertex per triangle corner, the whole triangle repe
 uv0..2 (the triangle's UVs, 0..1), p0..2 (world positions in the method's uploaded, re-centred frame, m),
 n0..2 (world corner normals, unit, not flipped), albedo, corner (0, 1, 2). Uniforms: texel_size (w, h),
 dilate (0: exact coverage, 1: grown by half a texel). Outputs (RGBA32F, bake size, GL row 0 = V = 0):
-position (w = 1 where covered), normal, albedo (w = 1).
+position (w = 1 where covered), normal, albedo (w = 1 where the texel's centre is covered,
+CONSERVATIVE_COVERAGE where only its square is).
 
 Coverage is conservative: every texel a triangle touches. A texel centre inside a triangle gets the exact
 affine map of its UV; one outside takes the triangle's nearest point, with its distance (texels) as the
@@ -36,8 +37,13 @@ _TRI_VARYINGS = (Var("v_bary", "vec3"), Var("v_bbox", "vec4"), Var("v_t0", "vec2
 _UNIFORMS = (Var("texel_size", "vec2"), Var("dilate", "float"))
 _OUTPUTS = (Var("out_position", "vec4"), Var("out_normal", "vec4"), Var("out_albedo", "vec4"))
 
+# albedo.w of a texel the surface touches without covering its centre: still covered (> 0.5, as alpha
+# is read everywhere), but told apart where a texel's sub-texels are averaged (lightmap.block_mean).
+CONSERVATIVE_COVERAGE = 0.75
+
 SPEC = ShaderSpec(name="bake_texel", vertex="bake/texel.vert.glsl", fragment="bake/texel.frag.glsl",
-                  uniforms=_UNIFORMS, attributes=_TRI_ATTRS, varyings=_TRI_VARYINGS, outputs=_OUTPUTS)
+                  uniforms=_UNIFORMS, attributes=_TRI_ATTRS, varyings=_TRI_VARYINGS, outputs=_OUTPUTS,
+                  defines=(("CONSERVATIVE_COVERAGE", repr(CONSERVATIVE_COVERAGE)),))
 POINTS = ShaderSpec(name="bake_points", vertex="bake/points.vert.glsl", fragment="bake/points.frag.glsl",
                     uniforms=(Var("texel_size", "vec2"),),
                     attributes=(Var("texel", "vec2"), Var("pos_ws", "vec3"), Var("normal_ws", "vec3"),

@@ -31,6 +31,17 @@ from .declare import (
 )
 from .light_views import KIND_CODE, LightView
 
+# Crossings nearer a shadow segment's start than this many shadow-map texels do not shadow (the exact
+# tests: here and the sky pass's rays). In a camera's G-buffer the depth test may keep a floor point a
+# hair beyond a wall's plane where the two meet, and its segment would cross the wall at once: cornell's
+# floor-wall seam read 0 over 14 pixels without this margin.
+CAMERA_NEAR_TEXELS = 0.05
+# A bake's texels are points of their own surface that no depth test chose: only fp32's rounding of a
+# position (1e-4 texels of a 1024-texel map) needs a margin. The camera's would let a face hidden
+# against another see past that one's edge: window-sky's SouthWall end face, pressed against the
+# WestWall, read 0.57-1.35 along the row of texels nearest the corner (Cycles: 0; docs/BAKE.md).
+SURFACE_NEAR_TEXELS = 0.001
+
 
 @functools.cache  # one spec, hence one program, per kind
 def _spec(polygons: bool, soft_sun: bool, area_samples: int = 0) -> ShaderSpec:
@@ -67,7 +78,8 @@ def _spec(polygons: bool, soft_sun: bool, area_samples: int = 0) -> ShaderSpec:
             Var("light_color_intensity", "vec3"), Var("face_index", "int"),
             Var("spot_cos_half", "float"), Var("spot_blend", "float"), Var("shadow_bias_texels", "float"),
             Var("accumulate", "int"),
-        ) + ((Var("poly_first", "int"), Var("poly_count", "int"), Var("emitter_radius_m", "float"),
+        ) + (() if polygons else (Var("exact_near_texels", "float"),))  # the exact tests': not a polygon's
+        + ((Var("poly_first", "int"), Var("poly_count", "int"), Var("emitter_radius_m", "float"),
                Var("light_view_projection_inverse", "mat4")) if polygons else ())
         + ((Var("sun_tan_half", "float"),) if soft_sun else ()),
         defines=((("POLYGONS", "1"),) if polygons else ())
@@ -86,14 +98,16 @@ DECL = PassDecl("direct_light", "gather", (GBUF_POSITION, GBUF_NORMAL, RSM_POSIT
 
 
 def run(backend: Backend, gbuf_position, gbuf_normal, shadow: dict, direct, view: LightView,
-        shadow_bias_texels: float, emitters, accumulate: bool = True, lists=()) -> None:
+        shadow_bias_texels: float, emitters, accumulate: bool = True, lists=(),
+        exact_near_texels: float = CAMERA_NEAR_TEXELS) -> None:
     """`shadow`: the shadow map's "position", "normal" and "flux" textures (the RSM's, or a sun's own map)
     and the "occluders" table its flux names triangles in (rsm.occluder_table).
     `emitters`: the emitter table texture; the view's uniforms give its rows (poly_first, poly_count).
     accumulate: add to `direct`; False: replace its pixels that see geometry (those that see none are not
     written: the caller keeps them 0). lists: where the G-buffer is a probe atlas, the texels to shade
     instead of every pixel, as (texel list, samples, footprint textures by name) each: the list's texels
-    shaded at `samples` points along their footprints (1: at their centres, no footprint needed)."""
+    shaded at `samples` points along their footprints (1: at their centres, no footprint needed).
+    exact_near_texels: the exact shadow tests' margin (CAMERA_NEAR_TEXELS, SURFACE_NEAR_TEXELS)."""
     view_uniforms = view.uniforms
     soft_sun = view_uniforms["light_kind"] == KIND_CODE["SUN"] and view_uniforms["sun_tan_half"] > 0.0
     polygons = view_uniforms.get("poly_count", 0) > 0
@@ -107,6 +121,8 @@ def run(backend: Backend, gbuf_position, gbuf_normal, shadow: dict, direct, view
         uniforms = {k: v for k, v in view_uniforms.items() if k in names}
         uniforms["shadow_bias_texels"] = shadow_bias_texels
         uniforms["accumulate"] = int(accumulate)
+        if not polygons:
+            uniforms["exact_near_texels"] = exact_near_texels
         bound = {**samplers, **more}
         backend.dispatch(backend.program(spec), group_count(size, spec.local_size), uniforms=uniforms,
                          samplers={s.name: bound[s.name] for s in spec.samplers}, images={"direct": direct})

@@ -34,7 +34,7 @@ from .. import bvh
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..scene import Light
 from ..world import power_shares
-from . import rsm
+from . import direct_light, rsm
 from .declare import BVH, DIRECT, GBUF_NORMAL, GBUF_POSITION, TRIANGLES, PassDecl, Port
 from .light_views import views_for
 
@@ -53,15 +53,22 @@ RAY_DIRECTIONS_PER_DISPATCH = 8
 AUTO = -1
 AUTO_RAYS = 8
 AUTO_WORLD_SHARE = 0.3
+# A bake's texels count every part of a surface alike, the parts a camera sees at a grazing angle or
+# not at all included, and on them the filter errs several times more per unit of the world's share s:
+# 0.3-3.2 s on the lightmaps measured (window-sky's Floor 2.37 and Ceiling 0.56 at s = 0.73,
+# window-sky-sun's Ceiling 0.097 at 0.09, the grey-world box's BackWall 0.022 at 0.07), 0.1-0.3 s in
+# their images. At ~1 x s it passes 0.03 from s = 0.03 (docs/BAKE.md). Sponza's grey world (0.024)
+# keeps the filter.
+AUTO_BAKE_WORLD_SHARE = 0.03
 
 
-def rays_for(setting: int, share: float) -> int:
+def rays_for(setting: int, share: float, least_share: float = AUTO_WORLD_SHARE) -> int:
     """Rays per sky region for RsmConfig.sky_rays = `setting` when the world gives `share` of the
-    direct light: the setting itself, or for AUTO, AUTO_RAYS from AUTO_WORLD_SHARE on and 0 (the filter)
-    below."""
+    direct light: the setting itself, or for AUTO, AUTO_RAYS from `least_share` on (AUTO_WORLD_SHARE;
+    a bake's AUTO_BAKE_WORLD_SHARE) and 0 (the filter) below."""
     if setting != AUTO:
         return setting
-    return AUTO_RAYS if share >= AUTO_WORLD_SHARE else 0
+    return AUTO_RAYS if share >= least_share else 0
 
 
 def viewport_rays(setting: int) -> int:
@@ -114,7 +121,7 @@ def _direct_spec(listed: bool, rays: bool) -> ShaderSpec:
         images=(Image("direct", "2D", "RGBA32F", "read_write"),),
         uniforms=(Var("sky_count", "int"), Var("sky_first", "int"), Var("sky_chunk", "int"), Var("tiles_x", "int"),
                   Var("tile_texels", "int"), Var("scene_diagonal_m", "float"), Var("accumulate", "int"))
-        + ((Var("sky_rays", "int"), Var("bvh_leaves", "int")) if rays else ()),
+        + ((Var("sky_rays", "int"), Var("bvh_leaves", "int"), Var("exact_near_texels", "float")) if rays else ()),
     )
 
 
@@ -295,12 +302,13 @@ class BvhTextures:
 
 def direct(backend: Backend, gbuf_position, gbuf_normal, atlas, sky_bounds, sky_table, out, layout: SkyLayout,
            scene_diagonal_m: float, accumulate: bool = True, texel_list=None, rays: int = 0,
-           tree: BvhTextures | None = None) -> None:
+           tree: BvhTextures | None = None, exact_near_texels: float = direct_light.CAMERA_NEAR_TEXELS) -> None:
     """`scene_diagonal_m`: the bounds' diagonal, the farthest a blocker can be from its receiver (it
     sizes the blocker search: the widest penumbra). accumulate: add to `out`; False: replace its pixels
     that see geometry (those that see none are not written). texel_list: shade only the texels it
     lists (probe_capture.texel_list) instead of every pixel. rays: the rays per region the table holds,
-    tested against `tree` (the triangles the shadow maps draw); 0: the shadow maps' filter."""
+    tested against `tree` (the triangles the shadow maps draw), skipping crossings nearer than
+    `exact_near_texels` (direct_light.CAMERA_NEAR_TEXELS); 0: the shadow maps' filter."""
     spec = DIRECT_SPECS[texel_list is not None, rays > 0]
     samplers = {"gbuf_position": gbuf_position, "gbuf_normal": gbuf_normal, "sky_depth_atlas": atlas,
                 "sky_bounds": sky_bounds, "sky_table": sky_table}
@@ -308,7 +316,7 @@ def direct(backend: Backend, gbuf_position, gbuf_normal, atlas, sky_bounds, sky_
                 "scene_diagonal_m": scene_diagonal_m}
     if rays:
         samplers.update(bvh_nodes=tree.nodes, bvh_triangles=tree.triangles)
-        uniforms.update(sky_rays=rays, bvh_leaves=tree.leaves)
+        uniforms.update(sky_rays=rays, bvh_leaves=tree.leaves, exact_near_texels=exact_near_texels)
     if texel_list is not None:
         samplers["texel_list"] = texel_list
     chunk = RAY_DIRECTIONS_PER_DISPATCH if rays else layout.count
