@@ -22,38 +22,7 @@
 // values differ by more than the noise explains (a real gradient) the taps stop; within the noise the
 // iteration widens the kernel (SVGF's edge-stopping function, Schied et al. 2017, from one frame).
 
-// The B3 spline (1, 4, 6, 4, 1) / 16 at tap k in -2..2; denoise.KERNEL is the same. A function, not a
-// const array: Blender translates bodies for Metal and Vulkan, and no other body here uses const arrays.
-float b3(int k) {
-    return k == 0 ? 0.375 : (abs(k) == 1 ? 0.25 : 0.0625);
-}
-
-bool covered(ivec2 q, ivec2 size) {
-    return all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, size)) && texelFetch(gbuf_position, q, 0).w != 0.0;
-}
-
-// Distance (m) to the nearer covered neighbour along `axis`, or -1 where neither side is covered.
-float axis_footprint(ivec2 px, vec3 p, ivec2 axis, ivec2 size) {
-    float nearest = -1.0;
-    for (int side = -1; side <= 1; side += 2) {
-        ivec2 q = px + side * axis;
-        if (covered(q, size)) {
-            float d = distance(texelFetch(gbuf_position, q, 0).xyz, p);
-            nearest = nearest < 0.0 ? d : min(nearest, d);
-        }
-    }
-    return nearest;
-}
-
-// The G-buffer weight of the tap at `offset` from the pixel (position p, normal n, footprint f).
-float geometry_weight(ivec2 q, ivec2 offset, vec3 p, vec3 n, float footprint) {
-    vec3 d = texelFetch(gbuf_position, q, 0).xyz - p;
-    float facing = pow(max(dot(n, texelFetch(gbuf_normal, q, 0).xyz), 0.0), normal_power);
-    float plane = abs(dot(n, d)) / (plane_sigma * footprint);
-    float expected = length(vec2(offset)) * footprint;
-    float excess = max(length(d) - expected, 0.0) / (position_sigma * expected);
-    return facing * exp(-(plane * plane + excess * excess));
-}
+#include "common/gbuffer_weight.glsl"
 
 // The k-th product's input, unfiltered input and output (k < PRODUCTS; a constant once loops unroll).
 vec4 source_at(int k, ivec2 q) {

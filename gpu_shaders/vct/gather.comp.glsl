@@ -4,11 +4,14 @@
 // pixel of its scale x scale block (upsample.comp.glsl brings them back to full size).
 #include "vct/diffuse.glsl"
 #include "vct/source_pixel.glsl"
+#include "common/gbuffer_weight.glsl"
 
 // Interleaving tiles are 2^TILE_BITS pixels a side (main).
 const int TILE_BITS = 3;
 // The tile's phase shift's own stream: random01(tile, hash_u32(stream ^ PHASE_STREAM)).
 const uint PHASE_STREAM = 0x2c1b3c6du;
+// The tap spacing (px) at which surface_support is measured: the filter's second iteration's.
+const int SUPPORT_STEP_PX = 2;
 
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
@@ -49,8 +52,19 @@ void main() {
     float i = float(sample_index);
     float jitter = fract((float(k) + random01(tile.x, tile.y, s + 1u)) / float(phases) + i * 0.75487767);
     float rotation = 6.28318531 * fract(random01(tile.x, tile.y, s) + 0.61803399 * float(k) + i * 0.56984029);
-    vec4 e = gather_diffuse(pos.xyz, n, rotation, jitter,
-                            fract(random01(uint(px.x), uint(px.y), hash_u32(s ^ DITHER_STREAM)) + i * 0.61803399));
+    float dither = fract(random01(uint(px.x), uint(px.y), hash_u32(s ^ DITHER_STREAM)) + i * 0.61803399);
+    vec4 e = gather_diffuse(pos.xyz, n, rotation, jitter, dither);
+    // Where the denoise filter will find little of the pixel's own surface around it (surface_support at
+    // its second iteration's spacing), it cannot average this gather's noise: such pixels gather
+    // `support_gathers` times, each turned and jittered a further 1 / support_gathers of the way, so the
+    // set stays stratified.
+    if (support_gathers > 1 && surface_support(src, pos.xyz, n, SUPPORT_STEP_PX) < support_threshold) {
+        for (int g = 1; g < support_gathers; g++) {
+            float t = float(g) / float(support_gathers);
+            e += gather_diffuse(pos.xyz, n, rotation + 6.28318531 * t, fract(jitter + t), fract(dither + t));
+        }
+        e /= float(support_gathers);
+    }
     imageStore(indirect, px, vec4(e.rgb, 1.0));
     imageStore(ao, px, vec4(vec3(1.0 - e.a), 1.0));
 }

@@ -95,6 +95,12 @@ class Params:
     position_sigma_footprints: float = 1.0
 
 
+def weight_uniforms(params: Params) -> dict:
+    """The G-buffer weights' uniforms (common/gbuffer_weight.glsl)."""
+    return {"normal_power": params.normal_power, "plane_sigma": params.plane_sigma_footprints,
+            "position_sigma": params.position_sigma_footprints}
+
+
 # Products one dispatch filters together (vct's indirect, ao and glossy): their G-buffer weights, most of
 # an iteration's work, are computed once per tap. At 1920 x 1080 on an NVIDIA H200 vct's three products
 # took 10.3 ms filtered one at a time and 5.0 ms together; one product alone 3.4 ms (benchmarks/gpu).
@@ -160,8 +166,7 @@ def run(backend: Backend, gbuf: dict, noisy, out, scratch=None, params: Params =
     sources = noisy
     for k in range(passes):
         guided = k == params.iterations
-        uniforms = {"step_px": 1 << k, "normal_power": params.normal_power,
-                    "plane_sigma": params.plane_sigma_footprints, "position_sigma": params.position_sigma_footprints}
+        uniforms = {"step_px": 1 << k, **weight_uniforms(params)}
         samplers = {"gbuf_position": gbuf["position"], "gbuf_normal": gbuf["normal"],
                     **{f"source{i}": t for i, t in enumerate(sources)}}
         if guided:

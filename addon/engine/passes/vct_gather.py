@@ -21,7 +21,7 @@ from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_coun
 from ..brdf import split_albedo_table
 from ..config import VctConfig
 from ..grid import Grid
-from . import declare
+from . import declare, denoise
 from .declare import (
     AO,
     GBUF_NORMAL,
@@ -54,7 +54,9 @@ PIXELS = ShaderSpec(
     local_size=GATHER_GROUP,
     samplers=(*_PYRAMID, Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D")),
     images=(Image("indirect", "2D"), Image("ao", "2D")),
-    uniforms=(*_DIFFUSE_UNIFORMS, Var("scale", "int"), Var("sample_index", "int")),
+    uniforms=(*_DIFFUSE_UNIFORMS, Var("scale", "int"), Var("sample_index", "int"), Var("support_gathers", "int"),
+              Var("support_threshold", "float"), Var("normal_power", "float"), Var("plane_sigma", "float"),
+              Var("position_sigma", "float")),
 )
 
 UPSAMPLE = ShaderSpec(
@@ -97,6 +99,9 @@ BOUNCE_DECL = PassDecl("vct_bounce", "solve", (VCT_PYRAMID, VOX_ALBEDO, VOX_NORM
                        "the next bounce gathered at the voxels")
 
 
+SUPPORT_THRESHOLD = 0.3
+
+
 def cone_uniforms(grid: Grid, config: VctConfig, seed: int, radiance_scale: float) -> dict:
     """`seed` turns every receiver's cone spiral by its own random angle (GIConfig.seed); radiance_scale
     is what the pyramid's radiance was multiplied by (vct_pyramid.radiance_scale)."""
@@ -122,7 +127,9 @@ def pixels(backend: Backend, pyramid: dict, radiance_scale: float, gbuf: dict, i
     out = (indirect, ao) if scale == 1 else low
     backend.dispatch(backend.program(PIXELS), group_count(out[0].size, PIXELS.local_size),
                      uniforms={**cone_uniforms(grid, config, seed, radiance_scale),
-                               "diffuse_cones": config.diffuse_cones, "scale": scale, "sample_index": sample},
+                               "diffuse_cones": config.diffuse_cones, "scale": scale, "sample_index": sample,
+                               "support_gathers": config.support_gathers, "support_threshold": SUPPORT_THRESHOLD,
+                               **denoise.weight_uniforms(denoise.Params())},
                      samplers={**named(pyramid, "pyr"), "gbuf_position": gbuf["position"],
                                "gbuf_normal": gbuf["normal"]},
                      images={"indirect": out[0], "ao": out[1]})
