@@ -71,6 +71,10 @@ class RsmConfig(_Validated):
     visibility: str = _choice("none", ("none", "voxel"), "VPL visibility in the `rsm` gather: none or voxel-traced")
     voxel_cells: int = _num(64, 8, 512, "voxel grid cells along the scene's longest side (voxel visibility)")
     voxel_offset_cells: float = _num(1.5, 0.0, 4.0, "ray ends moved off their surfaces, in cells")
+    # Where the denoise filter finds little of a pixel's own surface around it, the `rsm` gather makes
+    # this many sets of VPL draws (passes/surface_support.py; docs/RSM.md).
+    support_draws: int = _num(2, 1, 4, "sets of VPL draws at pixels whose denoise filter finds little of their "
+                                       "surface around them (thin or small details; 1: one set everywhere)")
     # An area light is split into patches_per_side^2 patches (sectors for disks and ellipses), each
     # with its exact unshadowed irradiance and soft shadows from its own RSM faces, which it costs
     # (area_light.py, docs/DIRECT.md).

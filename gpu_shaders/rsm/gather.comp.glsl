@@ -92,6 +92,16 @@ void main() {
     if (pos.w == 0.0) {
         return;
     }
+    // Pixels whose denoise filter finds little of their surface around them (passes/surface_support.py)
+    // make draw_sets sets of draws, one per dispatch set (draw_set), each weighing 1 / draw_sets and
+    // shifted a further 1 / draw_sets of the way within each draw's cell (the sets stay stratified);
+    // the other pixels make set 0 alone.
+    bool more = draw_sets > 1 && texelFetch(support, px, 0).x < support_threshold;
+    if (draw_set > 0 && !more) {
+        return;
+    }
+    float set_weight = more ? 1.0 / float(draw_sets) : 1.0;
+    float set_shift = float(draw_set) / float(draw_sets);
     vec3 x = pos.xyz;
     vec3 n = texelFetch(gbuf_normal, px, 0).xyz;
     ivec2 rsm_size = textureSize(rsm_flux, 0);
@@ -116,8 +126,8 @@ void main() {
     // golden ratio, so a pixel's draws over the samples form one low-discrepancy set (each still drawn
     // with the same densities: unbiased). Cornell 128 px, 16 samples: noise 0.012 with a fresh seed per
     // sample, 0.0058 so.
-    vec2 sample_step = float(sample_index) * vec2(0.75487767, 0.56984029);
-    float choice_step = float(sample_index) * 0.61803399;
+    vec2 sample_step = float(sample_index) * vec2(0.75487767, 0.56984029) + set_shift;
+    float choice_step = float(sample_index) * 0.61803399 + set_shift;
     // The strata, draws [row_begin k, row_end k) of k^2. Unguided (block_pdf.y = 0, the same in every
     // block): draw s = j k + i takes a texel uniformly in block (i, j). Guided: draw s picks its block by
     // inverting block_pdf's running sum at (s + v) / k^2, one draw per interval of equal probability,
@@ -190,5 +200,5 @@ void main() {
         }
     }
     vec4 acc = imageLoad(indirect, px);
-    imageStore(indirect, px, acc + vec4(irradiance / PI, 0.0));
+    imageStore(indirect, px, acc + vec4(set_weight * irradiance / PI, 0.0));
 }

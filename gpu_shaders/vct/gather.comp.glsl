@@ -10,8 +10,6 @@
 const int TILE_BITS = 3;
 // The tile's phase shift's own stream: random01(tile, hash_u32(stream ^ PHASE_STREAM)).
 const uint PHASE_STREAM = 0x2c1b3c6du;
-// The tap spacing (px) at which surface_support is measured: the filter's second iteration's.
-const int SUPPORT_STEP_PX = 2;
 
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
@@ -55,7 +53,8 @@ void main() {
     float dither = fract(random01(uint(px.x), uint(px.y), hash_u32(s ^ DITHER_STREAM)) + i * 0.61803399);
     vec4 e = gather_diffuse(pos.xyz, n, rotation, jitter, dither);
     // Where the denoise filter will find little of the pixel's own surface around it (surface_support at
-    // its second iteration's spacing), it cannot average this gather's noise: such pixels gather
+    // its second iteration's spacing, SUPPORT_STEP_PX: passes/surface_support.py), it cannot average
+    // this gather's noise: such pixels gather
     // `support_gathers` times, each turned and jittered a further 1 / support_gathers of the way, so the
     // set stays stratified.
     if (support_gathers > 1 && surface_support(src, pos.xyz, n, SUPPORT_STEP_PX) < support_threshold) {

@@ -595,26 +595,22 @@ def test_the_filter_leaves_out_glossy_light_where_nothing_is_glossy(gl):
 
 
 def pole_room(gl, support_gathers: int, seed: int):
-    """A closed 2 m room lit by a 200 W lamp, a 5 cm pole (1.3 px) standing before its back wall, 64 px
-    from the front, unfiltered (GIConfig.denoise off): the indirect, and where the pole is."""
+    """hard_scenes.pole_room's indirect with vct, unfiltered (GIConfig.denoise off), and its pole mask."""
     import sys
     from pathlib import Path
 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "hard"))
-    from hard_scenes import box, camera, parts, point, scene
+    from hard_scenes import pole_mask
+    from hard_scenes import pole_room as room
 
     from addon.engine import methods
     from addon.engine.config import GIConfig
 
-    geometry = parts((*box([-1, -1, 0], [1, 1, 2]), 0.7), (*box([-0.025, 0.5, 0], [0.025, 0.55, 2], inward=False), 0.7))
-    sc = scene(geometry, [point([0.3, -0.3, 1.8], 200.0)], camera([0, -0.95, 1.0], [0, 1, 0], size=64, fov_deg=80))
     method = methods.create(gl, {"gi": GIConfig(method="vct", resolution=64, seed=seed, denoise=False),
                                  "vct": VctConfig(voxel_cells=32, support_gathers=support_gathers)})
-    method.set_scene(sc)
+    method.set_scene(room())
     indirect = method.run().images["indirect"][..., :3]
-    pos = gl.read(method.gbuf["position"])[::-1] + np.append(method.origin_m, 0.0)
-    pole = (np.abs(pos[..., 0]) < 0.026) & (pos[..., 1] < 0.551) & (pos[..., 3] > 0)
-    return indirect, pole
+    return indirect, pole_mask(gl.read(method.gbuf["position"])[::-1] + np.append(method.origin_m, 0.0))
 
 
 def test_pixels_the_filter_cannot_average_gather_more(gl):

@@ -206,3 +206,21 @@ def sanity(images) -> str:
     if bad:
         return f"{bad} non-finite"
     return f"finite, min {min(float(img.min()) for img in images.values()):.3g}"
+
+
+POLE_HALF_M = 0.025  # pole_room's pole: 5 cm square
+
+
+def pole_room():
+    """A closed 2 m room lit by a 200 W lamp, a 5 cm pole (1.3 px) standing before its back wall, seen
+    at 64 px from the front: a thin detail whose pixels the denoise filter has little of their surface
+    to average with (passes/surface_support.py). pole_mask finds its pixels."""
+    h = POLE_HALF_M
+    geometry = parts((*box([-1, -1, 0], [1, 1, 2]), 0.7), (*box([-h, 0.5, 0], [h, 0.5 + 2 * h, 2], inward=False), 0.7))
+    return scene(geometry, [point([0.3, -0.3, 1.8], 200.0)], camera([0, -0.95, 1.0], [0, 1, 0], size=64, fov_deg=80))
+
+
+def pole_mask(position) -> np.ndarray:
+    """pole_room's pole pixels, from a G-buffer's world positions (row 0 = top, w = coverage)."""
+    return (np.abs(position[..., 0]) < POLE_HALF_M + 1e-3) & (position[..., 1] < 0.5 + 2 * POLE_HALF_M + 1e-3) & (
+        position[..., 3] > 0)

@@ -498,6 +498,7 @@ class DirectMethod:
     def _gather(self, views: list[LightView], timings: dict[str, float], slots, first: bool = True) -> None:
         self._bind_gather_targets()
         self.clear_products()
+        self.begin_gather(timings)
         self._sky_direct(timings)
         for view, slot in zip(views, slots, strict=True):
             self.rsm, self.rsm_target = self._rsm_slot(slot)
@@ -505,6 +506,10 @@ class DirectMethod:
             self._gather_view(view, timings)
         self.gather_pixels(timings)
         self._average_and_show(timings, first)
+
+    def begin_gather(self, timings: dict[str, float]) -> None:
+        """Hook: before a gather's light views, what they all read of the G-buffer (rsm: its surface
+        support). Nothing here."""
 
     def _bind_gather_targets(self) -> None:
         """The noisy products' attributes point at their raw textures while a gather writes them."""

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from .. import registry
 from ..grid import Grid
-from ..passes import accumulate, declare, denoise, rsm_gather, voxel_view, voxelize
+from ..passes import accumulate, declare, denoise, rsm_gather, surface_support, voxel_view, voxelize
 from ..passes.light_views import LightView
 from ..passes.voxelize import Voxelizer
 from .direct import OneBounceMethod
@@ -22,13 +22,14 @@ from .direct import OneBounceMethod
 class RsmMethod(OneBounceMethod):
     spec = registry.get("rsm")
     PASSES = declare.extend(OneBounceMethod.PASSES, setup=(voxelize.DECL,),
-                            gather=(rsm_gather.DECL, accumulate.DECL, denoise.DECL))
+                            gather=(surface_support.DECL, rsm_gather.DECL, accumulate.DECL, denoise.DECL))
     NOISY = ("indirect",)
     # rsm_gather.block_pdf's scratch, made on the first gather, and each face's block_pdf by (light,
     # face): computed on an update's gather and kept through the refinement gathers that follow, which
     # keep the G-buffer and the RSMs it is made from.
     block_importance: dict | None = None
     block_pdfs: dict | None = None
+    support = None  # surface_support's image at the G-buffer's size, made on the first gather
 
     def set_scene(self, scene) -> None:
         super().set_scene(scene)
@@ -54,6 +55,14 @@ class RsmMethod(OneBounceMethod):
         voxel_view.run(self.backend, self.gbuf["position"], voxels["vox_albedo"], self.grid, self._voxel_view)
         return self._voxel_view
 
+    def begin_gather(self, timings: dict[str, float]) -> None:
+        """The G-buffer's surface support, which every face's gather reads (RsmConfig.support_draws)."""
+        size = self.gbuf["position"].size
+        if self.support is None or self.support.size != size:
+            self.support = self.backend.texture(size, surface_support.SUPPORT.format)
+        with self.step(timings, surface_support.DECL):
+            surface_support.run(self.backend, self.gbuf, self.support)
+
     def gather_view(self, view: LightView, timings: dict[str, float]) -> None:
         with self.step(timings, rsm_gather.DECL):
             share = self.vpl_shares.get(view.light_index)
@@ -69,7 +78,7 @@ class RsmMethod(OneBounceMethod):
                                      self.block_pdfs[face])
             rsm_gather.run(self.backend, self.gbuf, self.rsm, self.indirect, vpls,
                            self.gi.seed + view.light_index * 6 + max(view.face_index, 0), view.view_projection,
-                           self.block_pdfs[face],
+                           self.block_pdfs[face], self.support,
                            occupancy=self.voxels["vox_albedo"] if self.voxels else None,
                            grid=self.voxels and self.grid, offset_cells=self.rsm_config.voxel_offset_cells,
-                           sample=self.sample_index)
+                           sample=self.sample_index, draw_sets=self.rsm_config.support_draws)

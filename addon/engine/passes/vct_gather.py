@@ -21,7 +21,7 @@ from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_coun
 from ..brdf import split_albedo_table
 from ..config import VctConfig
 from ..grid import Grid
-from . import declare, denoise
+from . import declare, denoise, surface_support
 from .declare import (
     AO,
     GBUF_NORMAL,
@@ -57,6 +57,7 @@ PIXELS = ShaderSpec(
     uniforms=(*_DIFFUSE_UNIFORMS, Var("scale", "int"), Var("sample_index", "int"), Var("support_gathers", "int"),
               Var("support_threshold", "float"), Var("normal_power", "float"), Var("plane_sigma", "float"),
               Var("position_sigma", "float")),
+    defines=(("SUPPORT_STEP_PX", str(surface_support.STEP_PX)),),
 )
 
 UPSAMPLE = ShaderSpec(
@@ -99,9 +100,6 @@ BOUNCE_DECL = PassDecl("vct_bounce", "solve", (VCT_PYRAMID, VOX_ALBEDO, VOX_NORM
                        "the next bounce gathered at the voxels")
 
 
-SUPPORT_THRESHOLD = 0.3
-
-
 def cone_uniforms(grid: Grid, config: VctConfig, seed: int, radiance_scale: float) -> dict:
     """`seed` turns every receiver's cone spiral by its own random angle (GIConfig.seed); radiance_scale
     is what the pyramid's radiance was multiplied by (vct_pyramid.radiance_scale)."""
@@ -128,7 +126,8 @@ def pixels(backend: Backend, pyramid: dict, radiance_scale: float, gbuf: dict, i
     backend.dispatch(backend.program(PIXELS), group_count(out[0].size, PIXELS.local_size),
                      uniforms={**cone_uniforms(grid, config, seed, radiance_scale),
                                "diffuse_cones": config.diffuse_cones, "scale": scale, "sample_index": sample,
-                               "support_gathers": config.support_gathers, "support_threshold": SUPPORT_THRESHOLD,
+                               "support_gathers": config.support_gathers,
+                               "support_threshold": surface_support.THRESHOLD,
                                **denoise.weight_uniforms(denoise.Params())},
                      samplers={**named(pyramid, "pyr"), "gbuf_position": gbuf["position"],
                                "gbuf_normal": gbuf["normal"]},
