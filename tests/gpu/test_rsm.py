@@ -1,5 +1,8 @@
 """RSM flux and the `rsm` method's VPL gather against exact answers."""
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -9,6 +12,9 @@ from addon.engine.scene import Camera, Light, Scene
 from addon.engine.transforms import look_along, perspective
 
 pytestmark = pytest.mark.gpu
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "hard"))
+from hard_scenes import assert_only_the_pole_changes, pole_indirect  # noqa: E402
 
 
 def rect(origin, u, v):
@@ -420,38 +426,22 @@ def test_rsm_reduce_keeps_every_watt(gl):
         np.testing.assert_allclose(got["normal"][by, bx, :3], mean_n / np.linalg.norm(mean_n), rtol=1e-4, atol=1e-6)
 
 
-def pole_indirect(gl, support_draws: int, seed: int):
-    """hard_scenes.pole_room's indirect with rsm, unfiltered (GIConfig.denoise off), and its pole mask."""
-    import sys
-    from pathlib import Path
-
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "hard"))
-    from hard_scenes import pole_mask, pole_room
-
-    from addon.engine import methods
-    from addon.engine.config import GIConfig, RsmConfig
-
-    method = methods.create(gl, {"gi": GIConfig(method="rsm", resolution=64, seed=seed, denoise=False),
-                                 "rsm": RsmConfig(resolution=64, support_draws=support_draws)})
-    method.set_scene(pole_room())
-    indirect = method.run().images["indirect"][..., :3]
-    return indirect, pole_mask(gl.read(method.gbuf["position"])[::-1] + np.append(method.origin_m, 0.0))
+def pole_rsm(gl, support_draws: int, seed: int):
+    """hard_scenes.pole_room's indirect with rsm (64-texel RSMs), and its pole's pixels."""
+    rsm = RsmConfig(resolution=64, support_draws=support_draws)
+    return pole_indirect(gl, {"gi": GIConfig(method="rsm"), "rsm": rsm}, seed)
 
 
 def test_pixels_the_filter_cannot_average_draw_more_vpls(gl):
     """RsmConfig.support_draws: pixels whose denoise filter finds little of their surface around them
     (passes/surface_support.py) make two sets of draws, the second shifted half a cell. On the pole
-    before the wall (hard_scenes.pole_room) 81 % of the pole's pixels change (bound 70 %), 3.3 % of the
-    image (bound 10 %: the walls stay bit for bit), and the pole's values spread less over six seeds
-    (per-pixel standard deviation measured 0.75 of one set's; bound 0.85; 1 / sqrt(2) = 0.71 for
-    independent draws: one pair of seeds is too few, it read 1.02)."""
-    one, pole = pole_indirect(gl, 1, seed=0)
-    two, _ = pole_indirect(gl, 2, seed=0)
-    changed = np.any(one != two, axis=-1)
-    print("changed share:", changed.mean(), "pole pixels:", pole.sum(), "changed on the pole:", changed[pole].mean())
-    assert pole.sum() >= 20 and changed[pole].mean() > 0.7
-    assert changed.mean() < 0.1
-    spread = [np.stack([pole_indirect(gl, sets, seed)[0][pole] for seed in range(6)]).std(axis=0).mean()
+    before the wall only the pole's pixels change (hard_scenes.assert_only_the_pole_changes), and its
+    values spread less over six seeds (per-pixel standard deviation measured 0.75 of one set's; bound
+    0.85; 1 / sqrt(2) = 0.71 for independent draws: one pair of seeds is too few, it read 1.02)."""
+    one, pole = pole_rsm(gl, 1, seed=0)
+    two, _ = pole_rsm(gl, 2, seed=0)
+    assert_only_the_pole_changes(one, two, pole)
+    spread = [np.stack([pole_rsm(gl, sets, seed)[0][pole] for seed in range(6)]).std(axis=0).mean()
               for sets in (1, 2)]
     print("pole spread over seeds, 2 sets / 1:", spread[1] / spread[0])
     assert spread[1] < 0.85 * spread[0]

@@ -6,6 +6,9 @@ Indirect). Synthetic volumes are built in numpy and go through the real level-0 
 Volumes read back as (z, y, x, 4) arrays.
 """
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -17,6 +20,9 @@ from addon.engine.passes.atlas import Atlas
 from addon.engine.passes.vct_inject import DIRECTIONS
 
 pytestmark = pytest.mark.gpu
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "hard"))
+from hard_scenes import assert_only_the_pole_changes, pole_indirect  # noqa: E402
 
 H_M = 0.1  # cell size of the synthetic grids
 # The pyramid holds radiance x a scale (vct_pyramid.radiance_scale, for half floats' range) that every
@@ -594,38 +600,23 @@ def test_the_filter_leaves_out_glossy_light_where_nothing_is_glossy(gl):
         assert np.isfinite(image).all() and image.min() >= 0.0
 
 
-def pole_room(gl, support_gathers: int, seed: int):
-    """hard_scenes.pole_room's indirect with vct, unfiltered (GIConfig.denoise off), and its pole mask."""
-    import sys
-    from pathlib import Path
-
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "hard"))
-    from hard_scenes import pole_mask
-    from hard_scenes import pole_room as room
-
-    from addon.engine import methods
+def pole_vct(gl, support_gathers: int, seed: int):
+    """hard_scenes.pole_room's indirect with vct (32 cells), and its pole's pixels."""
     from addon.engine.config import GIConfig
 
-    method = methods.create(gl, {"gi": GIConfig(method="vct", resolution=64, seed=seed, denoise=False),
-                                 "vct": VctConfig(voxel_cells=32, support_gathers=support_gathers)})
-    method.set_scene(room())
-    indirect = method.run().images["indirect"][..., :3]
-    return indirect, pole_mask(gl.read(method.gbuf["position"])[::-1] + np.append(method.origin_m, 0.0))
+    vct = VctConfig(voxel_cells=32, support_gathers=support_gathers)
+    return pole_indirect(gl, {"gi": GIConfig(method="vct"), "vct": vct}, seed)
 
 
 def test_pixels_the_filter_cannot_average_gather_more(gl):
     """VctConfig.support_gathers: pixels whose denoise filter finds little of their surface around them
     (surface_support, gbuffer_weight.glsl) gather twice, the second set turned and jittered half the way.
-    A pole before a wall, about a pixel wide: 81 % of the pole's pixels change (those at its foot and
-    head find the floor's and ceiling's; bound 70 %), 3.3 % of the image in all (a few more at the
-    image's corners; bound 10 %: the walls stay bit for bit), and on the pole two seeds differ less
-    (measured 0.60 of one gather's difference; bound 0.85, 1 / sqrt(2) = 0.71 for independent draws)."""
-    one, pole = pole_room(gl, 1, seed=0)
-    two, _ = pole_room(gl, 2, seed=0)
-    changed = np.any(one != two, axis=-1)
-    print("changed share:", changed.mean(), "pole pixels:", pole.sum(), "changed on the pole:", changed[pole].mean())
-    assert pole.sum() >= 20 and changed[pole].mean() > 0.7
-    assert changed.mean() < 0.1
-    noise = [np.sqrt(np.mean((pole_room(gl, g, seed=1)[0] - base)[pole] ** 2)) for g, base in ((1, one), (2, two))]
+    On a pole before a wall, about a pixel wide, only the pole's pixels change
+    (hard_scenes.assert_only_the_pole_changes), and there two seeds differ less (measured 0.60 of one
+    gather's difference; bound 0.85, 1 / sqrt(2) = 0.71 for independent draws)."""
+    one, pole = pole_vct(gl, 1, seed=0)
+    two, _ = pole_vct(gl, 2, seed=0)
+    assert_only_the_pole_changes(one, two, pole)
+    noise = [np.sqrt(np.mean((pole_vct(gl, g, seed=1)[0] - base)[pole] ** 2)) for g, base in ((1, one), (2, two))]
     print("pole noise, 2 gathers / 1:", noise[1] / noise[0])
     assert noise[1] < 0.85 * noise[0]

@@ -214,13 +214,34 @@ POLE_HALF_M = 0.025  # pole_room's pole: 5 cm square
 def pole_room():
     """A closed 2 m room lit by a 200 W lamp, a 5 cm pole (1.3 px) standing before its back wall, seen
     at 64 px from the front: a thin detail whose pixels the denoise filter has little of their surface
-    to average with (passes/surface_support.py). pole_mask finds its pixels."""
+    to average with (passes/surface_support.py). pole_indirect renders it and finds its pixels."""
     h = POLE_HALF_M
     geometry = parts((*box([-1, -1, 0], [1, 1, 2]), 0.7), (*box([-h, 0.5, 0], [h, 0.5 + 2 * h, 2], inward=False), 0.7))
     return scene(geometry, [point([0.3, -0.3, 1.8], 200.0)], camera([0, -0.95, 1.0], [0, 1, 0], size=64, fov_deg=80))
 
 
-def pole_mask(position) -> np.ndarray:
-    """pole_room's pole pixels, from a G-buffer's world positions (row 0 = top, w = coverage)."""
-    return (np.abs(position[..., 0]) < POLE_HALF_M + 1e-3) & (position[..., 1] < 0.5 + 2 * POLE_HALF_M + 1e-3) & (
-        position[..., 3] > 0)
+def pole_indirect(backend, settings: dict, seed: int):
+    """pole_room's indirect (row 0 = top) with `settings` ({group: config}, the method in gi's), at 64 px,
+    unfiltered (GIConfig.denoise off), and the pole's pixels (from the G-buffer's world positions)."""
+    from dataclasses import replace
+
+    from addon.engine import methods
+
+    method = methods.create(backend, {**settings, "gi": replace(settings["gi"], resolution=64, seed=seed,
+                                                                   denoise=False)})
+    method.set_scene(pole_room())
+    indirect = method.run().images["indirect"][..., :3]
+    position = backend.read(method.gbuf["position"])[::-1] + np.append(method.origin_m, 0.0)
+    pole = (np.abs(position[..., 0]) < POLE_HALF_M + 1e-3) & (position[..., 1] < 0.5 + 2 * POLE_HALF_M + 1e-3)
+    return indirect, pole & (position[..., 3] > 0)
+
+
+def assert_only_the_pole_changes(one, more, pole) -> None:
+    """Two pole_room images, one and more samples where the filter finds little surface
+    (passes/surface_support.py): 81 % of the pole's pixels change (those at its foot and head find the
+    floor's and ceiling's; bound 70 %), 3.3 % of the image in all (a few more at the image's corners;
+    bound 10 %: the walls stay bit for bit)."""
+    changed = np.any(one != more, axis=-1)
+    print("changed share:", changed.mean(), "pole pixels:", pole.sum(), "changed on the pole:", changed[pole].mean())
+    assert pole.sum() >= 20 and changed[pole].mean() > 0.7
+    assert changed.mean() < 0.1
