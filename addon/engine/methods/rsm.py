@@ -56,8 +56,11 @@ class RsmMethod(OneBounceMethod):
         return self._voxel_view
 
     def begin_gather(self, timings: dict[str, float]) -> None:
-        """The G-buffer's surface support, which every face's gather reads (RsmConfig.support_draws)."""
+        """The G-buffer's surface support, which every face's gather reads (RsmConfig.support_draws):
+        on an update's gather; the refinement gathers that follow keep the G-buffer, hence it."""
         size = self.gbuf["position"].size
+        if self.support is not None and self.support.size == size and self.sample_index > 0:
+            return
         if self.support is None or self.support.size != size:
             self.support = self.backend.texture(size, surface_support.SUPPORT.format)
         with self.step(timings, surface_support.DECL):
