@@ -1,5 +1,6 @@
 // The edge-aware weights of a G-buffer neighbourhood: the denoise filter's (common/denoise.comp.glsl,
-// whose header explains them), and what vct's gather asks of them (surface_support). Needs samplers
+// whose header explains them), and how much of its surface it finds around a pixel (surface_support,
+// for passes/surface_support.py). Needs samplers
 // gbuf_position, gbuf_normal and uniforms normal_power, plane_sigma, position_sigma.
 
 // The B3 spline (1, 4, 6, 4, 1) / 16 at tap k in -2..2; denoise.KERNEL is the same. A function, not a

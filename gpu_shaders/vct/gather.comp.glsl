@@ -4,7 +4,6 @@
 // pixel of its scale x scale block (upsample.comp.glsl brings them back to full size).
 #include "vct/diffuse.glsl"
 #include "vct/source_pixel.glsl"
-#include "common/gbuffer_weight.glsl"
 
 // Interleaving tiles are 2^TILE_BITS pixels a side (main).
 const int TILE_BITS = 3;
@@ -52,12 +51,11 @@ void main() {
     float rotation = 6.28318531 * fract(random01(tile.x, tile.y, s) + 0.61803399 * float(k) + i * 0.56984029);
     float dither = fract(random01(uint(px.x), uint(px.y), hash_u32(s ^ DITHER_STREAM)) + i * 0.61803399);
     vec4 e = gather_diffuse(pos.xyz, n, rotation, jitter, dither);
-    // Where the denoise filter will find little of the pixel's own surface around it (surface_support at
-    // its second iteration's spacing, SUPPORT_STEP_PX: passes/surface_support.py), it cannot average
-    // this gather's noise: such pixels gather
-    // `support_gathers` times, each turned and jittered a further 1 / support_gathers of the way, so the
-    // set stays stratified.
-    if (support_gathers > 1 && surface_support(src, pos.xyz, n, SUPPORT_STEP_PX) < support_threshold) {
+    // Where the denoise filter will find little of the pixel's own surface around it (`support`, from
+    // passes/surface_support.py, at the pixel the texel stands for), it cannot average this gather's
+    // noise: such pixels gather `support_gathers` times, each turned and jittered a further
+    // 1 / support_gathers of the way, so the set stays stratified.
+    if (support_gathers > 1 && texelFetch(support, src, 0).x < support_threshold) {
         for (int g = 1; g < support_gathers; g++) {
             float t = float(g) / float(support_gathers);
             e += gather_diffuse(pos.xyz, n, rotation + 6.28318531 * t, fract(jitter + t), fract(dither + t));

@@ -15,7 +15,7 @@ import pytest
 from addon.engine.config import VctConfig
 from addon.engine.grid import Grid
 from addon.engine.passes import atlas as atlas_pass
-from addon.engine.passes import vct_gather, vct_inject, vct_pyramid
+from addon.engine.passes import surface_support, vct_gather, vct_inject, vct_pyramid
 from addon.engine.passes.atlas import Atlas
 from addon.engine.passes.vct_inject import DIRECTIONS
 
@@ -81,6 +81,13 @@ def point_gbuffer(gl, grid, points_cells, normals) -> dict:
     return {"position": gl.texture((n, 1), data=pos), "normal": gl.texture((n, 1), data=nrm)}
 
 
+def support_of(gl, gbuf: dict):
+    """surface_support's image of a G-buffer, as DirectMethod.measure_support makes it."""
+    support = gl.texture(gbuf["position"].size, surface_support.SUPPORT.format)
+    surface_support.run(gl, gbuf, support)
+    return support
+
+
 def gather(gl, pyr, grid, points_cells, normals, config=None, scale=RADIANCE_SCALE):
     """E / pi and ao at points given in cell units (VctConfig's defaults unless `config`) from a pyramid
     built with radiance scale `scale`."""
@@ -88,7 +95,7 @@ def gather(gl, pyr, grid, points_cells, normals, config=None, scale=RADIANCE_SCA
     n = len(points_cells)
     gbuf = point_gbuffer(gl, grid, points_cells, normals)
     indirect, ao = gl.texture((n, 1)), gl.texture((n, 1))
-    vct_gather.pixels(gl, pyr, scale, gbuf, indirect, ao, grid, config)
+    vct_gather.pixels(gl, pyr, scale, gbuf, support_of(gl, gbuf), indirect, ao, grid, config)
     return gl.read(indirect)[0, :, :3], gl.read(ao)[0, :, 0]
 
 
@@ -112,7 +119,8 @@ def patch_image(gl, patch=1, side=64, distance=8, seed=0, sample=0):
     # One gather per pixel (support_gathers 1): all receivers sit at one point, so none has a surface
     # around it and each would gather twice; the tests below hold the single gather's pattern.
     config = VctConfig(offset_cells=0.0, support_gathers=1)
-    vct_gather.pixels(gl, pyr, RADIANCE_SCALE, gbuf, indirect, ao, vols.grid, config, seed, sample=sample)
+    vct_gather.pixels(gl, pyr, RADIANCE_SCALE, gbuf, support_of(gl, gbuf), indirect, ao, vols.grid, config, seed,
+                      sample=sample)
     return gl.read(indirect)[..., 0]
 
 def closed_box(n=32, lo=2, radiance=1.0):

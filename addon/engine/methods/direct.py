@@ -27,7 +27,7 @@ from ..area_light import emitter_table, split_area_light
 from ..backends.base import Backend, ShaderSpec
 from ..config import GIConfig, RsmConfig
 from ..errors import ConfigError
-from ..passes import accumulate, declare, denoise, direct_light, gbuffer, rsm, sky_light, zero
+from ..passes import accumulate, declare, denoise, direct_light, gbuffer, rsm, sky_light, surface_support, zero
 from ..passes.light_views import KIND_CODE, LightView, emissive_lights, reaches, views_for
 from ..scene import Camera, Scene
 
@@ -193,6 +193,7 @@ class DirectMethod:
         # surfaces themselves, no depth test chose them, and each counts alike (exact_near_texels,
         # sky_light.AUTO_BAKE_WORLD_SHARE).
         self.baking = False
+        self.support = None  # measure_support's image at the G-buffer's size, made on first use
         # The camera-sized images stay when the camera's size does (a geometry change rewrites them all;
         # at 1920 x 1080 re-making them cost ~200 ms of a geometry change); only the running average of
         # the noisy products restarts.
@@ -508,8 +509,20 @@ class DirectMethod:
         self._average_and_show(timings, first)
 
     def begin_gather(self, timings: dict[str, float]) -> None:
-        """Hook: before a gather's light views, what they all read of the G-buffer (rsm: its surface
-        support). Nothing here."""
+        """Hook: before a gather's light views, what they all read of the G-buffer (rsm and vct: its
+        surface support, measure_support). Nothing here."""
+
+    def measure_support(self, timings: dict[str, float]) -> None:
+        """`support`: how much of the denoise kernel lies on each pixel's own surface
+        (passes/surface_support.py), where the stochastic gathers take more samples. Measured on an
+        update's gather; the refinement gathers that follow keep the G-buffer, hence it."""
+        size = self.gbuf["position"].size
+        if self.support is not None and self.support.size == size and self.sample_index > 0:
+            return
+        if self.support is None or self.support.size != size:
+            self.support = self.backend.texture(size, surface_support.SUPPORT.format)
+        with self.step(timings, surface_support.DECL):
+            surface_support.run(self.backend, self.gbuf, self.support)
 
     def _bind_gather_targets(self) -> None:
         """The noisy products' attributes point at their raw textures while a gather writes them."""

@@ -29,7 +29,6 @@ class RsmMethod(OneBounceMethod):
     # keep the G-buffer and the RSMs it is made from.
     block_importance: dict | None = None
     block_pdfs: dict | None = None
-    support = None  # surface_support's image at the G-buffer's size, made on the first gather
 
     def set_scene(self, scene) -> None:
         super().set_scene(scene)
@@ -56,15 +55,7 @@ class RsmMethod(OneBounceMethod):
         return self._voxel_view
 
     def begin_gather(self, timings: dict[str, float]) -> None:
-        """The G-buffer's surface support, which every face's gather reads (RsmConfig.support_draws):
-        on an update's gather; the refinement gathers that follow keep the G-buffer, hence it."""
-        size = self.gbuf["position"].size
-        if self.support is not None and self.support.size == size and self.sample_index > 0:
-            return
-        if self.support is None or self.support.size != size:
-            self.support = self.backend.texture(size, surface_support.SUPPORT.format)
-        with self.step(timings, surface_support.DECL):
-            surface_support.run(self.backend, self.gbuf, self.support)
+        self.measure_support(timings)  # every face's gather reads it (RsmConfig.support_draws)
 
     def gather_view(self, view: LightView, timings: dict[str, float]) -> None:
         with self.step(timings, rsm_gather.DECL):

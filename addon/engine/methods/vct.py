@@ -28,6 +28,7 @@ from ..passes import (
     denoise,
     rsm,
     sky_light,
+    surface_support,
     vct_gather,
     vct_inject,
     vct_pyramid,
@@ -46,7 +47,8 @@ class VctMethod(OneBounceMethod):
     PASSES = declare.extend(OneBounceMethod.PASSES, setup=(voxelize.DECL,),
                             solve=(vct_inject.DECL, sky_light.RSM_DECL, vct_inject.SKY_DECL, vct_pyramid.DECL,
                                    vct_gather.BOUNCE_DECL, vct_pyramid.DECL),
-                            gather=(vct_gather.PIXELS_DECL, vct_gather.GLOSSY_DECL, accumulate.DECL, denoise.DECL))
+                            gather=(surface_support.DECL, vct_gather.PIXELS_DECL, vct_gather.GLOSSY_DECL,
+                                    accumulate.DECL, denoise.DECL))
     NOISY = ("indirect", "ao", "glossy")
     # The world's bounce: the camera's sky directions, each an RSM tile of the sky atlas, injected at
     # once (inject_sky), not RsmConfig.world_suns suns one RSM and injection each (docs/VCT.md).
@@ -182,10 +184,14 @@ class VctMethod(OneBounceMethod):
         # two images instead of three.
         return product == "glossy" and not self._glossy_anywhere
 
+    def begin_gather(self, timings: dict[str, float]) -> None:
+        self.measure_support(timings)  # the pixel gather reads it (VctConfig.support_gathers)
+
     def gather_pixels(self, timings: dict[str, float]) -> None:
         with self.step(timings, vct_gather.PIXELS_DECL):
-            vct_gather.pixels(self.backend, self.pyramid, self.radiance_scale, self.gbuf, self.indirect,
-                              self.ao, self.grid, self.vct_config, self.gi.seed, self._low, self.sample_index)
+            vct_gather.pixels(self.backend, self.pyramid, self.radiance_scale, self.gbuf, self.support,
+                              self.indirect, self.ao, self.grid, self.vct_config, self.gi.seed, self._low,
+                              self.sample_index)
         with self.step(timings, vct_gather.GLOSSY_DECL):
             vct_gather.glossy(self.backend, self.pyramid, self.radiance_scale, self.gbuf, self._lobe_albedo,
                               self.glossy, self.grid, self.vct_config, self.camera().position_m,

@@ -8,9 +8,9 @@ the camera, -1 for a pixel without a covered neighbour, 1 where there is no geom
 Why: the denoise filter averages a pixel with its surface's neighbours. A pixel with few of them (a thin
 column, a leaf, the last pixel before a crease) keeps its own gather's noise, and on Sponza such pixels
 (support below THRESHOLD, 9-12 % of them) hold 72 % of the squared noise between two seeds. The
-stochastic gathers draw more samples there: vct's cones (VctConfig.support_gathers, computed inline in
-its gather) and rsm's VPLs (RsmConfig.support_draws, which reads this pass's image in every one of its
-per-face dispatches).
+stochastic gathers draw more samples there: vct's cones (VctConfig.support_gathers) and rsm's VPLs
+(RsmConfig.support_draws, in every one of its per-face dispatches). DirectMethod.measure_support runs it
+once per update.
 """
 
 from __future__ import annotations

@@ -21,7 +21,7 @@ from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_coun
 from ..brdf import split_albedo_table
 from ..config import VctConfig
 from ..grid import Grid
-from . import declare, denoise, surface_support
+from . import declare, surface_support
 from .declare import (
     AO,
     GBUF_NORMAL,
@@ -52,12 +52,10 @@ PIXELS = ShaderSpec(
     name="vct_gather",
     compute="vct/gather.comp.glsl",
     local_size=GATHER_GROUP,
-    samplers=(*_PYRAMID, Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D")),
+    samplers=(*_PYRAMID, Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("support", "2D")),
     images=(Image("indirect", "2D"), Image("ao", "2D")),
     uniforms=(*_DIFFUSE_UNIFORMS, Var("scale", "int"), Var("sample_index", "int"), Var("support_gathers", "int"),
-              Var("support_threshold", "float"), Var("normal_power", "float"), Var("plane_sigma", "float"),
-              Var("position_sigma", "float")),
-    defines=(("SUPPORT_STEP_PX", str(surface_support.STEP_PX)),),
+              Var("support_threshold", "float")),
 )
 
 UPSAMPLE = ShaderSpec(
@@ -91,7 +89,8 @@ BOUNCE = ShaderSpec(
 )
 
 
-PIXELS_DECL = PassDecl("vct_gather", "gather", (GBUF_POSITION, GBUF_NORMAL, VCT_PYRAMID), (INDIRECT, AO),
+PIXELS_DECL = PassDecl("vct_gather", "gather", (GBUF_POSITION, GBUF_NORMAL, surface_support.SUPPORT, VCT_PYRAMID),
+                       (INDIRECT, AO),
                        "diffuse cones at every pixel")
 GLOSSY_DECL = PassDecl("vct_glossy", "gather", (GBUF_POSITION, GBUF_NORMAL, GBUF_SPECULAR, VCT_PYRAMID),
                        (declare.GLOSSY,),
@@ -115,10 +114,11 @@ def low_size(size: tuple[int, int], scale: int) -> tuple[int, int]:
     return (-(-size[0] // scale), -(-size[1] // scale))
 
 
-def pixels(backend: Backend, pyramid: dict, radiance_scale: float, gbuf: dict, indirect, ao, grid: Grid,
+def pixels(backend: Backend, pyramid: dict, radiance_scale: float, gbuf: dict, support, indirect, ao, grid: Grid,
            config: VctConfig, seed: int = 0, low: tuple | None = None, sample: int = 0) -> None:
     """Gather into `indirect` and `ao`; with config.gather_scale > 1, into `low` (two textures of
-    low_size) first, then upsample. `seed` is the update's; `sample` the gather's index among those
+    low_size) first, then upsample. `support` (surface_support's image of `gbuf`): pixels below its
+    THRESHOLD gather config.support_gathers times. `seed` is the update's; `sample` the gather's index among those
     averaged since (DirectMethod.sample_index): each pixel's cone pattern continues one low-discrepancy
     sequence over the samples (gather.comp.glsl)."""
     scale = config.gather_scale
@@ -127,10 +127,9 @@ def pixels(backend: Backend, pyramid: dict, radiance_scale: float, gbuf: dict, i
                      uniforms={**cone_uniforms(grid, config, seed, radiance_scale),
                                "diffuse_cones": config.diffuse_cones, "scale": scale, "sample_index": sample,
                                "support_gathers": config.support_gathers,
-                               "support_threshold": surface_support.THRESHOLD,
-                               **denoise.weight_uniforms(denoise.Params())},
+                               "support_threshold": surface_support.THRESHOLD},
                      samplers={**named(pyramid, "pyr"), "gbuf_position": gbuf["position"],
-                               "gbuf_normal": gbuf["normal"]},
+                               "gbuf_normal": gbuf["normal"], "support": support},
                      images={"indirect": out[0], "ao": out[1]})
     if scale > 1:
         upsample(backend, gbuf, low, indirect, ao, scale, grid.cell_size_m)
