@@ -91,11 +91,24 @@ def _srgb_to_linear(c: np.ndarray) -> np.ndarray:
     return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
 
 
-def _image_texels(image) -> np.ndarray | None:
-    """Linear RGB texels (h, w, 3), row 0 = the image's bottom (Blender's order, v = 0)."""
+# What Cycles reads from an image it cannot load (a missing or unreadable file): magenta, its kernel's
+# IMAGE_TEXTURE_MISSING_RGBA. The capture reads the same, so Bounce lights the scene Cycles renders.
+MISSING_IMAGE_RGB = (1.0, 0.0, 1.0)
+
+
+def _image_unreadable(image) -> bool:
+    """Whether Blender could not load the image (its size is then 0 x 0)."""
     w, h = image.size
-    if w * h == 0 or image.channels < 3:
-        return None
+    return w * h == 0
+
+
+def _image_texels(image) -> np.ndarray:
+    """Linear RGB texels (h, w, 3), row 0 = the image's bottom (Blender's order, v = 0); one magenta texel
+    for an image Blender cannot load (MISSING_IMAGE_RGB). A loaded image has 4 channels, grey files too
+    (checked on bpy 5.0 with one-channel EXR and PNG files)."""
+    if _image_unreadable(image):
+        return np.array([[MISSING_IMAGE_RGB]], np.float64)
+    w, h = image.size
     px = np.empty(w * h * image.channels, np.float32)
     image.pixels.foreach_get(px)
     rgb = px.reshape(h, w, image.channels)[..., :3].astype(np.float64)
@@ -138,10 +151,12 @@ def _input_color(node, name: str, problems: list[str], images: dict, textures: l
         key = src.image.name
         if key not in images:
             images[key] = _image_texels(src.image)
-        if images[key] is not None:
-            if textures is not None and src.type == "TEX_IMAGE" and not src.inputs["Vector"].is_linked:
-                textures.append(images[key])
-            return images[key].reshape(-1, 3).mean(axis=0)
+        if _image_unreadable(src.image):
+            problems.append(f"{name} <- image {key!r} ({src.image.filepath or 'no file'}) could not be "
+                            f"loaded: magenta, as Cycles renders it")
+        if textures is not None and src.type == "TEX_IMAGE" and not src.inputs["Vector"].is_linked:
+            textures.append(images[key])
+        return images[key].reshape(-1, 3).mean(axis=0)
     problems.append(f"{name} <- {src.bl_idname} (constant used)")
     return np.array(sock.default_value[:3], np.float64)
 
@@ -407,7 +422,7 @@ class SceneCache:
         colour: the interactive viewport, where a Cycles render from a timer would stall the UI."""
         self.render_world = render_world
         self.blocks: dict[tuple, _Block] = {}
-        self.images: dict[str, np.ndarray | None] = {}
+        self.images: dict[str, np.ndarray] = {}
         self.geometry_reads = 0
         self.scene: Scene | None = None
         self._dirty: set[str] = set()

@@ -47,13 +47,19 @@ def _principled(name, **inputs):
     return mat
 
 
-def _plane_head_on(tmp_path, inputs: dict, spp: int, pass_name: str):
-    """A 100 m Principled plane (`inputs`) filling a 16 x 16 Cycles render from 10 m above: returns the
-    capture and the render's layers, with `pass_name` ("Diffuse Color" or "Glossy Color") enabled."""
+def _plane_head_on(tmp_path, inputs: dict, spp: int, pass_name: str, base_image=None):
+    """A 100 m Principled plane (`inputs`; `base_image`, if given, an Image Texture into its Base Color)
+    filling a 16 x 16 Cycles render from 10 m above: returns the capture and the render's layers, with
+    `pass_name` ("Diffuse Color" or "Glossy Color") enabled."""
     from addon.bridge.images import read_multilayer
 
     plane = _obj("Plane", [(-50, -50, 0), (50, -50, 0), (50, 50, 0), (-50, 50, 0)], [(0, 1, 2, 3)])
-    plane.data.materials.append(_principled("M", **inputs))
+    mat = _principled("M", **inputs)
+    if base_image is not None:
+        tex = mat.node_tree.nodes.new("ShaderNodeTexImage")
+        tex.image = base_image
+        mat.node_tree.links.new(tex.outputs["Color"], mat.node_tree.nodes["Principled BSDF"].inputs["Base Color"])
+    plane.data.materials.append(mat)
     cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
     cam.data.lens = 200
     cam.location = (0, 0, 10)
@@ -300,6 +306,21 @@ def test_albedo_matches_cycles_diffuse_color(fresh_blend, tmp_path, level, metal
     np.testing.assert_allclose(diff_col, np.broadcast_to(s.albedo[0], diff_col.shape), atol=2e-3)
     expected_factor = {0.0: 1.0, 0.5: 0.9626, 1.0: 0.9254}[level]  # measured head-on (module docstring)
     np.testing.assert_allclose(s.albedo[0], np.array(base[:3]) * (1 - metallic) * expected_factor, atol=1e-3)
+
+
+def test_an_image_blender_cannot_load_reads_as_cycles_renders_it(fresh_blend, tmp_path):
+    """A Base Color image whose file is gone: Cycles renders it magenta (1, 0, 1), and the capture must
+    light that scene, not the socket's default colour; one warning names the image. Tolerance as in
+    test_albedo_matches_cycles_diffuse_color (Specular IOR Level 0: no dielectric factor)."""
+    img = bpy.data.images.new("gone", 4, 4)
+    img.source, img.filepath = "FILE", str(tmp_path / "no-such-texture.png")
+    img.reload()
+    s, layers = _plane_head_on(tmp_path, {"Specular IOR Level": 0.0, "Base Color": (0.2, 0.8, 0.2, 1)},
+                               spp=1, pass_name="Diffuse Color", base_image=img)
+    diff_col = layers["Diffuse Color"][:, :, :3]
+    np.testing.assert_allclose(diff_col, np.broadcast_to([1.0, 0.0, 1.0], diff_col.shape), atol=2e-3)
+    np.testing.assert_allclose(s.albedo[0], diff_col[8, 8], atol=2e-3)
+    assert len(s.warnings) == 1 and "'gone'" in s.warnings[0] and "magenta" in s.warnings[0]
 
 
 def test_camera_projection_matches_world_to_camera_view(fresh_blend):
