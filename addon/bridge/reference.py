@@ -65,6 +65,15 @@ def _open_blend(blend_path):
     return bpy, scene
 
 
+def unloadable_images(bpy) -> list[str]:
+    """Notes naming each image in use whose file Blender cannot load: Cycles renders it magenta (and the
+    capture reads it so, capture.MISSING_IMAGE_RGB), which is rarely the scene its author meant."""
+    return [f"image {img.name!r} ({img.filepath}) could not be loaded: Cycles renders it magenta "
+            f"(File > External Data > Find Missing Files)"
+            for img in bpy.data.images
+            if img.users and img.source in ("FILE", "SEQUENCE", "TILED") and img.size[0] * img.size[1] == 0]
+
+
 def _use_gpu_if_any(bpy, scene) -> str:
     """Pick a Cycles GPU device when Cycles reports one, else CPU. Returns a description."""
     scene.cycles.device = "CPU"
@@ -195,6 +204,7 @@ def render_reference(blend_path, out_dir, spp: int = 1024, bounces: int = 1, res
         "glossy": glossy,
         "blender_version": bpy.app.version_string,
         **info,
+        "notes": unloadable_images(bpy),
     }
     (out / "stats.json").write_text(json.dumps(stats, indent=2))
     return stats

@@ -208,6 +208,31 @@ def test_aspect_portrait(tmp_path):
 
 @pytest.mark.slow
 @pytest.mark.blender
+def test_an_image_cycles_cannot_load_is_named_in_the_notes(tmp_path):
+    """The floor's Base Color reads an image whose file is gone: Cycles renders it magenta, so the
+    reference's stats.json says which image and where it was looked for; a scene without one says
+    nothing (the notes are empty)."""
+    bpy = pytest.importorskip("bpy")
+    from addon.bridge.reference import render_reference
+
+    build_scene(bpy, tmp_path / "ok.blend")
+    assert render_reference(tmp_path / "ok.blend", tmp_path / "ok", spp=1, res=16)["notes"] == []
+    img = bpy.data.images.new("gone", 4, 4)
+    img.source, img.filepath = "FILE", str(tmp_path / "no-such-texture.png")
+    mat = bpy.data.objects["Floor"].data.materials[0]
+    tex = mat.node_tree.nodes.new("ShaderNodeTexImage")
+    tex.image = img
+    mat.node_tree.links.new(tex.outputs["Color"], mat.node_tree.nodes["Principled BSDF"].inputs["Base Color"])
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "gone.blend"))
+    stats = render_reference(tmp_path / "gone.blend", tmp_path / "gone", spp=1, res=16)
+    assert len(stats["notes"]) == 1 and "'gone'" in stats["notes"][0] and "no-such-texture.png" in stats["notes"][0]
+    albedo = images.read_exr(tmp_path / "gone" / "albedo.exr")
+    floor = albedo[albedo[..., 3] > 0.5][:, :3]
+    assert np.isclose(floor, [1.0, 0.0, 1.0], atol=2e-3).all(axis=1).any()  # magenta, as the note says
+
+
+@pytest.mark.slow
+@pytest.mark.blender
 def test_noise_floor_and_curve(scene_4x3, tmp_path):
     from addon.bridge.reference import cycles_curve, noise_floor, render_reference
 
