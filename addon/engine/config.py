@@ -72,8 +72,11 @@ class RsmConfig(_Validated):
     voxel_cells: int = _num(64, 8, 512, "voxel grid cells along the scene's longest side (voxel visibility)")
     voxel_offset_cells: float = _num(1.5, 0.0, 4.0, "ray ends moved off their surfaces, in cells")
     # Where the denoise filter finds little of a pixel's own surface around it, the `rsm` gather makes
-    # this many sets of VPL draws (passes/surface_support.py; docs/RSM.md).
-    support_draws: int = _num(2, 1, 4, "sets of VPL draws at pixels whose denoise filter finds little of their "
+    # this many sets of VPL draws (passes/surface_support.py; docs/RSM.md). Sponza (noise between seeds,
+    # one update) at 128 / 512 px: 1 set 0.099 / 0.045, 2 sets 0.071 / 0.031, 3 sets 0.059 / 0.026 (4: 0.052 at 128
+    # px, and with --accumulate 16 0.0108 as 3); a lights update 1.14x two sets' on Sponza at 128 px, 1.11x
+    # on cornell, whose noise it leaves alone.
+    support_draws: int = _num(3, 1, 4, "sets of VPL draws at pixels whose denoise filter finds little of their "
                                        "surface around them (thin or small details; 1: one set everywhere)")
     # An area light is split into patches_per_side^2 patches (sectors for disks and ellipses), each
     # with its exact unshadowed irradiance and soft shadows from its own RSM faces, which it costs
@@ -179,8 +182,9 @@ class VctConfig(_Validated):
     gather_scale: int = _num(1, 1, 4, "cones at one pixel per n x n block, upsampled along edges (1: every pixel)")
     # Where the denoise filter finds little of a pixel's own surface around it (thin columns, leaves, the
     # last pixels before an edge) it cannot average the gather's noise, so those pixels gather this many
-    # times (gather.comp.glsl). Sponza 128 / 512 px: noise between seeds 0.120 / 0.061 -> 0.083 / 0.038
-    # at 2 (4: 0.072 at 128), for 18 % more gather half on llvmpipe; cornell unchanged (docs/VCT.md).
+    # times (gather.comp.glsl). Sponza 128 / 512 px: noise between seeds 0.118 / 0.058 -> 0.083 / 0.037
+    # at 2 (4: 0.072 at 128; 3: 0.035 at 512), for 18 % more gather half on llvmpipe; cornell unchanged
+    # (docs/VCT.md).
     support_gathers: int = _num(2, 1, 4, "gathers at pixels whose denoise filter finds little of their surface around "
                                          "them (thin or small details; 1: one gather everywhere)")
     radiance: str = _choice("anisotropic", ("anisotropic", "isotropic"),
