@@ -96,7 +96,7 @@ def _srgb_to_linear(c: np.ndarray) -> np.ndarray:
 MISSING_IMAGE_RGB = (1.0, 0.0, 1.0)
 
 
-def _image_unreadable(image) -> bool:
+def image_unreadable(image) -> bool:
     """Whether Blender could not load the image (its size is then 0 x 0)."""
     w, h = image.size
     return w * h == 0
@@ -106,7 +106,7 @@ def _image_texels(image) -> np.ndarray:
     """Linear RGB texels (h, w, 3), row 0 = the image's bottom (Blender's order, v = 0); one magenta texel
     for an image Blender cannot load (MISSING_IMAGE_RGB). A loaded image has 4 channels, grey files too
     (checked on bpy 5.0 with one-channel EXR and PNG files)."""
-    if _image_unreadable(image):
+    if image_unreadable(image):
         return np.array([[MISSING_IMAGE_RGB]], np.float64)
     w, h = image.size
     px = np.empty(w * h * image.channels, np.float32)
@@ -151,7 +151,7 @@ def _input_color(node, name: str, problems: list[str], images: dict, textures: l
         key = src.image.name
         if key not in images:
             images[key] = _image_texels(src.image)
-        if _image_unreadable(src.image):
+        if image_unreadable(src.image):
             problems.append(f"{name} <- image {key!r} ({src.image.filepath or 'no file'}) could not be "
                             f"loaded: magenta, as Cycles renders it")
         if textures is not None and src.type == "TEX_IMAGE" and not src.inputs["Vector"].is_linked:

@@ -28,7 +28,7 @@ import numpy as np
 from ..engine.errors import ConfigError, SceneError
 from ..engine.metrics import compare
 from . import images
-from .capture import image_size
+from .capture import image_size, image_unreadable
 
 PASSES = {"indirect": "Diffuse Indirect", "direct": "Diffuse Direct", "albedo": "Diffuse Color", "normal": "Normal"}
 GLOSSY_PASSES = ("Glossy Indirect", "Glossy Color")  # multiplied into glossy.exr
@@ -71,7 +71,7 @@ def unloadable_images(bpy) -> list[str]:
     return [f"image {img.name!r} ({img.filepath}) could not be loaded: Cycles renders it magenta "
             f"(File > External Data > Find Missing Files)"
             for img in bpy.data.images
-            if img.users and img.source in ("FILE", "SEQUENCE", "TILED") and img.size[0] * img.size[1] == 0]
+            if img.users and img.source in ("FILE", "SEQUENCE", "TILED") and image_unreadable(img)]
 
 
 def _use_gpu_if_any(bpy, scene) -> str:

@@ -73,9 +73,9 @@ class RsmConfig(_Validated):
     voxel_offset_cells: float = _num(1.5, 0.0, 4.0, "ray ends moved off their surfaces, in cells")
     # Where the denoise filter finds little of a pixel's own surface around it, the `rsm` gather makes
     # this many sets of VPL draws (passes/surface_support.py; docs/RSM.md). Sponza (noise between seeds,
-    # one update) at 128 / 512 px: 1 set 0.099 / 0.045, 2 sets 0.071 / 0.031, 3 sets 0.059 / 0.026 (4: 0.052 at 128
-    # px, and with --accumulate 16 0.0108 as 3); a lights update 1.14x two sets' on Sponza at 128 px, 1.11x
-    # on cornell, whose noise it leaves alone.
+    # one update) at 128 / 512 px: 1 set 0.099 / 0.045, 2 sets 0.071 / 0.031, 3 sets 0.059 / 0.026 (4:
+    # 0.052 at 128 px, and with --accumulate 16 0.0108 as 3); a lights update 1.14x two sets' on Sponza
+    # at 128 px, 1.11x on cornell, whose noise it leaves alone.
     support_draws: int = _num(3, 1, 4, "sets of VPL draws at pixels whose denoise filter finds little of their "
                                        "surface around them (thin or small details; 1: one set everywhere)")
     # An area light is split into patches_per_side^2 patches (sectors for disks and ellipses), each
