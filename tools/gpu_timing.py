@@ -78,6 +78,7 @@ def save_scene(scene, path_stem: Path, meta: dict | None = None) -> dict:
         positions_m=np.asarray(scene.positions_m, np.float32),
         normals=np.asarray(scene.normals, np.float32),
         albedo=np.asarray(scene.albedo, np.float32),
+        bounce_albedo=scene.bounce_reflectance(),
         emission=np.asarray(scene.emission, np.float32),
         camera_visible=np.asarray(visible, bool),
         specular=scene.specular_f0(),
@@ -131,6 +132,7 @@ def load_scene(path_stem: Path, size: tuple[int, int] | None = None):
                  world_color=np.array(info["world_color"], np.float32), camera=camera,
                  warnings=list(info.get("warnings", [])), camera_visible=arrays["camera_visible"],
                  specular=arrays.get("specular"), roughness=arrays.get("roughness"),  # absent in older exports
+                 bounce_albedo=arrays.get("bounce_albedo"),
                  world_map=arrays.get("world_map"))
 
 

@@ -10,7 +10,9 @@ What is captured, and why:
   split normals) go to world space by the inverse transpose. Triangles with NaN/Inf corners or zero area
   (after the transform) are dropped and counted in one warning.
 - Albedo is what Cycles' *Diffuse Color* pass shows: base colour x (1 - metallic) x (1 - transmission)
-  x the dielectric specular layer's attenuation (see `specular_layer_factor`). Emission is radiance
+  x the dielectric specular layer's attenuation (see `specular_layer_factor`). The bounce albedo
+  (`Scene.bounce_albedo`, what the emitters of indirect light reflect with) leaves that layer out, as
+  Cycles does after a diffuse bounce. Emission is radiance
   W/m^2/sr (colour x strength). Node setups we cannot read give albedo 0.8 and a warning, never silence.
 - Lengths are multiplied by `scene.unit_settings.scale_length` (Blender units -> metres). Light power
   (W) and sun strength (W/m^2) are taken as they are: Cycles does not rescale them with the unit scale.
@@ -179,19 +181,24 @@ def _surface_node(tree, output_type: str, input_name: str):
 
 
 def material_values(mat, images: dict | None = None, textures: list | None = None
-                    ) -> tuple[np.ndarray, np.ndarray, str | None]:
-    """(albedo, emission, warning or None) of a material, as Cycles' Diffuse Color pass and emission see it.
+                    ) -> tuple[np.ndarray, np.ndarray, str | None, np.ndarray]:
+    """(albedo, emission, warning or None, bounce albedo) of a material: albedo as Cycles' Diffuse Color
+    pass sees it, and as another diffuse surface sees it (Scene.bounce_albedo: without the specular
+    layer, which Cycles drops after a diffuse bounce).
 
     With `textures` (a list), a Base Color image texture read through UVs is appended to it and the
     returned albedo is the texture's average times the rest of the factors: per-triangle albedo is
     then albedo / average x the texture's mean over the triangle (`_material_arrays`)."""
     images = {} if images is None else images
     if mat is None:
-        return np.full(3, NEUTRAL_ALBEDO), np.zeros(3), None  # Cycles' default surface
+        grey = np.full(3, NEUTRAL_ALBEDO)  # Cycles' default surface
+        return grey, np.zeros(3), None, grey
     if not compat.uses_nodes(mat):
-        return np.array(mat.diffuse_color[:3], np.float64), np.zeros(3), None
+        colour = np.array(mat.diffuse_color[:3], np.float64)
+        return colour, np.zeros(3), None, colour
     node = _surface_node(mat.node_tree, "OUTPUT_MATERIAL", "Surface")
     problems: list[str] = []
+    layer_factor = 1.0  # the specular layer's attenuation of the diffuse lobe, seen from the camera only
     if node is not None and node.type == "BSDF_PRINCIPLED":
         base = _input_color(node, "Base Color", problems, images, textures)
         metallic = _input_float(node, "Metallic", problems)
@@ -199,7 +206,8 @@ def material_values(mat, images: dict | None = None, textures: list | None = Non
         level = _input_float(node, "Specular IOR Level", problems)
         ior = _input_float(node, "IOR", problems)
         rough = _input_float(node, "Roughness", problems)
-        albedo = base * (1 - metallic) * (1 - transmission) * specular_layer_factor(level, ior, rough)
+        albedo = base * (1 - metallic) * (1 - transmission)
+        layer_factor = specular_layer_factor(level, ior, rough)
         for layer in ("Coat Weight", "Sheen Weight", "Subsurface Weight"):
             if _input_float(node, layer, problems) > 0:
                 problems.append(f"{layer} > 0 ignored")
@@ -212,10 +220,12 @@ def material_values(mat, images: dict | None = None, textures: list | None = Non
         albedo, emission = _input_color(node, "Color", problems, images, textures), np.zeros(3)
     else:
         kind = "no surface" if node is None else node.bl_idname
-        return np.full(3, NEUTRAL_ALBEDO), np.zeros(3), (
-            f"material {mat.name!r}: unsupported surface ({kind}); albedo {NEUTRAL_ALBEDO} used")
+        grey = np.full(3, NEUTRAL_ALBEDO)
+        return grey, np.zeros(3), (
+            f"material {mat.name!r}: unsupported surface ({kind}); albedo {NEUTRAL_ALBEDO} used"), grey
     warn = f"material {mat.name!r}: " + "; ".join(problems) if problems else None
-    return np.clip(albedo, 0.0, 1.0), np.maximum(emission, 0.0), warn
+    bounce = np.clip(albedo, 0.0, 1.0)
+    return bounce * layer_factor, np.maximum(emission, 0.0), warn, bounce
 
 
 def material_glossy(mat, images: dict | None = None) -> tuple[np.ndarray, float]:
@@ -513,7 +523,7 @@ class SceneCache:
         dropped = sum(b.world[3] for b in seen.values())
         if dropped:
             out.warnings.append(f"{dropped} triangles with NaN/Inf corners or zero area dropped")
-        for _, _, warn, _ in mats.values():
+        for _, _, warn, _, _ in mats.values():
             if warn:
                 out.warnings.append(warn)
         self._capture_world(scene_bl.world, out)
@@ -528,9 +538,10 @@ class SceneCache:
             out.normals = np.concatenate([p[1] for p in parts])
             out.albedo = np.concatenate([p[2] for p in parts]).astype(np.float32)
             out.emission = np.concatenate([p[3] for p in parts]).astype(np.float32)
-            out.specular = np.concatenate([p[4] for p in parts]).astype(np.float32)
-            out.roughness = np.concatenate([p[5] for p in parts]).astype(np.float32)
-            out.camera_visible = np.concatenate([np.full(len(p[0]), p[6], bool) for p in parts])
+            out.bounce_albedo = np.concatenate([p[4] for p in parts]).astype(np.float32)
+            out.specular = np.concatenate([p[5] for p in parts]).astype(np.float32)
+            out.roughness = np.concatenate([p[6] for p in parts]).astype(np.float32)
+            out.camera_visible = np.concatenate([np.full(len(p[0]), p[7], bool) for p in parts])
         self.scene = out
         return out
 
@@ -538,26 +549,31 @@ class SceneCache:
         """A block's world triangles with per-triangle albedo/emission looked up from its material slots;
         an image-textured Base Color is averaged over each triangle's UVs."""
         pos, nrm, keep, _ = block.world
-        table_a, table_e, table_tex = [], [], []
+        table_a, table_e, table_b, table_tex = [], [], [], []
         for mat in slots or [None]:
             key = mat.name if mat is not None else None
             if key not in mats:
                 textures: list = []
                 mats[key] = (*material_values(mat, self.images, textures), textures[0] if textures else None)
-            table_a.append(mats[key][0])
-            table_e.append(mats[key][1])
-            table_tex.append(mats[key][3])
+            albedo_m, emission_m, _, bounce_m, texels_m = mats[key]
+            table_a.append(albedo_m)
+            table_e.append(emission_m)
+            table_b.append(bounce_m)
+            table_tex.append(texels_m)
         idx = np.clip(block.mat_index[keep], 0, len(table_a) - 1)  # Cycles clamps the index too
         albedo = np.asarray(table_a).reshape(-1, 3)[idx]
+        bounce = np.asarray(table_b).reshape(-1, 3)[idx]
         if block.uv is not None:
             uv = block.uv[keep]
             for slot, texels in enumerate(table_tex):
                 on = idx == slot
                 if texels is not None and np.any(on):
                     mean = texels.reshape(-1, 3).mean(axis=0)
-                    scale = np.divide(table_a[slot], mean, out=np.zeros(3), where=mean > 0)
-                    albedo[on] = np.clip(triangle_texture_average(texels, uv[on]) * scale, 0.0, 1.0)
-        return pos, nrm, albedo, np.asarray(table_e).reshape(-1, 3)[idx]
+                    texture = triangle_texture_average(texels, uv[on])
+                    for out, table in ((albedo, table_a), (bounce, table_b)):
+                        scale = np.divide(table[slot], mean, out=np.zeros(3), where=mean > 0)
+                        out[on] = np.clip(texture * scale, 0.0, 1.0)
+        return pos, nrm, albedo, np.asarray(table_e).reshape(-1, 3)[idx], bounce
 
 
     def _glossy_arrays(self, block: _Block, slots: list, glossy: dict) -> tuple:

@@ -98,7 +98,8 @@ def _same_arrays(a: tuple, b: tuple) -> bool:
 
 
 def _geometry(scene: Scene) -> tuple:
-    return scene.positions_m, scene.normals, scene.albedo, scene.emission, scene.specular_f0(), scene.glossy_roughness()
+    return (scene.positions_m, scene.normals, scene.albedo, scene.bounce_reflectance(), scene.emission,
+            scene.specular_f0(), scene.glossy_roughness())
 
 
 def _lights(scene: Scene) -> list:

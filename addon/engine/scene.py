@@ -101,7 +101,14 @@ class Scene:
 
     The glossy lobe (optional, None = none): per triangle `specular` (n, 3), the GGX lobe's reflectance
     at normal incidence F0 (metals: their base colour; dielectrics ((ior - 1) / (ior + 1))^2 x 2 x
-    Specular IOR Level), and `roughness` (n,), Blender's Roughness (GGX alpha = roughness^2)."""
+    Specular IOR Level), and `roughness` (n,), Blender's Roughness (GGX alpha = roughness^2).
+
+    `albedo` is what the camera sees (Cycles' Diffuse Color pass); `bounce_albedo` (n, 3, optional, None =
+    `albedo`) is how a surface reflects light toward another diffuse surface (a path's vertex after a
+    diffuse bounce), which the emitters of every indirect method use. They differ under a glossy layer:
+    there Cycles drops Principled BSDF's specular layer (reflective caustics off, as the reference
+    renders) and with it the layer's attenuation of the diffuse lobe, so the surface reflects its full
+    base colour (with caustics on, the layer reflects about what it takes from the diffuse lobe)."""
 
     positions_m: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 3), np.float32))
     normals: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 3), np.float32))
@@ -117,6 +124,11 @@ class Scene:
     camera_visible: np.ndarray | None = None
     specular: np.ndarray | None = None
     roughness: np.ndarray | None = None
+    bounce_albedo: np.ndarray | None = None
+
+    def bounce_reflectance(self) -> np.ndarray:
+        """(n, 3) float32 albedo toward other diffuse surfaces (see the class): `albedo` where None."""
+        return np.asarray(self.albedo if self.bounce_albedo is None else self.bounce_albedo, np.float32)
 
     def specular_f0(self) -> np.ndarray:
         """(n, 3) float32 F0 of every triangle's glossy lobe; zeros when the scene has none."""
@@ -175,7 +187,8 @@ class Scene:
             warnings.append(f"{int(copies.sum())} duplicated triangles (the same corners as another) were ignored")
         kept = replace(self, positions_m=pos[keep], normals=self.normals[keep], albedo=self.albedo[keep],
                        emission=self.emission[keep], warnings=warnings, camera_visible=self.seen_by_camera()[keep],
-                       specular=self.specular_f0()[keep], roughness=self.glossy_roughness()[keep])
+                       specular=self.specular_f0()[keep], roughness=self.glossy_roughness()[keep],
+                       bounce_albedo=self.bounce_reflectance()[keep])
         lo, hi = kept.bounds_m()
         origin = (lo + hi) / 2.0
         # Geometry only: lights and camera stay in world space and are shifted per update by the method.

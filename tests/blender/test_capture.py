@@ -306,6 +306,9 @@ def test_albedo_matches_cycles_diffuse_color(fresh_blend, tmp_path, level, metal
     np.testing.assert_allclose(diff_col, np.broadcast_to(s.albedo[0], diff_col.shape), atol=2e-3)
     expected_factor = {0.0: 1.0, 0.5: 0.9626, 1.0: 0.9254}[level]  # measured head-on (module docstring)
     np.testing.assert_allclose(s.albedo[0], np.array(base[:3]) * (1 - metallic) * expected_factor, atol=1e-3)
+    # Toward other surfaces the layer is gone, as in Cycles after a diffuse bounce (tests/e2e/
+    # test_glossy_bounce.py); exact: the same product without the factor.
+    np.testing.assert_allclose(s.bounce_albedo[0], np.array(base[:3]) * (1 - metallic), atol=1e-6)
 
 
 def test_an_image_blender_cannot_load_reads_as_cycles_renders_it(fresh_blend, tmp_path):

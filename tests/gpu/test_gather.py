@@ -33,7 +33,7 @@ def _triangles(tris):
     normals = np.repeat(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), 3, axis=0)
     normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
     return {"pos_ws": tris.reshape(-1, 3), "plane_ws": np.repeat(face_planes(tris), 3, axis=0), "normal_ws": normals,
-            "albedo": np.full((len(normals), 3), ALBEDO)}
+            "bounce_albedo": np.full((len(normals), 3), ALBEDO)}
 
 
 def _square(z, half):

@@ -35,7 +35,7 @@ def mesh_of(gl, triangles):
     normals = np.repeat(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), 3, axis=0)
     normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
     attrs = {"pos_ws": tris.reshape(-1, 3), "plane_ws": np.repeat(face_planes(tris), 3, axis=0), "normal_ws": normals,
-             "albedo": np.full((len(normals), 3), 0.5)}
+             "bounce_albedo": np.full((len(normals), 3), 0.5)}
     return gl.mesh(gl.program(probe_capture.SPEC), attrs, "triangles")
 
 

@@ -95,10 +95,10 @@ def face_planes(positions_m: np.ndarray) -> np.ndarray:
 
 def triangle_attributes(scene: Scene, spec: ShaderSpec,
                         select: np.ndarray | None = None) -> dict[str, np.ndarray] | None:
-    """Per-vertex arrays for raster pass `spec`, the attributes it declares only: three
-    vertices per triangle, flat albedo and glossy lobe (specular: F0, roughness), the triangle's plane
-    (face_planes: 110 ms for 279 k triangles, so only for the passes that read it); `select` picks
-    triangles (None: all). None when nothing is left to draw."""
+    """Per-vertex arrays for raster pass `spec`, the attributes it declares only: three vertices per
+    triangle, flat albedo (the camera's; bounce_albedo: toward other surfaces) and glossy lobe
+    (specular: F0, roughness), the triangle's plane (face_planes: 110 ms for 279 k triangles, so only
+    for the passes that read it); `select` picks triangles (None: all). None when nothing is left."""
     sel = np.ones(scene.triangle_count, bool) if select is None else select
     n = int(sel.sum())
     if n == 0:
@@ -108,6 +108,7 @@ def triangle_attributes(scene: Scene, spec: ShaderSpec,
         "plane_ws": lambda: np.repeat(face_planes(scene.positions_m[sel]), 3, axis=0),
         "normal_ws": lambda: scene.normals[sel].reshape(n * 3, 3).astype(np.float32),
         "albedo": lambda: np.repeat(scene.albedo[sel].astype(np.float32), 3, axis=0),
+        "bounce_albedo": lambda: np.repeat(scene.bounce_reflectance()[sel], 3, axis=0),
         "specular": lambda: np.repeat(np.c_[scene.specular_f0()[sel], scene.glossy_roughness()[sel]], 3, axis=0),
     }
     return {a.name: build[a.name]() for a in spec.attributes}

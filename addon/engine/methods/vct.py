@@ -65,7 +65,8 @@ class VctMethod(OneBounceMethod):
         volumes, tests/gpu/test_voxelize.py) and the grid's other textures are kept."""
         super().set_scene(scene)
         be, cfg = self.backend, self.vct_config
-        self._albedo_max = float(self.scene.albedo.max()) if len(self.scene.albedo) else 0.0
+        bounce = self.scene.bounce_reflectance()
+        self._albedo_max = float(bounce.max()) if len(bounce) else 0.0
         self._glossy_anywhere = bool(np.any(self.scene.specular_f0() > 0))  # known_zero, once per geometry
         grid = Grid.fit(*self.bounds_m, max_cells=cfg.voxel_cells)
         if grid.same_cells(self.grid):

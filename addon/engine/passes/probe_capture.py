@@ -5,7 +5,7 @@ the distance moments its Chebyshev visibility reads, and per probe whether it is
 capture: for each probe and face, the scene's triangles drawn with the face's 90-degree view-projection
 (probe_grid.face_view_projection) into that face's n x n viewport of the atlas (layout: probe_grid.py).
 Outputs (RGBA32F, atlas): position (m, w = 1 where geometry), normal (towards the probe, w = +1 front
-face / -1 back face), albedo (w = 1 where geometry); depth 32F.
+face / -1 back face), albedo (the bounce albedo, Scene.bounce_albedo; w = 1 where geometry); depth 32F.
 moments: mean and mean square of the probe-to-surface distance over a (2 MOMENT_RADIUS + 1)^2 window
 of the texel's face, distances clamped at MAX_DISTANCE_RATIO x spacing (directions without geometry
 count as that).
@@ -51,7 +51,7 @@ def _atlas(name, units):
 
 ATLAS = (_atlas("position", "world position (m) a probe texel sees, w = 1 where geometry"),
          _atlas("normal", "world normal towards the probe; w = +1 front face, -1 back face"),
-         _atlas("albedo", "diffuse albedo (linear), w = 1 where geometry"))
+         _atlas("albedo", "bounce albedo (linear; Scene.bounce_albedo), w = 1 where geometry"))
 ATLAS_POSITION, ATLAS_NORMAL, ATLAS_ALBEDO = ATLAS
 MOMENTS = _atlas("moments", "probe-to-surface distance: mean (m), mean square (m^2) over a texel window")
 STATE = Port("probes", "state", "RGBA32F", "probes", "x: 1 probe on, 0 off (inside geometry); y: back-face share")
@@ -89,7 +89,8 @@ SPEC = ShaderSpec(
     vertex="probes/capture.vert.glsl",
     fragment="probes/capture.frag.glsl",
     uniforms=(Var("view_projection", "mat4"), Var("camera_pos_ws", "vec3")),
-    attributes=(Var("pos_ws", "vec3"), Var("plane_ws", "vec4"), Var("normal_ws", "vec3"), Var("albedo", "vec3")),
+    attributes=(Var("pos_ws", "vec3"), Var("plane_ws", "vec4"), Var("normal_ws", "vec3"),
+                Var("bounce_albedo", "vec3")),
     varyings=(Var("v_pos_ws", "vec3"), Var("v_plane_ws", "vec4", "flat"), Var("v_normal_ws", "vec3"),
               Var("v_albedo", "vec3")),
     outputs=(Var("out_position", "vec4"), Var("out_normal", "vec4"), Var("out_albedo", "vec4")),

@@ -29,7 +29,7 @@ SPEC = ShaderSpec(
         Var("light_color_intensity", "vec3"), Var("spot_blend", "float"),
         Var("occluder_radius", "float"), Var("area_weight", "float"),
     ),
-    attributes=(Var("pos_ws", "vec3"), Var("normal_ws", "vec3"), Var("albedo", "vec3")),
+    attributes=(Var("pos_ws", "vec3"), Var("normal_ws", "vec3"), Var("bounce_albedo", "vec3")),
     varyings=(Var("v_pos_ws", "vec3"), Var("v_normal_ws", "vec3"), Var("v_albedo", "vec3")),
     outputs=(Var("out_position", "vec4"), Var("out_normal", "vec4"), Var("out_flux", "vec4")),
 )

@@ -1,8 +1,9 @@
 """Voxelization pass (shared by VCT, LPV's geometry volume and voxel visibility).
 
 Inputs: scene triangles; a Grid. Outputs (RGBA32F 3D textures of grid.dims, canonical x, y, z layout):
-`vox_albedo` (diffuse albedo, a = occupancy 0/1), `vox_normal` (area-weighted mean normal, w = surface
-area in the cell in cell units^2), `vox_emission` (emitted radiance W/m^2/sr, a = occupancy),
+`vox_albedo` (diffuse albedo toward other surfaces, Scene.bounce_albedo; a = occupancy 0/1),
+`vox_normal` (area-weighted mean normal, w = surface area in the cell in cell units^2), `vox_emission`
+(emitted radiance W/m^2/sr, a = occupancy),
 `vox_projected` (xyz = per axis the larger of the areas the surfaces facing + and - project along it,
 in cell units^2: a one-sided wall its area, both faces of a thin wall one of them, a closed column its
 silhouette; unlike the mean normal it does not cancel in thin walls: VCT's directional opacity and
@@ -141,7 +142,7 @@ class Voxelizer:
         triangle into every slab cost Sponza's 67k triangles x 3 x 128 slabs: 60 ms on an H100)."""
         n = scene.triangle_count
         self._positions_m = np.array(scene.positions_m, np.float64)
-        self._albedo, self._emission = np.array(scene.albedo), np.array(scene.emission)
+        self._albedo, self._emission = np.array(scene.bounce_reflectance()), np.array(scene.emission)
         self._normals = np.zeros((n, 3))
         self._axis = np.full(n, -1, np.int64)
         self._first_layer, self._last_layer = np.zeros(n, np.int64), np.zeros(n, np.int64)
@@ -160,7 +161,7 @@ class Voxelizer:
             self.set_scene(scene)
             return scene.triangle_count
         pos = np.asarray(scene.positions_m, np.float64)
-        albedo, emission = np.asarray(scene.albedo), np.asarray(scene.emission)
+        albedo, emission = scene.bounce_reflectance(), np.asarray(scene.emission)
         changed = np.flatnonzero(np.any(pos != self._positions_m, axis=(1, 2))
                                  | np.any(albedo != self._albedo, axis=1)
                                  | np.any(emission != self._emission, axis=1))
