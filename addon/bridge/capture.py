@@ -180,15 +180,47 @@ def _surface_node(tree, output_type: str, input_name: str):
     return cycles[0].inputs[input_name].links[0].from_node
 
 
+def _closures(node, weight: float, problems: list[str]) -> list[tuple[float, object]]:
+    """The shader nodes whose closures a surface sums, each with its weight: through Add Shader (both
+    inputs, 1 each), Mix Shader (1 - Fac and Fac) and reroutes, as Cycles adds closures. An unlinked
+    shader input adds nothing, as in Cycles."""
+    if node.type == "REROUTE":
+        links = node.inputs[0].links
+        return _closures(links[0].from_node, weight, problems) if links else []
+    if node.type == "ADD_SHADER":
+        parts = ((node.inputs[0], 1.0), (node.inputs[1], 1.0))
+    elif node.type == "MIX_SHADER":
+        fac_socket = node.inputs[0]  # "Fac" in Blender 4, "Factor" in 5
+        if fac_socket.is_linked:
+            problems.append("Mix Shader factor is linked (constant used)")
+        fac = min(max(float(fac_socket.default_value), 0.0), 1.0)
+        parts = ((node.inputs[1], 1.0 - fac), (node.inputs[2], fac))
+    else:
+        return [(weight, node)]
+    out: list[tuple[float, object]] = []
+    for sock, share in parts:
+        if sock.is_linked and share > 0:
+            out += _closures(sock.links[0].from_node, weight * share, problems)
+    return out
+
+
+# Closures that reflect no diffuse light and emit none: with reflective caustics off Cycles drops them
+# after a diffuse bounce, and its Diffuse Color pass leaves them out. Their glossy lobe is
+# material_glossy's.
+_GLOSSY_ONLY = ("BSDF_GLOSSY",)
+
+
 def material_values(mat, images: dict | None = None, textures: list | None = None
                     ) -> tuple[np.ndarray, np.ndarray, str | None, np.ndarray]:
     """(albedo, emission, warning or None, bounce albedo) of a material: albedo as Cycles' Diffuse Color
     pass sees it, and as another diffuse surface sees it (Scene.bounce_albedo: without the specular
-    layer, which Cycles drops after a diffuse bounce).
+    layer, which Cycles drops after a diffuse bounce). A surface of several closures (Add and Mix
+    Shader) sums them, each times its weight.
 
     With `textures` (a list), a Base Color image texture read through UVs is appended to it and the
     returned albedo is the texture's average times the rest of the factors: per-triangle albedo is
-    then albedo / average x the texture's mean over the triangle (`_material_arrays`)."""
+    then albedo / average x the texture's mean over the triangle (`_material_arrays`). Only a surface
+    of one closure gives its texture; several take their averages."""
     images = {} if images is None else images
     if mat is None:
         grey = np.full(3, NEUTRAL_ALBEDO)  # Cycles' default surface
@@ -198,56 +230,82 @@ def material_values(mat, images: dict | None = None, textures: list | None = Non
         return colour, np.zeros(3), None, colour
     node = _surface_node(mat.node_tree, "OUTPUT_MATERIAL", "Surface")
     problems: list[str] = []
-    layer_factor = 1.0  # the specular layer's attenuation of the diffuse lobe, seen from the camera only
-    if node is not None and node.type == "BSDF_PRINCIPLED":
+    parts = _closures(node, 1.0, problems) if node is not None else []
+    unsupported = [n.bl_idname for _, n in parts
+                   if n.type not in ("BSDF_PRINCIPLED", "EMISSION", "BSDF_DIFFUSE", *_GLOSSY_ONLY)]
+    if node is None or unsupported:
+        kind = "no surface" if node is None else ", ".join(unsupported)
+        grey = np.full(3, NEUTRAL_ALBEDO)
+        return grey, np.zeros(3), (
+            f"material {mat.name!r}: unsupported surface ({kind}); albedo {NEUTRAL_ALBEDO} used"), grey
+    single_textures = textures if len(parts) == 1 else None
+    albedo, bounce, emission = np.zeros(3), np.zeros(3), np.zeros(3)
+    for weight, part in parts:
+        part_albedo, part_bounce, part_emission = _closure_values(part, problems, images, single_textures)
+        albedo += weight * part_albedo
+        bounce += weight * part_bounce
+        emission += weight * part_emission
+    warn = f"material {mat.name!r}: " + "; ".join(problems) if problems else None
+    return np.clip(albedo, 0.0, 1.0), np.maximum(emission, 0.0), warn, np.clip(bounce, 0.0, 1.0)
+
+
+def _closure_values(node, problems: list[str], images: dict, textures: list | None
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(albedo, bounce albedo, emission) of one shader node of a kind material_values supports."""
+    if node.type == "BSDF_PRINCIPLED":
         base = _input_color(node, "Base Color", problems, images, textures)
         metallic = _input_float(node, "Metallic", problems)
         transmission = _input_float(node, "Transmission Weight", problems)
         level = _input_float(node, "Specular IOR Level", problems)
         ior = _input_float(node, "IOR", problems)
         rough = _input_float(node, "Roughness", problems)
-        albedo = base * (1 - metallic) * (1 - transmission)
-        layer_factor = specular_layer_factor(level, ior, rough)
+        bounce = np.clip(base * (1 - metallic) * (1 - transmission), 0.0, 1.0)
         for layer in ("Coat Weight", "Sheen Weight", "Subsurface Weight"):
             if _input_float(node, layer, problems) > 0:
                 problems.append(f"{layer} > 0 ignored")
         emission = _input_color(node, "Emission Color", problems, images) * _input_float(
             node, "Emission Strength", problems)
-    elif node is not None and node.type == "EMISSION":
-        albedo = np.zeros(3)
+        return bounce * specular_layer_factor(level, ior, rough), bounce, emission
+    if node.type == "EMISSION":
         emission = _input_color(node, "Color", problems, images) * _input_float(node, "Strength", problems)
-    elif node is not None and node.type == "BSDF_DIFFUSE":
-        albedo, emission = _input_color(node, "Color", problems, images, textures), np.zeros(3)
-    else:
-        kind = "no surface" if node is None else node.bl_idname
-        grey = np.full(3, NEUTRAL_ALBEDO)
-        return grey, np.zeros(3), (
-            f"material {mat.name!r}: unsupported surface ({kind}); albedo {NEUTRAL_ALBEDO} used"), grey
-    warn = f"material {mat.name!r}: " + "; ".join(problems) if problems else None
-    bounce = np.clip(albedo, 0.0, 1.0)
-    return bounce * layer_factor, np.maximum(emission, 0.0), warn, bounce
+        return np.zeros(3), np.zeros(3), emission
+    if node.type == "BSDF_DIFFUSE":
+        colour = np.clip(_input_color(node, "Color", problems, images, textures), 0.0, 1.0)
+        return colour, colour, np.zeros(3)
+    return np.zeros(3), np.zeros(3), np.zeros(3)  # _GLOSSY_ONLY
 
 
 def material_glossy(mat, images: dict | None = None) -> tuple[np.ndarray, float]:
     """(F0, roughness) of a material's GGX lobe (Scene.specular / roughness); (0, 1) where it has none.
 
     Principled BSDF: metals reflect their base colour; the dielectric layer ((ior - 1) / (ior + 1))^2 x
-    2 x Specular IOR Level (0.5: the IOR's own F0) x Specular Tint, over what is not metal. Other
-    surfaces (Diffuse, Emission, unsupported) carry no glossy lobe here."""
+    2 x Specular IOR Level (0.5: the IOR's own F0) x Specular Tint, over what is not metal. Glossy
+    BSDF: its colour at every angle (no Fresnel). Several closures (Add and Mix Shader): their F0s
+    summed with their weights, the roughness of the one that reflects most. Other surfaces (Diffuse,
+    Emission, unsupported) carry no glossy lobe here."""
     images = {} if images is None else images
     tree = mat.node_tree if mat is not None and compat.uses_nodes(mat) else None
     node = _surface_node(tree, "OUTPUT_MATERIAL", "Surface") if tree is not None else None
-    if node is None or node.type != "BSDF_PRINCIPLED":
-        return np.zeros(3), 1.0
     problems: list[str] = []  # material_values reports the same inputs' problems once
-    base = _input_color(node, "Base Color", problems, images)
-    metallic = min(max(_input_float(node, "Metallic", problems), 0.0), 1.0)
-    ior = max(_input_float(node, "IOR", problems), 1.0)
-    level = max(_input_float(node, "Specular IOR Level", problems), 0.0)
-    tint = _input_color(node, "Specular Tint", problems, images)
-    dielectric = min(((ior - 1.0) / (ior + 1.0)) ** 2 * 2.0 * level, 1.0) * tint
-    f0 = metallic * base + (1.0 - metallic) * dielectric
-    rough = min(max(_input_float(node, "Roughness", problems), 0.0), 1.0)
+    f0, rough, strongest = np.zeros(3), 1.0, 0.0
+    for weight, part in _closures(node, 1.0, problems) if node is not None else []:
+        if part.type == "BSDF_PRINCIPLED":
+            base = _input_color(part, "Base Color", problems, images)
+            metallic = min(max(_input_float(part, "Metallic", problems), 0.0), 1.0)
+            ior = max(_input_float(part, "IOR", problems), 1.0)
+            level = max(_input_float(part, "Specular IOR Level", problems), 0.0)
+            tint = _input_color(part, "Specular Tint", problems, images)
+            dielectric = min(((ior - 1.0) / (ior + 1.0)) ** 2 * 2.0 * level, 1.0) * tint
+            part_f0 = metallic * base + (1.0 - metallic) * dielectric
+        elif part.type in _GLOSSY_ONLY:
+            part_f0 = _input_color(part, "Color", problems, images)
+        else:
+            continue
+        part_f0 = weight * np.clip(part_f0, 0.0, 1.0)
+        f0 = f0 + part_f0
+        if part_f0.mean() > strongest:
+            strongest = float(part_f0.mean())
+            rough = min(max(_input_float(part, "Roughness", problems), 0.0), 1.0)
     return np.clip(f0, 0.0, 1.0), rough
 
 

@@ -47,14 +47,14 @@ def _principled(name, **inputs):
     return mat
 
 
-def _plane_head_on(tmp_path, inputs: dict, spp: int, pass_name: str, base_image=None):
-    """A 100 m Principled plane (`inputs`; `base_image`, if given, an Image Texture into its Base Color)
-    filling a 16 x 16 Cycles render from 10 m above: returns the capture and the render's layers, with
-    `pass_name` ("Diffuse Color" or "Glossy Color") enabled."""
+def _plane_head_on(tmp_path, inputs: dict, spp: int, pass_name: str, base_image=None, material=None):
+    """A 100 m Principled plane (`inputs`; `base_image`, if given, an Image Texture into its Base Color;
+    or `material`) filling a 16 x 16 Cycles render from 10 m above: returns the capture and the render's
+    layers, with `pass_name` ("Diffuse Color" or "Glossy Color") enabled."""
     from addon.bridge.images import read_multilayer
 
     plane = _obj("Plane", [(-50, -50, 0), (50, -50, 0), (50, 50, 0), (-50, 50, 0)], [(0, 1, 2, 3)])
-    mat = _principled("M", **inputs)
+    mat = material if material is not None else _principled("M", **inputs)
     if base_image is not None:
         tex = mat.node_tree.nodes.new("ShaderNodeTexImage")
         tex.image = base_image
@@ -259,15 +259,74 @@ def test_degenerate_triangles_dropped_with_one_warning(fresh_blend):
 
 def test_unsupported_material_neutral_albedo_and_one_warning(fresh_blend):
     plane, cube = _plane_cube()
-    mat = bpy.data.materials.new("Shiny")
+    mat = bpy.data.materials.new("Waxy")
     nt = mat.node_tree
-    gl = nt.nodes.new("ShaderNodeBsdfGlossy")
-    nt.links.new(gl.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
+    mix = nt.nodes.new("ShaderNodeMixShader")  # one unsupported closure makes the whole surface so
+    nt.links.new(nt.nodes.new("ShaderNodeBsdfTranslucent").outputs[0], mix.inputs[1])
+    nt.links.new(nt.nodes.new("ShaderNodeBsdfDiffuse").outputs[0], mix.inputs[2])
+    nt.links.new(mix.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
     plane.data.materials.append(mat)
     cube.data.materials.append(mat)  # two users: still one warning
     s = cap.capture(_dg())
     np.testing.assert_allclose(s.albedo, cap.NEUTRAL_ALBEDO)
-    assert len([w for w in s.warnings if "'Shiny'" in w]) == 1 and len(s.warnings) == 1
+    np.testing.assert_allclose(s.bounce_albedo, cap.NEUTRAL_ALBEDO)
+    warnings = [w for w in s.warnings if "'Waxy'" in w]
+    assert len(warnings) == 1 and len(s.warnings) == 1 and "ShaderNodeBsdfTranslucent" in warnings[0]
+
+
+def _mixed(name: str, mix_factor: float | None):
+    """A Diffuse BSDF (0.6, 0.3, 0.1) with a Glossy BSDF (0.2, 0.4, 0.6, roughness 0.3) added
+    (mix_factor None) or, through a Mix Shader of that factor, a Principled BSDF (0.2, 0.5, 0.8,
+    Specular IOR Level 1, roughness 0.5) through a reroute."""
+    mat = bpy.data.materials.new(name)
+    nt = mat.node_tree
+    nt.nodes.remove(nt.nodes["Principled BSDF"])
+    diffuse = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = (0.6, 0.3, 0.1, 1)
+    if mix_factor is None:
+        other = nt.nodes.new("ShaderNodeBsdfGlossy")
+        other.inputs["Color"].default_value = (0.2, 0.4, 0.6, 1)
+        other.inputs["Roughness"].default_value = 0.3
+        join = nt.nodes.new("ShaderNodeAddShader")
+        nt.links.new(diffuse.outputs[0], join.inputs[0])
+        nt.links.new(other.outputs[0], join.inputs[1])
+    else:
+        other = nt.nodes.new("ShaderNodeBsdfPrincipled")
+        other.inputs["Base Color"].default_value = (0.2, 0.5, 0.8, 1)
+        other.inputs["Specular IOR Level"].default_value = 1.0
+        other.inputs["Roughness"].default_value = 0.5
+        reroute = nt.nodes.new("NodeReroute")
+        nt.links.new(other.outputs[0], reroute.inputs[0])
+        join = nt.nodes.new("ShaderNodeMixShader")
+        join.inputs[0].default_value = mix_factor
+        nt.links.new(diffuse.outputs[0], join.inputs[1])
+        nt.links.new(reroute.outputs[0], join.inputs[2])
+    nt.links.new(join.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
+    return mat
+
+
+@pytest.mark.parametrize("mix_factor", [None, 0.25])
+def test_added_and_mixed_closures_match_cycles_diffuse_color(fresh_blend, tmp_path, mix_factor):
+    """Add Shader and Mix Shader sum their closures' weights: the captured albedo equals Cycles' Diffuse
+    Color pass (tolerance as in test_albedo_matches_cycles_diffuse_color). Exact values: Add (Diffuse,
+    Glossy): the diffuse colour (a Glossy BSDF has no diffuse part), F0 the glossy colour; Mix 0.25:
+    0.75 x diffuse + 0.25 x the Principled's base x 0.9254 (its layer, measured head-on), and toward
+    other surfaces 0.75 x diffuse + 0.25 x base (no layer after a diffuse bounce)."""
+    s, layers = _plane_head_on(tmp_path, {}, spp=1, pass_name="Diffuse Color",
+                               material=_mixed("Mixed", mix_factor))
+    diff_col = layers["Diffuse Color"][:, :, :3]
+    np.testing.assert_allclose(diff_col, np.broadcast_to(s.albedo[0], diff_col.shape), atol=2e-3)
+    diffuse, base = np.array([0.6, 0.3, 0.1]), np.array([0.2, 0.5, 0.8])
+    if mix_factor is None:
+        np.testing.assert_allclose(s.albedo[0], diffuse, atol=1e-6)
+        np.testing.assert_allclose(s.bounce_albedo[0], diffuse, atol=1e-6)
+        np.testing.assert_allclose(s.specular[0], [0.2, 0.4, 0.6], atol=1e-6)
+        assert s.roughness[0] == pytest.approx(0.3)
+    else:
+        np.testing.assert_allclose(s.albedo[0], 0.75 * diffuse + 0.25 * base * 0.9254, atol=1e-3)
+        np.testing.assert_allclose(s.bounce_albedo[0], 0.75 * diffuse + 0.25 * base, atol=1e-6)
+        np.testing.assert_allclose(s.specular[0], 0.25 * 0.08, atol=1e-6)  # F0 0.04 x 2 x level 1
+    assert s.warnings == []
 
 
 def test_image_texture_average_and_world(fresh_blend):
