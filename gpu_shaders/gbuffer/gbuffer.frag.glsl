@@ -1,13 +1,13 @@
 #include "common/face_plane.glsl"
 
-// Cycles shades both sides of a surface and flips the normal towards the viewer at a back face;
-// do the same so back faces seen by the camera receive light like Cycles' Diffuse passes.
+// Cycles shades both sides of a surface and, at a back face, flips the normal towards the viewer; do
+// the same so back faces seen by the camera receive light like Cycles' Diffuse passes. Which side is
+// seen is the triangle's own (face_side): a smooth normal may lean away from the camera on a face that
+// faces it (a long wall triangle whose corners' normals lean into the walls beside it), and Cycles
+// keeps it so.
 void main() {
     vec3 p = on_face_plane(v_pos_ws, v_plane_ws);
-    vec3 n = normalize(v_normal_ws);
-    if (dot(n, camera_pos_ws - p) < 0.0) {
-        n = -n;
-    }
+    vec3 n = normalize(v_normal_ws) * face_side(v_plane_ws, normalize(v_normal_ws), camera_pos_ws - p);
     out_position = vec4(p, 1.0);  // w = 1 marks geometry (coverage)
     out_normal = vec4(n, 0.0);
     out_albedo = vec4(v_albedo, 1.0);

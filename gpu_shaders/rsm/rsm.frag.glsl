@@ -6,6 +6,7 @@
 // The flux's w names the triangle the texel sees, its index in the drawn mesh + 1 (0: none): the direct
 // pass's exact shadow test (direct/shade.comp.glsl) intersects the shadow ray with it. A float holds every
 // index below 2^24 exactly.
+#include "common/face_plane.glsl"
 #include "common/light.glsl"
 
 void main() {
@@ -14,22 +15,21 @@ void main() {
     float area_m2;
     // Grazing surfels have huge footprints; 0.05 caps them at 20x the texel's cross-section.
     const float MIN_COS = 0.05;
+    // The normal faces the light on the side of the triangle the light sees (face_side: as Cycles
+    // decides a back face, by the triangle's own normal). The footprint is the triangle's plane's.
+    vec3 facing = dot(v_plane_ws.xyz, v_plane_ws.xyz) > 0.0 ? v_plane_ws.xyz : n;
     if (light_kind == LIGHT_SUN) {
-        if (dot(n, emit_axis) > 0.0) {
-            n = -n;
-        }
+        n *= face_side(v_plane_ws, n, -emit_axis);
         flux = v_albedo * light_color_intensity * texel_scale;
-        area_m2 = texel_scale / max(-dot(n, emit_axis), MIN_COS);
+        area_m2 = texel_scale / max(abs(dot(facing, emit_axis)), MIN_COS);
     } else {
         vec3 w = normalize(v_pos_ws - light_pos_ws);
-        if (dot(n, w) > 0.0) {
-            n = -n;
-        }
+        n *= face_side(v_plane_ws, n, -w);
         float cos_face = max(dot(w, face_axis), 1e-6);
         float solid_angle = texel_scale * cos_face * cos_face * cos_face;
         flux = v_albedo * light_intensity(light_kind, w, emit_axis, light_color_intensity, spot_cos_half, spot_blend) * solid_angle;
         float dist = length(v_pos_ws - light_pos_ws);
-        area_m2 = solid_angle * dist * dist / max(-dot(n, w), MIN_COS);
+        area_m2 = solid_angle * dist * dist / max(abs(dot(facing, w)), MIN_COS);
         if (occluder_radius > 0.0) {
             // The emitter's own surface, a disc of that radius at the light facing emit_axis, takes the
             // share of the surfel's reflected light that goes back at it: its view factor from the

@@ -2,6 +2,7 @@
 void main() {
     gl_Position = light_view_projection * vec4(pos_ws, 1.0);
     v_pos_ws = pos_ws;
+    v_plane_ws = plane_ws;
     v_normal_ws = normal_ws;
     v_albedo = bounce_albedo;  // what it reflects toward other surfaces (Scene.bounce_albedo)
 }

@@ -398,3 +398,36 @@ def test_a_glowing_surface_does_not_light_itself(gl):
         p = floor_point_at_pixel(cam, row, col)
         want = radiance * polygon_irradiance(p, np.array([0.0, 0.0, 1.0]), np.array(corners)) / np.pi
         assert img[row, col] == pytest.approx(want, rel=1e-4)
+
+
+@pytest.mark.parametrize("winding", ["facing", "reversed"])
+def test_the_triangles_side_decides_the_normals_flip_as_in_cycles(gl, winding):
+    """Cycles decides a back face by the triangle's own normal and flips the shading normal with it, so
+    a smooth normal that leans away from the viewer on a face that faces it stays as it is (a long wall
+    triangle whose corners' normals lean into the walls beside it: the conference room's top strip read
+    no light when the lean decided). A floor seen from above and lit by a sun from above, its corner
+    normals all n = (-1, 0, 0.05) / |.|: n faces away from the camera and the sun at every pixel, while
+    the triangle faces both. Exact: the G-buffer's and the RSM's normals are n, also where the triangle
+    is wound downwards with corner normals -n (its back is seen: flipped to n)."""
+    lean = np.array([-1.0, 0.0, 0.05]) / np.linalg.norm([-1.0, 0.0, 0.05])
+    tris = np.array(quad(-1, 1, -1, 1, 0.0), np.float32)
+    corner_normal = lean
+    if winding == "reversed":  # wound downwards, its corner normals -lean on that side
+        tris = tris[:, ::-1].copy()
+        corner_normal = -lean
+    normals = np.broadcast_to(corner_normal, tris.shape).astype(np.float32)
+    expected = lean
+    cam = Camera(look_along([0, 0, 5], [0, 0, -1], [0, 1, 0]), perspective(np.radians(30), 0.1, 100), SIZE, SIZE)
+    scene = Scene(tris, normals, np.full((2, 3), 0.8, np.float32), np.zeros((2, 3), np.float32),
+                  [Light("SUN", [0, 0, 0], [0, 0, -1], [1, 1, 1], sun_strength=2.0)], camera=cam)
+    method = DirectMethod(gl, GIConfig(), RsmConfig(resolution=64))
+    method.set_scene(scene)
+    method.run()
+    gbuffer = gl.read(method.gbuf["position"])[..., 3] > 0
+    seen_normals = gl.read(method.gbuf["normal"])[..., :3][gbuffer]
+    assert gbuffer.sum() > SIZE * SIZE // 4
+    np.testing.assert_allclose(seen_normals, np.broadcast_to(expected, seen_normals.shape), atol=1e-5)
+    rsm = gl.read(method.rsm["position"])[..., 3] > 0
+    rsm_normals = gl.read(method.rsm["normal"])[..., :3][rsm]
+    assert rsm.sum() > 0
+    np.testing.assert_allclose(rsm_normals, np.broadcast_to(expected, rsm_normals.shape), atol=1e-5)

@@ -82,12 +82,19 @@ class Result:
     timings_ms: dict[str, float] = field(default_factory=dict)
 
 
-def face_planes(positions_m: np.ndarray) -> np.ndarray:
+def face_planes(positions_m: np.ndarray, corner_normals: np.ndarray | None = None) -> np.ndarray:
     """(T, 4) float32: each triangle's unit normal and offset d (m; the plane n . x = d) of its fp32
     vertices, in float64; zeros for a degenerate triangle. The raster passes put their interpolated
-    positions back on this plane (gbuffer.frag.glsl)."""
+    positions back on this plane (gbuffer.frag.glsl) and tell by its normal which side of the triangle
+    they see (face_plane.glsl, face_side), as Cycles tells a back face. The normal points to the side
+    of the winding or, given `corner_normals` (T, 3, 3), to the side those point to on average: the same
+    side for a Blender mesh, whose corner normals follow its winding, and for a scene built with normals
+    against its winding, the side its normals name."""
     p = np.asarray(positions_m, np.float32).astype(np.float64)
     normal = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    if corner_normals is not None:
+        against = np.einsum("ij,ij->i", normal, np.asarray(corner_normals, np.float64).sum(axis=1)) < 0
+        normal[against] *= -1.0
     length = np.linalg.norm(normal, axis=1, keepdims=True)
     normal = np.divide(normal, length, out=np.zeros_like(normal), where=length > 0)
     return np.c_[normal, np.einsum("ij,ij->i", normal, p.mean(axis=1))].astype(np.float32)
@@ -105,7 +112,7 @@ def triangle_attributes(scene: Scene, spec: ShaderSpec,
         return None
     build = {
         "pos_ws": lambda: scene.positions_m[sel].reshape(n * 3, 3).astype(np.float32),
-        "plane_ws": lambda: np.repeat(face_planes(scene.positions_m[sel]), 3, axis=0),
+        "plane_ws": lambda: np.repeat(face_planes(scene.positions_m[sel], scene.normals[sel]), 3, axis=0),
         "normal_ws": lambda: scene.normals[sel].reshape(n * 3, 3).astype(np.float32),
         "albedo": lambda: np.repeat(scene.albedo[sel].astype(np.float32), 3, axis=0),
         "bounce_albedo": lambda: np.repeat(scene.bounce_reflectance()[sel], 3, axis=0),

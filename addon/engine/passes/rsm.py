@@ -1,12 +1,13 @@
 """Reflective shadow map pass (Dachsbacher & Stamminger 2005): the scene seen from one light face.
 
-Inputs: scene triangles (pos_ws, normal_ws, albedo), a LightView (light_views.py). Outputs (RGBA32F,
-resolution^2, GL row 0 = bottom): position (world, m; w = 1 where geometry), normal (world, facing the
-light), flux (W reflected by the texel's surfel: albedo x I(w) x texel solid angle, or albedo x sun
-irradiance x texel area). The flux sums to the light's reflected power (tested against the analytic
-cone integral). With Light.occluder_radius_m (an emissive mesh's lamp: the emitter's own surface) the
-flux is reduced by the view factor from the surfel to that disc, light_views.disc_view_factor: what the
-surfel sends back at the emitter stops there.
+Inputs: scene triangles (pos_ws, plane_ws (methods/direct.face_planes: which side the light sees),
+normal_ws, bounce_albedo), a LightView (light_views.py). Outputs (RGBA32F, resolution^2, GL row 0 =
+bottom): position (world, m; w = 1 where geometry), normal (world, flipped where the light sees its
+triangle's back), flux (W reflected by the texel's surfel: albedo x I(w) x texel solid angle, or
+albedo x sun irradiance x texel area). The flux sums to the light's reflected power (tested against
+the analytic cone integral). With Light.occluder_radius_m (an emissive mesh's lamp: the emitter's own
+surface) the flux is reduced by the view factor from the surfel to that disc,
+light_views.disc_view_factor: what the surfel sends back at the emitter stops there.
 """
 
 from __future__ import annotations
@@ -29,8 +30,10 @@ SPEC = ShaderSpec(
         Var("light_color_intensity", "vec3"), Var("spot_blend", "float"),
         Var("occluder_radius", "float"), Var("area_weight", "float"),
     ),
-    attributes=(Var("pos_ws", "vec3"), Var("normal_ws", "vec3"), Var("bounce_albedo", "vec3")),
-    varyings=(Var("v_pos_ws", "vec3"), Var("v_normal_ws", "vec3"), Var("v_albedo", "vec3")),
+    attributes=(Var("pos_ws", "vec3"), Var("plane_ws", "vec4"), Var("normal_ws", "vec3"),
+                Var("bounce_albedo", "vec3")),
+    varyings=(Var("v_pos_ws", "vec3"), Var("v_plane_ws", "vec4", "flat"), Var("v_normal_ws", "vec3"),
+              Var("v_albedo", "vec3")),
     outputs=(Var("out_position", "vec4"), Var("out_normal", "vec4"), Var("out_flux", "vec4")),
 )
 
