@@ -314,16 +314,20 @@ def choose(model: Model, features: dict, error_budget: float | None = None,
 # is unlike the benchmark's (the only sun scene, the only thin wall), while the run-time estimate (a
 # row's image against its check row's, `check_row`) is within a factor 1.5 of the measured error for
 # nine rows in ten (benchmarks/choice/REPORT.md). So the candidates are the rows predicted within
-# VERIFY_LOOSEN budgets (x margin), fastest first, and the first whose estimate is within the budget is
-# taken; at most VERIFY_MAX_TRIES are rendered. Swept on the benchmark's 15 held-out scenes (loosening 1,
-# 1.5, 2, 3 x at most 4, 6, 8, 10 tries; tools/fit_choice.py's judgement, chosen on those same scenes,
-# so its figures flatter it a little): at 1.5 and 4 the budget was met on 9 / 12 / 14 scenes at
-# E = 0.1 / 0.2 / 0.3, the choice was within 2x of the fastest row meeting it on 5 / 8 / 13 and its
-# estimate within a factor 1.5 of the measured error on 9 / 10 / 13, after 1.9-3.1 rows rendered on
-# average; at 2 and 6 7 / 11 / 13, 5 / 7 / 13 and 9 / 10 / 12 after 3.4-3.8. 1 meets most (10 / 12 /
-# 14) but seldom leaves the model's choice (within 2x 2 / 7 / 11); 3 renders more rows for no more met.
-VERIFY_LOOSEN = 1.5
+# VERIFY_LOOSEN budgets (x margin), fastest first, and the first whose estimate is within VERIFY_ACCEPT
+# budgets is taken; at most VERIFY_MAX_TRIES are rendered. Swept on the benchmark's 15 held-out scenes
+# (`tools/fit_choice.py RESULTS --cache C --sweep-verify`; chosen on those same scenes, so its figures
+# flatter it a little; the model's margin at tools/fit_choice.py's MARGIN_QUANTILE). Met / within 2x of
+# the fastest row meeting it / estimate within a factor 1.5 of the measured error, at E = 0.1, 0.2, 0.3:
+# - loosening 1, at most 4: 12 / 6 / 10, 12 / 9 / 10, 14 / 13 / 13, after 1.6-2.1 rows on average;
+# - loosening 1.5, at most 4: 8 / 5 / 10, 11 / 9 / 10, 14 / 13 / 14, after 2.4-3.1 rows;
+# - loosening 2, at most 6: 9 / 8 / 11, 11 / 9 / 11, 13 / 13 / 13, after 3.1-4.1 rows.
+# 1 is the only one that meets the budget on 80 % of the scenes at every E (the first target),
+# at the price of speed at E = 0.1 where the model overestimates the faster rows. Taking a candidate
+# only below 0.9 or 0.8 budgets met no more scenes at any loosening and lost speed.
+VERIFY_LOOSEN = 1.0
 VERIFY_MAX_TRIES = 4
+VERIFY_ACCEPT = 1.0
 
 
 def verify(model: Model, features: dict, error_budget: float, difference,
@@ -343,7 +347,7 @@ def verify(model: Model, features: dict, error_budget: float, difference,
         if estimate is None:
             continue
         tried.append({"row": key, "estimated_rel_rmse_8": float(estimate)})
-        if estimate <= error_budget:
+        if estimate <= VERIFY_ACCEPT * error_budget:
             return key, tried
     return None, tried
 

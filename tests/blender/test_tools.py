@@ -71,6 +71,15 @@ def test_fit_choice_fits_judges_and_writes(tmp_path):
 
     fitted = choice.Model.from_json(json.loads(model.read_text()))
     assert set(fitted.rows) == {"rsm vpl_samples=256", "lpv grid_cells=16"}
+    # The sweep of --verify's constants: a row per combination, the same figures as the summary's at every
+    # one (nothing is rendered, so every one falls back to the model's choice), and nothing written.
+    model.unlink()
+    table = tool("tools/fit_choice.py", str(results), "--cache", str(cache), "--out", str(out), "--model",
+                 str(model), "--sweep-verify").strip().splitlines()
+    combos = [line for line in table if line.startswith("| ") and line[2].isdigit()]
+    assert len(combos) == 3 * 2 * 3  # fit_choice.SWEEP: loosenings x try counts x acceptances
+    assert all(line.split(" | ")[-2] == "3 / 3 / 0.0 / 3" for line in combos)  # E = 0.2
+    assert not model.exists()
 
 
 def test_diffusion_box_prints_both_transfers():
