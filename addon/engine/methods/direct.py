@@ -100,19 +100,21 @@ def face_planes(positions_m: np.ndarray, corner_normals: np.ndarray | None = Non
     return np.c_[normal, np.einsum("ij,ij->i", normal, p.mean(axis=1))].astype(np.float32)
 
 
-def triangle_attributes(scene: Scene, spec: ShaderSpec,
-                        select: np.ndarray | None = None) -> dict[str, np.ndarray] | None:
+def triangle_attributes(scene: Scene, spec: ShaderSpec, select: np.ndarray | None = None,
+                        planes: np.ndarray | None = None) -> dict[str, np.ndarray] | None:
     """Per-vertex arrays for raster pass `spec`, the attributes it declares only: three vertices per
     triangle, flat albedo (the camera's; bounce_albedo: toward other surfaces) and glossy lobe
-    (specular: F0, roughness), the triangle's plane (face_planes: 110 ms for 279 k triangles, so only
-    for the passes that read it); `select` picks triangles (None: all). None when nothing is left."""
+    (specular: F0, roughness), the triangle's plane (`planes`: face_planes of all of `scene`'s
+    triangles, made once per geometry change as they take 70-100 ms for 279 k; None: made here for the
+    selection); `select` picks triangles (None: all). None when nothing is left."""
     sel = np.ones(scene.triangle_count, bool) if select is None else select
     n = int(sel.sum())
     if n == 0:
         return None
     build = {
         "pos_ws": lambda: scene.positions_m[sel].reshape(n * 3, 3).astype(np.float32),
-        "plane_ws": lambda: np.repeat(face_planes(scene.positions_m[sel], scene.normals[sel]), 3, axis=0),
+        "plane_ws": lambda: np.repeat(face_planes(scene.positions_m[sel], scene.normals[sel])
+                                      if planes is None else planes[sel], 3, axis=0),
         "normal_ws": lambda: scene.normals[sel].reshape(n * 3, 3).astype(np.float32),
         "albedo": lambda: np.repeat(scene.albedo[sel].astype(np.float32), 3, axis=0),
         "bounce_albedo": lambda: np.repeat(scene.bounce_reflectance()[sel], 3, axis=0),
@@ -175,9 +177,11 @@ class DirectMethod:
         not_emitting = ~np.any(self.scene.emission > 0, axis=1)
         selections = {gbuffer.SPEC: self.scene.seen_by_camera(), rsm.SPEC: not_emitting,
                       sky_light.SHADOW_SPEC: not_emitting}
+        # Every triangle's plane, once: the G-buffer's, the RSMs' and the probes' capture read it.
+        self.planes = face_planes(self.scene.positions_m, self.scene.normals)
         self._meshes = {}
         for spec, select in selections.items():
-            attrs = triangle_attributes(self.scene, spec, select)
+            attrs = triangle_attributes(self.scene, spec, select, self.planes)
             self._meshes[spec.name] = be.mesh(be.program(spec), attrs, "triangles") if attrs is not None else None
         # The RSM's triangles by the index its texels name (rsm.frag.glsl): the direct pass's exact shadows.
         table = rsm.occluder_table(self.scene.positions_m[not_emitting])

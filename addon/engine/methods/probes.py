@@ -70,7 +70,7 @@ class ProbesMethod(OneBounceMethod):
         self.offset = probe_relocate.allocate(be, grid)
         far = probe_capture.far_m(self.bounds_m)
         # every triangle: emitters and camera-hidden objects block
-        attrs = triangle_attributes(self.scene, probe_capture.SPEC)
+        attrs = triangle_attributes(self.scene, probe_capture.SPEC, planes=self.planes)
         mesh = be.mesh(be.program(probe_capture.SPEC), attrs, "triangles") if attrs is not None else None
         tri = self.scene.positions_m
         needed = grid.read_by(tri.min(axis=1), tri.max(axis=1), cfg.normal_bias * grid.spacing_m) \
