@@ -531,13 +531,14 @@ def scene_references(blend: Path, key: str, spp: int, opt: Options, products) ->
 
 
 def _compare(test_exr: Path, ref_exr: Path) -> dict:
-    """Errors over the reference's geometry, less its black-albedo pixels (reference.reference_mask)."""
+    """Errors over the reference's geometry, less the pixels black in either image's albedo
+    (reference.reference_mask)."""
     from ..engine.metrics import compare
     from . import images
     from .reference import reference_mask
 
     a, b = images.read_exr(test_exr), images.read_exr(ref_exr)
-    return compare(a[:, :, :3], b[:, :, :3], reference_mask(ref_exr, b))
+    return compare(a[:, :, :3], b[:, :, :3], reference_mask(ref_exr, b, test_exr))
 
 
 def _compare_full(run_dir: Path, ref_dir: Path) -> dict | None:

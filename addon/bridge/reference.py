@@ -210,19 +210,27 @@ def render_reference(blend_path, out_dir, spp: int = 1024, bounces: int = 1, res
     return stats
 
 
-def reference_mask(ref_exr, ref_pixels: np.ndarray) -> np.ndarray | None:
+def reference_mask(ref_exr, ref_pixels: np.ndarray, test_exr=None) -> np.ndarray | None:
     """The pixels a reference's light is judged on: its geometry (alpha > 0.5), less the pixels whose
-    Diffuse Color (the albedo.exr beside it, where there is one) is black: Cycles' Diffuse passes are
-    divided by that colour and 0 there (an emitter's black panel), while Bounce's light products do not
-    depend on it. None for a reference without alpha (every pixel counts)."""
+    Diffuse Color is black in the reference (the albedo.exr beside `ref_exr`) or in the image under test
+    (the albedo.exr beside `test_exr`, where given). Cycles' Diffuse passes are divided by that colour,
+    and a surface without one (an emitter's black panel) has no diffuse light to compare: Cycles writes 0
+    there, while Bounce's light products do not depend on it. The test's side matters on an emitter's
+    silhouette: Cycles lands a stray sample or two of a pixel beside its centre (docs/DIRECT.md, the
+    emissive scene), so a pixel Bounce sees as the black panel can read in Cycles the light of the
+    ceiling 2 cm behind it, from 1/spp of its samples. None for a reference without alpha (every pixel
+    counts)."""
     if ref_pixels.shape[2] < 4:
         return None
     mask = ref_pixels[:, :, 3] > 0.5
-    albedo = Path(ref_exr).with_name("albedo.exr")
-    if albedo.name != Path(ref_exr).name and albedo.is_file():
-        albedo_pixels = images.read_exr(albedo)
-        if albedo_pixels.shape[:2] == mask.shape:
-            mask &= albedo_pixels[:, :, :3].max(axis=2) > 0
+    for light in (ref_exr, test_exr):
+        if light is None:
+            continue
+        albedo = Path(light).with_name("albedo.exr")
+        if albedo.name != Path(light).name and albedo.is_file():
+            albedo_pixels = images.read_exr(albedo)
+            if albedo_pixels.shape[:2] == mask.shape:
+                mask &= albedo_pixels[:, :, :3].max(axis=2) > 0
     return mask
 
 

@@ -1,8 +1,8 @@
 """`python -m addon compare A.exr B.exr`: errors of A against the reference B, as one JSON object.
 
 If B has an alpha channel it is the reference's geometry mask (alpha > 0.5 counts, as written by
-`reference`), less the pixels whose albedo.exr beside B is black (an emitter's panel, where Cycles'
-Diffuse passes are 0): the pixels `bench` judges (reference.reference_mask). A plain RGB reference
+`reference`), less the pixels whose albedo.exr beside B or beside A is black (an emitter's panel, where
+Cycles' Diffuse passes are 0): the pixels `bench` judges (reference.reference_mask). A plain RGB reference
 counts every pixel. Images of different sizes: exit 2. HDR-FLIP is
 added when the flip-evaluator package is installed (requirements.txt pins it), else reported as null.
 Only linear float images are compared (OpenEXR, Radiance HDR): a PNG, JPEG or TIFF holds display-encoded
@@ -60,7 +60,7 @@ def compare_files(test_path, reference_path) -> dict:
                           f"{reference_path} is {b.shape[1]}x{b.shape[0]}")
     if a.shape[2] < 3 or b.shape[2] < 3:
         raise ConfigError("compare needs RGB or RGBA images")
-    mask = reference_mask(reference_path, b)
+    mask = reference_mask(reference_path, b, test_path)
     masked = mask is not None
     try:
         flip = hdr_flip(a[:, :, :3], b[:, :, :3], mask)
