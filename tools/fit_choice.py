@@ -130,6 +130,7 @@ def agreement(records: list[dict], features: dict, cache: Path, ridge: float, re
     be most accurate, B; and the estimates built from it: `agree` = that difference, `blend` = the
     geometric mean of it and the model's prediction. Each beside the measured error."""
     from addon.bridge import images
+    from addon.bridge.reference import reference_mask
     from addon.engine.metrics import rel_rmse_8
 
     out = []
@@ -142,10 +143,7 @@ def agreement(records: list[dict], features: dict, cache: Path, ridge: float, re
         if not rows or not refs:
             continue
         ref = images.read_exr(refs[-1] / "indirect.exr")
-        mask = ref[..., 3] > 0.5
-        albedo = refs[-1] / "albedo.exr"
-        if albedo.is_file():
-            mask &= images.read_exr(albedo)[..., :3].max(axis=2) > 0
+        mask = reference_mask(refs[-1] / "indirect.exr", ref)  # the pixels bench judged the rows on
         pred = {choice.row_key(r["method"], r["setting"]): model.predict(choice.row_key(r["method"], r["setting"]),
                                                                           features[held])[0] for r in rows}
         for r in rows:

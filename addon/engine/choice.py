@@ -332,7 +332,7 @@ VERIFY_ACCEPT = 1.0
 
 def verify(model: Model, features: dict, error_budget: float, difference,
            methods: tuple[str, ...] | None = None) -> tuple[str | None, list[dict]]:
-    """(the first candidate row whose run-time estimate is within `error_budget`, or None; every
+    """(the first candidate row whose run-time estimate is within VERIFY_ACCEPT x `error_budget`, or None; every
     candidate tried with its estimate). `difference(key)` gives a row's estimate (its image's rel_rmse_8
     against its check row's), or None where it has none (the row is then skipped, not counted)."""
     preds = [(k, *model.predict(k, features)) for k, row in model.rows.items()
