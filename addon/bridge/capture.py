@@ -23,11 +23,12 @@ What is captured, and why:
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import bpy
 import numpy as np
 
-from ..engine.scene import AREA_SHAPES, Camera, Light, Scene
+from ..engine.scene import AREA_SHAPES, AlbedoTextures, Camera, Light, Scene
 from ..engine.world import directions as world_directions
 from . import compat, world_capture
 
@@ -105,11 +106,11 @@ def image_unreadable(image) -> bool:
 
 
 def _image_texels(image) -> np.ndarray:
-    """Linear RGB texels (h, w, 3), row 0 = the image's bottom (Blender's order, v = 0); one magenta texel
-    for an image Blender cannot load (MISSING_IMAGE_RGB). A loaded image has 4 channels, grey files too
-    (checked on bpy 5.0 with one-channel EXR and PNG files)."""
+    """Linear RGB texels (h, w, 3) float32 (as the G-buffer samples them), row 0 = the image's bottom
+    (Blender's order, v = 0); one magenta texel for an image Blender cannot load (MISSING_IMAGE_RGB). A
+    loaded image has 4 channels, grey files too (checked on bpy 5.0 with one-channel EXR and PNG files)."""
     if image_unreadable(image):
-        return np.array([[MISSING_IMAGE_RGB]], np.float64)
+        return np.array([[MISSING_IMAGE_RGB]], np.float32)
     w, h = image.size
     px = np.empty(w * h * image.channels, np.float32)
     image.pixels.foreach_get(px)
@@ -117,7 +118,7 @@ def _image_texels(image) -> np.ndarray:
     # Image.pixels of a byte image holds the file's encoded values; float buffers are already linear.
     if not image.is_float and image.colorspace_settings.name.lower().startswith("srgb"):
         rgb = _srgb_to_linear(rgb)
-    return rgb
+    return rgb.astype(np.float32)
 
 
 # Dunavant's 6-point rule on the triangle (exact for polynomials of degree 4). Every point is inside,
@@ -137,12 +138,22 @@ def triangle_texture_average(texels: np.ndarray, uv: np.ndarray) -> np.ndarray:
     return np.einsum("nkc,k->nc", texels[y, x], _TRI_WEIGHTS)
 
 
+class UVTexture(NamedTuple):
+    """An Image Texture read through the object's UV map: its image's name and texels (_image_texels),
+    and how Cycles samples it (Closest interpolation; Extend rather than Repeat)."""
+
+    name: str
+    texels: np.ndarray
+    nearest: bool
+    clamp: bool
+
+
 def _input_color(node, name: str, problems: list[str], images: dict, textures: list | None = None) -> np.ndarray:
     """A colour input's value: its constant, an RGB node, or an Image Texture's average colour.
 
-    `textures`, when given, receives the texels of an Image Texture read through the object's UV map
-    (its Vector input unlinked): the caller then averages it per triangle and uses the returned mean
-    only where a mesh has no UVs."""
+    `textures`, when given, receives a UVTexture for an Image Texture read through the object's UV map
+    (its Vector input unlinked): the caller then averages it per triangle (and the camera samples it
+    per pixel) and uses the returned mean only where a mesh has no UVs."""
     sock = node.inputs[name]
     if not sock.is_linked:
         return np.array(sock.default_value[:3], np.float64)
@@ -157,8 +168,8 @@ def _input_color(node, name: str, problems: list[str], images: dict, textures: l
             problems.append(f"{name} <- image {key!r} ({src.image.filepath or 'no file'}) could not be "
                             f"loaded: magenta, as Cycles renders it")
         if textures is not None and src.type == "TEX_IMAGE" and not src.inputs["Vector"].is_linked:
-            textures.append(images[key])
-        return images[key].reshape(-1, 3).mean(axis=0)
+            textures.append(UVTexture(key, images[key], src.interpolation == "Closest", src.extension == "EXTEND"))
+        return images[key].reshape(-1, 3).mean(axis=0, dtype=np.float64)
     problems.append(f"{name} <- {src.bl_idname} (constant used)")
     return np.array(sock.default_value[:3], np.float64)
 
@@ -217,9 +228,10 @@ def material_values(mat, images: dict | None = None, textures: list | None = Non
     layer, which Cycles drops after a diffuse bounce). A surface of several closures (Add and Mix
     Shader) sums them, each times its weight.
 
-    With `textures` (a list), a Base Color image texture read through UVs is appended to it and the
-    returned albedo is the texture's average times the rest of the factors: per-triangle albedo is
-    then albedo / average x the texture's mean over the triangle (`_material_arrays`). Only a surface
+    With `textures` (a list), a Base Color image texture read through UVs is appended to it (a
+    UVTexture) and the returned albedo is the texture's average times the rest of the factors:
+    per-triangle albedo is then albedo / average x the texture's mean over the triangle, and the
+    camera's albedo at a pixel albedo / average x the texel there (`_material_arrays`). Only a surface
     of one closure gives its texture; several take their averages."""
     images = {} if images is None else images
     if mat is None:
@@ -536,6 +548,7 @@ class SceneCache:
         mats: dict[str, tuple] = {}
         glossy: dict[str, tuple] = {}
         parts: list[tuple] = []
+        uv_textures: dict[str, tuple[int, UVTexture]] = {}
         for inst in depsgraph.object_instances:
             obj = inst.object
             if inst.is_instance:
@@ -574,8 +587,8 @@ class SceneCache:
             # light, as in Cycles: the G-buffer leaves these triangles out, the RSMs keep them.
             seen_by_camera = obj.original.visible_camera and (
                 not inst.is_instance or inst.parent.original.visible_camera)
-            parts.append((*self._material_arrays(block, slots, mats), *self._glossy_arrays(block, slots, glossy),
-                          seen_by_camera))
+            material = self._material_arrays(block, slots, mats, uv_textures)
+            parts.append((*material[:5], *self._glossy_arrays(block, slots, glossy), seen_by_camera, *material[5:]))
         self.blocks = seen
         out.lights = lights
         dropped = sum(b.world[3] for b in seen.values())
@@ -600,12 +613,22 @@ class SceneCache:
             out.specular = np.concatenate([p[5] for p in parts]).astype(np.float32)
             out.roughness = np.concatenate([p[6] for p in parts]).astype(np.float32)
             out.camera_visible = np.concatenate([np.full(len(p[0]), p[7], bool) for p in parts])
+            if uv_textures:
+                ordered = [t for _, t in sorted(uv_textures.values(), key=lambda e: e[0])]
+                out.albedo_textures = AlbedoTextures(
+                    images=[t.texels for t in ordered], nearest=[t.nearest for t in ordered],
+                    clamp=[t.clamp for t in ordered], index=np.concatenate([p[8] for p in parts]),
+                    uv=np.concatenate([p[9] for p in parts]), scale=np.concatenate([p[10] for p in parts]),
+                    bounce_scale=np.concatenate([p[11] for p in parts]))
         self.scene = out
         return out
 
-    def _material_arrays(self, block: _Block, slots: list, mats: dict) -> tuple:
+    def _material_arrays(self, block: _Block, slots: list, mats: dict, uv_textures: dict) -> tuple:
         """A block's world triangles with per-triangle albedo/emission looked up from its material slots;
-        an image-textured Base Color is averaged over each triangle's UVs."""
+        an image-textured Base Color is averaged over each triangle's UVs. Also, for the albedo read
+        per pixel (AlbedoTextures' fields): each triangle's texture (-1: none; an index into
+        `uv_textures`, {image name: (index, UVTexture)}, which gains the block's new ones), corner UVs
+        and the factors its texels are multiplied by (the camera's, the bounce's)."""
         pos, nrm, keep, _ = block.world
         table_a, table_e, table_b, table_tex = [], [], [], []
         for mat in slots or [None]:
@@ -613,26 +636,32 @@ class SceneCache:
             if key not in mats:
                 textures: list = []
                 mats[key] = (*material_values(mat, self.images, textures), textures[0] if textures else None)
-            albedo_m, emission_m, _, bounce_m, texels_m = mats[key]
+            albedo_m, emission_m, _, bounce_m, texture_m = mats[key]
             table_a.append(albedo_m)
             table_e.append(emission_m)
             table_b.append(bounce_m)
-            table_tex.append(texels_m)
+            table_tex.append(texture_m)
         idx = np.clip(block.mat_index[keep], 0, len(table_a) - 1)  # Cycles clamps the index too
         albedo = np.asarray(table_a).reshape(-1, 3)[idx]
         bounce = np.asarray(table_b).reshape(-1, 3)[idx]
+        n = len(idx)
+        tex_index, tex_uv = np.full(n, -1, np.int32), np.zeros((n, 3, 2), np.float32)
+        tex_scale, bounce_scale = np.zeros((n, 3), np.float32), np.zeros((n, 3), np.float32)
         if block.uv is not None:
             uv = block.uv[keep]
-            for slot, texels in enumerate(table_tex):
+            for slot, texture in enumerate(table_tex):
                 on = idx == slot
-                if texels is not None and np.any(on):
-                    mean = texels.reshape(-1, 3).mean(axis=0)
-                    texture = triangle_texture_average(texels, uv[on])
-                    for out, table in ((albedo, table_a), (bounce, table_b)):
+                if texture is not None and np.any(on):
+                    mean = texture.texels.reshape(-1, 3).mean(axis=0, dtype=np.float64)
+                    average = triangle_texture_average(texture.texels, uv[on])
+                    for out, table, scales in ((albedo, table_a, tex_scale), (bounce, table_b, bounce_scale)):
                         scale = np.divide(table[slot], mean, out=np.zeros(3), where=mean > 0)
-                        out[on] = np.clip(texture * scale, 0.0, 1.0)
-        return pos, nrm, albedo, np.asarray(table_e).reshape(-1, 3)[idx], bounce
-
+                        out[on] = np.clip(average * scale, 0.0, 1.0)
+                        scales[on] = scale
+                    entry = uv_textures.setdefault(texture.name, (len(uv_textures), texture))
+                    tex_index[on], tex_uv[on] = entry[0], uv[on]
+        return (pos, nrm, albedo, np.asarray(table_e).reshape(-1, 3)[idx], bounce, tex_index, tex_uv, tex_scale,
+                bounce_scale)
 
     def _glossy_arrays(self, block: _Block, slots: list, glossy: dict) -> tuple:
         """Per-triangle F0 (n, 3) and roughness (n,) from the block's material slots."""

@@ -93,6 +93,33 @@ def first_copies(positions_m: np.ndarray) -> np.ndarray:
 
 
 @dataclass
+class AlbedoTextures:
+    """Base Color image textures read per pixel: by the camera's G-buffer and the RSMs (the VPLs' flux).
+    The voxels and the probes keep the per-triangle albedos (`Scene.albedo`, `bounce_albedo`: the
+    texture's mean over the triangle), as they average light over far more than a texel.
+
+    `images[k]` (h, w, 3) float32 linear RGB, row 0 = v 0 (Blender's order); `nearest[k]`: Closest
+    interpolation (else bilinear, Cycles' Linear), `clamp[k]`: Extend (else Repeat). Per triangle:
+    `index` (n,) int32, -1 where the albedo is flat; `uv` (n, 3, 2) float32 corner UVs; `scale` (n, 3)
+    float32, the camera's albedo at a point is clip(texel x scale, 0, 1) (the material's other factors
+    over the texture: `Scene.albedo` is the same product averaged over the triangle); `bounce_scale`
+    the same for the albedo toward other surfaces (`Scene.bounce_albedo`), which the RSMs read per
+    texel."""
+
+    images: list[np.ndarray]
+    nearest: list[bool]
+    clamp: list[bool]
+    index: np.ndarray
+    uv: np.ndarray
+    scale: np.ndarray
+    bounce_scale: np.ndarray
+
+    def subset(self, keep: np.ndarray) -> AlbedoTextures:
+        return replace(self, index=self.index[keep], uv=self.uv[keep], scale=self.scale[keep],
+                       bounce_scale=self.bounce_scale[keep])
+
+
+@dataclass
 class Scene:
     """Triangles (n, 3 corners, 3) with per-corner normals, per-triangle diffuse albedo and emitted
     radiance (W/m^2/sr, emission colour x strength), lights, the world (a constant radiance
@@ -125,6 +152,7 @@ class Scene:
     specular: np.ndarray | None = None
     roughness: np.ndarray | None = None
     bounce_albedo: np.ndarray | None = None
+    albedo_textures: AlbedoTextures | None = None  # None: every triangle's albedo is flat
 
     def bounce_reflectance(self) -> np.ndarray:
         """(n, 3) float32 albedo toward other diffuse surfaces (see the class): `albedo` where None."""
@@ -188,7 +216,8 @@ class Scene:
         kept = replace(self, positions_m=pos[keep], normals=self.normals[keep], albedo=self.albedo[keep],
                        emission=self.emission[keep], warnings=warnings, camera_visible=self.seen_by_camera()[keep],
                        specular=self.specular_f0()[keep], roughness=self.glossy_roughness()[keep],
-                       bounce_albedo=self.bounce_reflectance()[keep])
+                       bounce_albedo=self.bounce_reflectance()[keep],
+                       albedo_textures=None if self.albedo_textures is None else self.albedo_textures.subset(keep))
         lo, hi = kept.bounds_m()
         origin = (lo + hi) / 2.0
         # Geometry only: lights and camera stay in world space and are shifted per update by the method.

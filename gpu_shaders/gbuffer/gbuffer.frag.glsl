@@ -1,4 +1,5 @@
 #include "common/face_plane.glsl"
+#include "common/albedo_texture.glsl"
 
 // Cycles shades both sides of a surface and, at a back face, flips the normal towards the viewer; do
 // the same so back faces seen by the camera receive light like Cycles' Diffuse passes. Which side is
@@ -10,6 +11,11 @@ void main() {
     vec3 n = normalize(v_normal_ws) * face_side(v_plane_ws, normalize(v_normal_ws), camera_pos_ws - p);
     out_position = vec4(p, 1.0);  // w = 1 marks geometry (coverage)
     out_normal = vec4(n, 0.0);
-    out_albedo = vec4(v_albedo, 1.0);
+    // A textured Base Color: the texel under the pixel's centre times the material's other factors.
+    vec3 albedo = v_albedo_rect.z > 0.0
+        ? clamp(albedo_texture(albedo_atlas, v_albedo_rect, v_albedo_sampling, v_albedo_uv) * v_albedo_scale,
+                0.0, 1.0)
+        : v_albedo;
+    out_albedo = vec4(albedo, 1.0);
     out_specular = v_specular;
 }

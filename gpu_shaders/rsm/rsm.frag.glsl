@@ -6,11 +6,18 @@
 // The flux's w names the triangle the texel sees, its index in the drawn mesh + 1 (0: none): the direct
 // pass's exact shadow test (direct/shade.comp.glsl) intersects the shadow ray with it. A float holds every
 // index below 2^24 exactly.
+#include "common/albedo_texture.glsl"
 #include "common/face_plane.glsl"
 #include "common/light.glsl"
 
 void main() {
     vec3 n = normalize(v_normal_ws);
+    // A textured Base Color reflects the texel under the texel's centre (times the material's other
+    // factors toward a diffuse surface); a flat one its albedo.
+    vec3 albedo = v_albedo_rect.z > 0.0
+        ? clamp(albedo_texture(albedo_atlas, v_albedo_rect, v_albedo_sampling, v_albedo_uv) * v_albedo_scale,
+                0.0, 1.0)
+        : v_albedo;
     vec3 flux;
     float area_m2;
     // Grazing surfels have huge footprints; 0.05 caps them at 20x the texel's cross-section.
@@ -20,14 +27,14 @@ void main() {
     vec3 facing = dot(v_plane_ws.xyz, v_plane_ws.xyz) > 0.0 ? v_plane_ws.xyz : n;
     if (light_kind == LIGHT_SUN) {
         n *= face_side(v_plane_ws, n, -emit_axis);
-        flux = v_albedo * light_color_intensity * texel_scale;
+        flux = albedo * light_color_intensity * texel_scale;
         area_m2 = texel_scale / max(abs(dot(facing, emit_axis)), MIN_COS);
     } else {
         vec3 w = normalize(v_pos_ws - light_pos_ws);
         n *= face_side(v_plane_ws, n, -w);
         float cos_face = max(dot(w, face_axis), 1e-6);
         float solid_angle = texel_scale * cos_face * cos_face * cos_face;
-        flux = v_albedo * light_intensity(light_kind, w, emit_axis, light_color_intensity, spot_cos_half, spot_blend) * solid_angle;
+        flux = albedo * light_intensity(light_kind, w, emit_axis, light_color_intensity, spot_cos_half, spot_blend) * solid_angle;
         float dist = length(v_pos_ws - light_pos_ws);
         area_m2 = solid_angle * dist * dist / max(abs(dot(facing, w)), MIN_COS);
         if (occluder_radius > 0.0) {

@@ -491,6 +491,17 @@ def test_image_texture_averaged_per_triangle(fresh_blend):
     np.testing.assert_allclose(s.albedo[:, 0], u_centroid, atol=1 / 256)
     assert np.ptp(s.albedo[:, 0]) > 0.9  # per triangle, not one average (which would be 0.5)
     np.testing.assert_allclose(s.albedo[:, 1:], 0.0)
+    # The camera samples the same texture per pixel (Scene.albedo_textures): the image itself, every
+    # triangle's corner UVs, Linear and Repeat (the node's defaults), and the factor 1 / 1 (Base Color is
+    # the texture alone; the factor's red is albedo / the texture's mean, 0.5 / 0.5).
+    t = s.albedo_textures
+    (image,) = t.images
+    np.testing.assert_allclose(image[0, :, 0], ramp, rtol=1e-6)
+    assert t.nearest == [False] and t.clamp == [False]
+    np.testing.assert_array_equal(t.index, 0)
+    np.testing.assert_allclose(t.uv[..., 0], s.positions_m[..., 0] / 2 + 0.5, atol=1e-6)
+    np.testing.assert_allclose(t.scale, np.broadcast_to([1.0, 0.0, 0.0], t.scale.shape), atol=1e-6)
+    np.testing.assert_allclose(t.bounce_scale, t.scale, atol=1e-6)  # no glossy layer: the same factor
 
 
 @pytest.mark.parametrize("metallic,level,roughness", [(0.25, 1.0, 0.3), (1.0, 0.5, 0.5), (0.0, 0.5, 0.2),

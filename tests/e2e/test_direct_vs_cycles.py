@@ -174,3 +174,29 @@ def test_a_worlds_sun_lights_as_in_cycles(world, tmp_path):
     assert noise["rel_rmse"] < BOUND_REL_RMSE / 2, f"reference too noisy for the bound: {noise}"
     assert err["rel_rmse"] <= BOUND_REL_RMSE, err
     assert BOUND_BIAS[0] <= err["bias"] <= BOUND_BIAS[1], err
+
+
+def test_the_albedo_of_a_textured_scene_matches_cycles_diffuse_color(tmp_path):
+    """The camera's albedo (`render`'s albedo.exr) against Cycles' Diffuse Color pass on the textured
+    box, whose floor and back wall take a checker image (Closest interpolation) through their UVs: the
+    G-buffer samples the texel under each pixel's centre, as Cycles' camera rays do at `filter_width`
+    0.01 px. Measured 99.1 % of the covered pixels within 1e-4 (the rest: the seam diagonals, where
+    pixel centres lie on the edge between two faces and the two renderers' fill rules differ); bound
+    98 %. The per-triangle average alone (the floor's two triangles one grey) read 69 %, the untextured
+    walls and blocks."""
+    from addon.bridge import images, scenes
+    from addon.bridge.pipeline import render_file
+    from addon.bridge.reference import render_reference
+    from addon.engine.config import GIConfig
+
+    blend = tmp_path / "textured.blend"
+    scenes.save("textured", blend)
+    (tmp_path / "ours").mkdir()
+    render_file(blend, tmp_path / "ours", {"gi": GIConfig(method="direct", resolution=RES)}, repeat=1)
+    render_reference(blend, tmp_path / "ref", spp=4, bounces=1, res=RES, seed=0)
+    ours = images.read_exr(tmp_path / "ours" / "albedo.exr")
+    ref = images.read_exr(tmp_path / "ref" / "albedo.exr")
+    covered = ref[..., 3] > 0.5
+    close = np.abs(ours[..., :3] - ref[..., :3]).max(axis=-1)[covered] <= 1e-4
+    print(f"textured: {close.mean():.4f} of {covered.sum()} covered pixels within 1e-4 of Cycles' Diffuse Color")
+    assert close.mean() >= 0.98

@@ -72,7 +72,7 @@ def test_dropped_gl_objects_are_released(gl):
     from addon.engine.passes import gbuffer
 
     prog = gl.program(gbuffer.SPEC)
-    attrs = {v.name: np.zeros((3, 4 if v.name == "specular" else 3), np.float32) for v in gbuffer.SPEC.attributes}
+    attrs = {v.name: np.zeros((3, int(v.type[-1])), np.float32) for v in gbuffer.SPEC.attributes}  # vecN
     for _ in range(10):
         gl.mesh(prog, attrs, "triangles")
         gl.texture((4, 4))

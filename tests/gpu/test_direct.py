@@ -13,7 +13,7 @@ import pytest
 from addon.engine.area_light import polygon_irradiance
 from addon.engine.config import GIConfig, RsmConfig
 from addon.engine.methods.direct import DirectMethod
-from addon.engine.scene import Camera, Light, Scene
+from addon.engine.scene import AlbedoTextures, Camera, Light, Scene
 from addon.engine.transforms import look_along, perspective
 
 pytestmark = pytest.mark.gpu
@@ -431,3 +431,76 @@ def test_the_triangles_side_decides_the_normals_flip_as_in_cycles(gl, winding):
     rsm_normals = gl.read(method.rsm["normal"])[..., :3][rsm]
     assert rsm.sum() > 0
     np.testing.assert_allclose(rsm_normals, np.broadcast_to(expected, rsm_normals.shape), atol=1e-5)
+
+
+def _sample_texture(texture, u, v, nearest, clamp):
+    """Cycles' Image Texture at (u, v): Closest or Linear (texel centres at (i + 0.5) / size), Repeat or
+    Extend; texture (h, w, 3), row 0 = v 0."""
+    h, w = texture.shape[:2]
+
+    def texel(i, j):
+        i, j = (np.clip(i, 0, h - 1), np.clip(j, 0, w - 1)) if clamp else (i % h, j % w)
+        return texture[i, j]
+
+    if nearest:
+        return texel(int(np.floor(v * h)), int(np.floor(u * w)))
+    x, y = u * w - 0.5, v * h - 0.5
+    j0, i0 = int(np.floor(x)), int(np.floor(y))
+    fx, fy = x - j0, y - i0
+    bottom = (1 - fx) * texel(i0, j0) + fx * texel(i0, j0 + 1)
+    top = (1 - fx) * texel(i0 + 1, j0) + fx * texel(i0 + 1, j0 + 1)
+    return (1 - fy) * bottom + fy * top
+
+
+@pytest.mark.parametrize("nearest", [True, False], ids=["closest", "linear"])
+@pytest.mark.parametrize("clamp", [False, True], ids=["repeat", "extend"])
+def test_the_camera_sees_a_base_color_texture_per_pixel(gl, nearest, clamp):
+    """The G-buffer's albedo is the texel under each pixel's centre times the material's other factors
+    (Scene.albedo_textures), sampled as Cycles samples an Image Texture, while the per-triangle albedo
+    stays for the other passes. A floor seen at a slant (so the UVs need perspective-correct
+    interpolation), its left half textured by a random 4 x 4 image whose UVs run from -0.5 to 1.5 (so
+    Repeat and Extend differ), scale (0.5, 1, 3) (clipped at 1 as Cycles' Diffuse Color is); its right
+    half flat 0.25. Exact up to fp32 interpolation of the UVs (atol 2e-4 against a bilinear slope of at
+    most 4 per UV unit x the 4-texel image); Closest skips pixels within 1e-3 texel of a texel edge."""
+    rng = np.random.default_rng(7)
+    image = rng.uniform(0.05, 0.95, (4, 4, 3)).astype(np.float32)
+    scale = np.array([0.5, 1.0, 3.0], np.float32)
+    tris = np.array(quad(-1, 0, -1, 1, 0.0) + quad(0, 1, -1, 1, 0.0), np.float32)
+    normals = np.zeros_like(tris)
+    normals[..., 2] = 1.0
+
+    def uv_of(p):  # x in [-1, 0] -> u in [-0.5, 1.5], y in [-1, 1] -> v in [-0.5, 1.5]
+        return np.stack([(p[..., 0] + 1.0) * 2.0 - 0.5, (p[..., 1] + 1.0) - 0.5], axis=-1)
+
+    textures = AlbedoTextures(images=[image], nearest=[nearest], clamp=[clamp], index=np.array([0, 0, -1, -1]),
+                              uv=uv_of(tris).astype(np.float32), scale=np.tile(scale, (4, 1)),
+                              bounce_scale=np.tile(scale, (4, 1)))
+    cam = Camera(look_along([0.3, -2.5, 3.0], [-0.1, 0.6, -0.8], [0, 0, 1]), perspective(np.radians(40), 0.1, 100),
+                 SIZE, SIZE)
+    flat = np.full((4, 3), 0.25, np.float32)
+    scene = Scene(tris, normals, flat, np.zeros((4, 3), np.float32),
+                  [Light("SUN", [0, 0, 0], [0, 0, -1], [1, 1, 1], sun_strength=1.0)], camera=cam,
+                  albedo_textures=textures)
+    method = DirectMethod(gl, GIConfig(), RsmConfig(resolution=64))
+    method.set_scene(scene)
+    albedo = method.run().images["albedo"]
+    checked = {"textured": 0, "flat": 0}
+    for row in range(SIZE):
+        for col in range(SIZE):
+            if albedo[row, col, 3] <= 0:
+                continue
+            p = floor_point_at_pixel(cam, row, col)
+            if abs(p[0]) < 0.02:  # the seam between the halves
+                continue
+            if p[0] > 0:
+                np.testing.assert_allclose(albedo[row, col, :3], 0.25, atol=1e-6)
+                checked["flat"] += 1
+                continue
+            u, v = uv_of(p)
+            edge = np.abs(np.array([u, v]) * 4 - np.round(np.array([u, v]) * 4))
+            if nearest and edge.min() < 1e-3:
+                continue
+            expected = np.clip(_sample_texture(image, u, v, nearest, clamp) * scale, 0.0, 1.0)
+            np.testing.assert_allclose(albedo[row, col, :3], expected, atol=2e-4)
+            checked["textured"] += 1
+    assert checked["textured"] > 300 and checked["flat"] > 300

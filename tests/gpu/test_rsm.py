@@ -8,7 +8,7 @@ import pytest
 
 from addon.engine.config import GIConfig, RsmConfig
 from addon.engine.methods.rsm import RsmMethod
-from addon.engine.scene import Camera, Light, Scene
+from addon.engine.scene import AlbedoTextures, Camera, Light, Scene
 from addon.engine.transforms import look_along, perspective
 
 pytestmark = pytest.mark.gpu
@@ -445,3 +445,31 @@ def test_pixels_the_filter_cannot_average_draw_more_vpls(gl):
               for sets in (1, 2)]
     print("pole spread over seeds, 2 sets / 1:", spread[1] / spread[0])
     assert spread[1] < 0.85 * spread[0]
+
+
+def test_rsm_flux_reads_a_base_color_texture_per_texel(gl):
+    # A 2 m floor under a sun straight down (3 W/m^2), its Base Color a random 4 x 4 image (Closest,
+    # Repeat) over UVs (x + 1) / 2, (y + 1) / 2, times a bounce factor (0.5, 1, 2): each RSM texel's flux
+    # is the texel under its centre x the factor (clipped at 1) x E x its area (normal.w, the footprint
+    # of a texel facing the sun). The per-triangle albedo (0.3 here) must not be used. fp32: rtol 1e-5;
+    # texels within 1e-3 of an image texel's edge are skipped (the nearest texel is a coin toss there).
+    rng = np.random.default_rng(11)
+    image = rng.uniform(0.05, 0.95, (4, 4, 3)).astype(np.float32)
+    factor = np.array([0.5, 1.0, 2.0], np.float32)
+    light = Light("SUN", [0, 0, 0], [0, 0, -1], [1, 1, 1], sun_strength=3.0)
+    cam = Camera(look_along([0, 0, 5], [0, 0, -1], [0, 1, 0]), perspective(np.radians(30), 0.1, 100), 8, 8)
+    scene = scene_of([rect([-1, -1, 0], [2, 0, 0], [0, 2, 0])], [[0.3] * 3], light, cam)
+    uv = ((scene.positions_m[..., :2] + 1.0) / 2.0).astype(np.float32)
+    scene.albedo_textures = AlbedoTextures(images=[image], nearest=[True], clamp=[False], index=np.zeros(2, np.int32),
+                                           uv=uv, scale=np.tile(factor, (2, 1)), bounce_scale=np.tile(factor, (2, 1)))
+    method = RsmMethod(gl, GIConfig(method="rsm"), RsmConfig(resolution=64))
+    method.set_scene(scene)
+    method.run()
+    position, normal, flux = (gl.read(method.rsm[k]) for k in ("position", "normal", "flux"))
+    seen = position[..., 3] > 0
+    u, v = ((position[seen][:, :2] + 1.0) / 2.0).T
+    i, j = np.floor(v * 4).astype(int) % 4, np.floor(u * 4).astype(int) % 4
+    clear = np.minimum(np.abs(u * 4 - np.round(u * 4)), np.abs(v * 4 - np.round(v * 4))) > 1e-3
+    expected = np.clip(image[i, j] * factor, 0.0, 1.0) * 3.0 * normal[seen][:, 3:4]
+    assert clear.sum() > 1000
+    np.testing.assert_allclose(flux[seen][clear, :3], expected[clear], rtol=1e-5)

@@ -95,6 +95,33 @@ def test_an_area_light_draws_in_a_real_window(shots):
     assert (added.max(axis=2) > 4 / 255).mean() > 0.05
 
 
+def test_a_base_color_texture_shows_per_pixel_in_the_combined_view(shots):
+    # The white surfaces' Base Color becomes an 8 x 8 checker, then its inverse: the combined view
+    # multiplies the light by the G-buffer's albedo, which samples the texture per pixel, so the
+    # difference of the two screens changes sign at every square's edge, 7 times across each textured
+    # wall. An albedo averaged per triangle changes it only where one triangle meets the next (a quad's
+    # diagonal): at most a few times along a row of the view.
+    result, crop = shots
+    entry = result["texture"]
+    for name in ("checker", "inverse"):
+        assert entry[name]["error"] is None and entry[name]["gpu_runs"] >= 1, entry
+    checker, inverse = crop(entry["checker"]["shot"]), crop(entry["inverse"]["shot"])
+    if os.environ.get("BOUNCE_SCREENSHOTS"):
+        import matplotlib.pyplot as plt
+
+        plt.imsave(Path(os.environ["BOUNCE_SCREENSHOTS"]) / "real_texture.png", np.clip(checker, 0, 1))
+        plt.imsave(Path(os.environ["BOUNCE_SCREENSHOTS"]) / "real_texture_inverse.png", np.clip(inverse, 0, 1))
+    d = (checker - inverse).mean(axis=2)
+
+    def sign_changes(row):  # along a row, over the pixels where the two differ visibly
+        signs = np.sign(row[np.abs(row) > 8 / 255])
+        return int((signs[1:] != signs[:-1]).sum())
+
+    changes = np.array([sign_changes(row) for row in d])
+    print("rows with >= 6 sign changes:", (changes >= 6).mean(), "most:", changes.max())
+    assert (changes >= 6).mean() > 0.1
+
+
 def test_a_sky_lights_by_direction_once_captured(shots):
     # A Sky Texture world: the overlay lights it as its average (the panel's row says so) until the
     # Capture World Light operator renders its map and measures its sun disc in the real binary; then

@@ -27,7 +27,18 @@ from ..area_light import emitter_table, split_area_light
 from ..backends.base import Backend, ShaderSpec
 from ..config import GIConfig, RsmConfig
 from ..errors import ConfigError
-from ..passes import accumulate, declare, denoise, direct_light, gbuffer, rsm, sky_light, surface_support, zero
+from ..passes import (
+    accumulate,
+    albedo_atlas,
+    declare,
+    denoise,
+    direct_light,
+    gbuffer,
+    rsm,
+    sky_light,
+    surface_support,
+    zero,
+)
 from ..passes.light_views import KIND_CODE, LightView, emissive_lights, reaches, views_for
 from ..scene import Camera, Scene
 
@@ -101,12 +112,14 @@ def face_planes(positions_m: np.ndarray, corner_normals: np.ndarray | None = Non
 
 
 def triangle_attributes(scene: Scene, spec: ShaderSpec, select: np.ndarray | None = None,
-                        planes: np.ndarray | None = None) -> dict[str, np.ndarray] | None:
+                        planes: np.ndarray | None = None, atlas: albedo_atlas.Atlas | None = None
+                        ) -> dict[str, np.ndarray] | None:
     """Per-vertex arrays for raster pass `spec`, the attributes it declares only: three vertices per
     triangle, flat albedo (the camera's; bounce_albedo: toward other surfaces) and glossy lobe
     (specular: F0, roughness), the triangle's plane (`planes`: face_planes of all of `scene`'s
     triangles, made once per geometry change as they take 70-100 ms for 279 k; None: made here for the
-    selection); `select` picks triangles (None: all). None when nothing is left."""
+    selection), the Base Color texture's place in `atlas` (albedo_atlas.triangle_attributes); `select`
+    picks triangles (None: all). None when nothing is left."""
     sel = np.ones(scene.triangle_count, bool) if select is None else select
     n = int(sel.sum())
     if n == 0:
@@ -120,7 +133,11 @@ def triangle_attributes(scene: Scene, spec: ShaderSpec, select: np.ndarray | Non
         "bounce_albedo": lambda: np.repeat(scene.bounce_reflectance()[sel], 3, axis=0),
         "specular": lambda: np.repeat(np.c_[scene.specular_f0()[sel], scene.glossy_roughness()[sel]], 3, axis=0),
     }
-    return {a.name: build[a.name]() for a in spec.attributes}
+    names = [a.name for a in spec.attributes]
+    if any(name.startswith("albedo_") for name in names):
+        build.update({name: (lambda array=array: array) for name, array in
+                      albedo_atlas.triangle_attributes(scene.albedo_textures, atlas, sel).items()})
+    return {name: build[name]() for name in names}
 
 
 class DirectMethod:
@@ -179,9 +196,12 @@ class DirectMethod:
                       sky_light.SHADOW_SPEC: not_emitting}
         # Every triangle's plane, once: the G-buffer's, the RSMs' and the probes' capture read it.
         self.planes = face_planes(self.scene.positions_m, self.scene.normals)
+        textures = self.scene.albedo_textures
+        atlas = albedo_atlas.pack(textures.images) if textures is not None else None
+        self.albedo_atlas = albedo_atlas.upload(be, atlas)
         self._meshes = {}
         for spec, select in selections.items():
-            attrs = triangle_attributes(self.scene, spec, select, self.planes)
+            attrs = triangle_attributes(self.scene, spec, select, self.planes, atlas)
             self._meshes[spec.name] = be.mesh(be.program(spec), attrs, "triangles") if attrs is not None else None
         # The RSM's triangles by the index its texels name (rsm.frag.glsl): the direct pass's exact shadows.
         table = rsm.occluder_table(self.scene.positions_m[not_emitting])
@@ -412,7 +432,7 @@ class DirectMethod:
             if run_gbuffer:
                 with self.step(timings, gbuffer.DECL):
                     gbuffer.run(self.backend, self.gbuf_target, self.gbuf, self._meshes[gbuffer.SPEC.name],
-                                self.camera())
+                                self.camera(), self.albedo_atlas)
             if keep:
                 if solve:
                     with self.timed(timings, "solve"):
@@ -453,9 +473,10 @@ class DirectMethod:
         self.rsm, self.rsm_target = self._rsm_slot(slot)
         self._slot = slot
         with self.step(timings, rsm.DECL):
-            rsm.run(self.backend, self.rsm_target, self._meshes[rsm.SPEC.name], view)
+            rsm.run(self.backend, self.rsm_target, self._meshes[rsm.SPEC.name], view, self.albedo_atlas)
             if self._own_sun_shadow(view):  # the same orthographic view, finer
-                rsm.run(self.backend, self._sun_shadow_slot(slot)[1], self._meshes[rsm.SPEC.name], view)
+                rsm.run(self.backend, self._sun_shadow_slot(slot)[1], self._meshes[rsm.SPEC.name], view,
+                        self.albedo_atlas)
 
     def _solve(self, views: list[LightView], timings: dict[str, float], slots) -> None:
         self._draw_sky(timings)

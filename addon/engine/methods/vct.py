@@ -169,7 +169,8 @@ class VctMethod(OneBounceMethod):
             return
         textures, target = sky.rsm_target(self.backend)
         with self.step(timings, sky_light.RSM_DECL):
-            sky_light.rsm_tiles(self.backend, target, self._meshes[rsm.SPEC.name], sky.layout, sky.views)
+            sky_light.rsm_tiles(self.backend, target, self._meshes[rsm.SPEC.name], self.albedo_atlas, sky.layout,
+                                sky.views)
         with self.step(timings, vct_inject.SKY_DECL):
             filtered = self.vct_config.filtered_injection
             size = sky.layout.size

@@ -1,15 +1,17 @@
 """G-buffer pass: rasterize the scene from the camera.
 
 Inputs: the scene's triangles (mesh attributes pos_ws, plane_ws (methods/direct.face_planes), normal_ws,
-albedo, specular). Uniforms: view_projection, camera_pos_ws. Outputs (RGBA32F, camera resolution, GL row
-0 = bottom): position (world, m, on its triangle's plane; w = 1 where geometry), normal (world, unit,
-flipped towards the camera), albedo (diffuse, linear), specular (rgb = the glossy lobe's F0, a =
-roughness; Scene.specular). Depth: 32F.
+albedo, specular, and the Base Color texture's albedo_rect, albedo_sampling, albedo_uv, albedo_scale:
+passes/albedo_atlas.py) and the albedo atlas (sampler). Uniforms: view_projection, camera_pos_ws.
+Outputs (RGBA32F, camera resolution, GL row 0 = bottom): position (world, m, on its triangle's plane;
+w = 1 where geometry), normal (world, unit, flipped towards the camera), albedo (diffuse, linear: the
+texel times albedo_scale where the triangle has a texture, else its flat albedo), specular (rgb = the
+glossy lobe's F0, a = roughness; Scene.specular). Depth: 32F.
 """
 
 from __future__ import annotations
 
-from ..backends.base import Backend, ShaderSpec, Var
+from ..backends.base import Backend, Sampler, ShaderSpec, Texture, Var
 from ..scene import Camera
 from . import zero
 from .declare import GBUFFER, TRIANGLES, PassDecl
@@ -19,10 +21,14 @@ SPEC = ShaderSpec(
     vertex="gbuffer/gbuffer.vert.glsl",
     fragment="gbuffer/gbuffer.frag.glsl",
     uniforms=(Var("view_projection", "mat4"), Var("camera_pos_ws", "vec3")),
+    samplers=(Sampler("albedo_atlas", "2D"),),
     attributes=(Var("pos_ws", "vec3"), Var("plane_ws", "vec4"), Var("normal_ws", "vec3"), Var("albedo", "vec3"),
-                Var("specular", "vec4")),
+                Var("specular", "vec4"), Var("albedo_rect", "vec4"), Var("albedo_sampling", "vec2"),
+                Var("albedo_uv", "vec2"), Var("albedo_scale", "vec3")),
     varyings=(Var("v_pos_ws", "vec3"), Var("v_plane_ws", "vec4", "flat"), Var("v_normal_ws", "vec3"),
-              Var("v_albedo", "vec3"), Var("v_specular", "vec4")),
+              Var("v_albedo", "vec3"), Var("v_specular", "vec4"), Var("v_albedo_rect", "vec4", "flat"),
+              Var("v_albedo_sampling", "vec2", "flat"), Var("v_albedo_uv", "vec2"),
+              Var("v_albedo_scale", "vec3", "flat")),
     outputs=(Var("out_position", "vec4"), Var("out_normal", "vec4"), Var("out_albedo", "vec4"),
              Var("out_specular", "vec4")),
 )
@@ -34,13 +40,14 @@ CHANNELS = tuple(port.name for port in GBUFFER)  # the outputs' textures, in ord
 DECL = PassDecl("gbuffer", "camera", (TRIANGLES,), GBUFFER, "the scene rasterized from the camera")
 
 
-def run(backend: Backend, target, textures: dict, mesh, camera: Camera) -> None:
-    """Draw into `target` (the CHANNELS textures of `textures` + depth). The colours are zeroed by a
-    compute pass and only depth by a clear: a framebuffer clear of four 1080p RGBA32F targets is raster
-    work, slow on compute GPUs (passes/zero.py)."""
+def run(backend: Backend, target, textures: dict, mesh, camera: Camera, albedo_atlas: Texture) -> None:
+    """Draw into `target` (the CHANNELS textures of `textures` + depth); `albedo_atlas` from
+    albedo_atlas.upload. The colours are zeroed by a compute pass and only depth by a clear: a
+    framebuffer clear of four 1080p RGBA32F targets is raster work, slow on compute GPUs
+    (passes/zero.py)."""
     zero.images(backend, [textures[c] for c in CHANNELS])
     backend.clear(target, color=None, depth=1.0)
     if mesh is not None:
         backend.draw(backend.program(SPEC), target, mesh,
                      uniforms={"view_projection": camera.view_projection, "camera_pos_ws": camera.position_m},
-                     depth_test=True)
+                     samplers={"albedo_atlas": albedo_atlas}, depth_test=True)

@@ -266,13 +266,13 @@ def shadow(backend: Backend, target, mesh, layout: SkyLayout, views: list) -> No
                      depth_test=True, viewport=layout.viewport(k))
 
 
-def rsm_tiles(backend: Backend, target, mesh, layout: SkyLayout, views: list) -> None:
-    """Every direction's RSM (passes/rsm.py, a sun's view at the tile's size) into its tile of the
-    textures behind `target` (position, normal, flux): the world's VPLs, one tile per region of the sky,
-    for a method that injects them all at once (vct)."""
+def rsm_tiles(backend: Backend, target, mesh, albedo_atlas, layout: SkyLayout, views: list) -> None:
+    """Every direction's RSM (passes/rsm.py, a sun's view at the tile's size; `albedo_atlas` its
+    textures) into its tile of the textures behind `target` (position, normal, flux): the world's VPLs,
+    one tile per region of the sky, for a method that injects them all at once (vct)."""
     backend.clear(target, color=(0, 0, 0, 0), depth=1.0)
     for k, view in enumerate(views):
-        rsm.draw(backend, target, mesh, view, viewport=layout.viewport(k))
+        rsm.draw(backend, target, mesh, view, albedo_atlas, viewport=layout.viewport(k))
 
 
 def bounds(backend: Backend, atlas, out, layout: SkyLayout) -> None:

@@ -116,6 +116,26 @@ def steps():
     yield from until_updated(live, viewport, runs)
     result["area_light"] = {"shot": shot("area_light"), "status": live.status(), "error": live.STATE.error,
                             "gpu_runs": viewport.gpu_runs - runs}
+    # A Base Color image texture in the combined view (light x albedo): the white surfaces take an 8 x 8
+    # checker of 1 and 0, then its inverse. The two have the same mean, so only an albedo read per pixel
+    # tells them apart on the screen.
+    settings.view_mode = "COMBINED"
+    tree = bpy.data.materials["White"].node_tree
+    tex = tree.nodes.new("ShaderNodeTexImage")
+    tex.interpolation = "Closest"
+    link = tree.links.new(tex.outputs["Color"], tree.nodes["Principled BSDF"].inputs["Base Color"])
+    entry = result["texture"] = {}
+    for name, phase in (("checker", 0), ("inverse", 1)):
+        image = bpy.data.images.new(name, 8, 8, float_buffer=True)
+        image.pixels.foreach_set([float((i // 4 // 8 + i // 4 % 8 + phase) % 2) if i % 4 < 3 else 1.0
+                                  for i in range(8 * 8 * 4)])
+        tex.image = image
+        runs = viewport.gpu_runs
+        yield from until_updated(live, viewport, runs)
+        entry[name] = {"shot": shot(f"texture_{name}"), "error": live.STATE.error,
+                       "gpu_runs": viewport.gpu_runs - runs}
+    tree.links.remove(link)
+    settings.view_mode = "INDIRECT"
     # A sky (Blender's Sky Texture, its sun disc on: no map Bounce reads itself) instead of the lamps: the
     # overlay lights it as its average until Capture World Light renders its map and its sun, then by
     # direction.
