@@ -261,6 +261,12 @@ def format_scene(sc: dict) -> str:
                      *([format_eevee_cell(r["vs_eevee"])] if eevee else [])]
             out.append("| " + " | ".join(cells) + " |")
         out.append("")
+        full = [r for r in sc["runs"] if r.get("full")]
+        if full:
+            out.append("Full image, (direct + indirect) x albedo against Cycles' (Diffuse Direct + Diffuse Indirect) "
+                       "x Diffuse Color, rel_rmse_8 / bias: " + "; ".join(
+                           f"{r['method']} ({r['setting']}) {_num(r['full']['rel_rmse_8'])} / "
+                           f"{_num(r['full']['bias'], '{:.4f}')}" for r in full) + ".\n")
     for product, curve in sc["curve"].items():
         denoised = sc.get("curve_oidn", {}).get(product)
         out.append(f"Cycles' curve, {product} pass (seed 1 against the reference)"

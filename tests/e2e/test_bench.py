@@ -298,6 +298,10 @@ def test_full_image_is_direct_plus_indirect_times_albedo(tmp_path):
     assert full["bias"] == pytest.approx(1.5, rel=1e-6) and full["rel_rmse_8"] == pytest.approx(0.5, rel=1e-6)
     (tmp_path / "ours" / "indirect.exr").unlink()
     assert bench._compare_full(tmp_path / "ours", tmp_path / "ref") is None
+    # The report gives it per row that has one, as measured.
+    result = _fake_result()
+    result["scenes"][0]["runs"][1]["full"] = full
+    assert "rel_rmse_8 / bias: rsm (vpl_samples 64) 0.5 / 1.5000.\n" in bench.format_report(result)
 
 
 def test_code_version_names_the_commit(tmp_path):
