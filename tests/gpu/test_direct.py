@@ -504,3 +504,27 @@ def test_the_camera_sees_a_base_color_texture_per_pixel(gl, nearest, clamp):
             np.testing.assert_allclose(albedo[row, col, :3], expected, atol=2e-4)
             checked["textured"] += 1
     assert checked["textured"] > 300 and checked["flat"] > 300
+
+
+def test_the_albedo_atlas_is_packed_again_only_for_other_images(gl):
+    # A geometry change (set_scene) keeps the uploaded atlas while the texture images are the same
+    # arrays (the capture keeps an unchanged image's texels), and packs again for a new array.
+    image = np.ones((2, 2, 3), np.float32)
+    tris = np.array(quad(-1, 1, -1, 1, 0.0), np.float32)
+    normals = np.zeros_like(tris)
+    normals[..., 2] = 1.0
+
+    def scene(img):
+        textures = AlbedoTextures(images=[img], nearest=[True], clamp=[False], index=np.zeros(2, np.int32),
+                                  uv=np.zeros((2, 3, 2), np.float32), scale=np.ones((2, 3), np.float32),
+                                  bounce_scale=np.ones((2, 3), np.float32))
+        return Scene(tris, normals, np.full((2, 3), 0.5, np.float32), np.zeros((2, 3), np.float32), [],
+                     albedo_textures=textures)
+
+    method = DirectMethod(gl, GIConfig(), RsmConfig(resolution=64))
+    method.set_scene(scene(image))
+    first = method.albedo_atlas
+    method.set_scene(scene(image))
+    assert method.albedo_atlas is first
+    method.set_scene(scene(image.copy()))
+    assert method.albedo_atlas is not first

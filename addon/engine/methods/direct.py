@@ -169,6 +169,8 @@ class DirectMethod:
         # Per-pass timings wait for the GPU around every pass: right for benchmarks, a stall per pass
         # in an interactive viewport, which turns it off and times the whole update itself.
         self.profile = True
+        self._atlas_images: list | None = None  # the images self.albedo_atlas was packed from
+        self._atlas: albedo_atlas.Atlas | None = None
 
     def timed(self, timings: dict[str, float], name: str):
         """Time a block into timings[name] when profiling; otherwise run it untimed (no GPU sync)."""
@@ -196,9 +198,7 @@ class DirectMethod:
                       sky_light.SHADOW_SPEC: not_emitting}
         # Every triangle's plane, once: the G-buffer's, the RSMs' and the probes' capture read it.
         self.planes = face_planes(self.scene.positions_m, self.scene.normals)
-        textures = self.scene.albedo_textures
-        atlas = albedo_atlas.pack(textures.images) if textures is not None else None
-        self.albedo_atlas = albedo_atlas.upload(be, atlas)
+        atlas = self._albedo_atlas(self.scene.albedo_textures)
         self._meshes = {}
         for spec, select in selections.items():
             attrs = triangle_attributes(self.scene, spec, select, self.planes, atlas)
@@ -246,6 +246,19 @@ class DirectMethod:
         map of its own for its direct light (RsmConfig.sun_shadow_texels)."""
         return (self.rsm_config.sun_shadow_texels > 0 and view.uniforms["light_kind"] == KIND_CODE["SUN"]
                 and view.light_index not in self.vpl_shares)
+
+    def _albedo_atlas(self, textures) -> albedo_atlas.Atlas | None:
+        """The atlas of `textures`' images (Scene.albedo_textures), uploaded as self.albedo_atlas. Packed
+        again only when the images are other arrays than the last geometry change's: the capture keeps
+        an image's texels while the image is unchanged, and a scene's textures can reach the atlas's
+        128-256 MB, too much to pack and upload each time an object moves."""
+        images = [] if textures is None else textures.images
+        kept = self._atlas_images
+        if kept is None or len(kept) != len(images) or any(a is not b for a, b in zip(kept, images, strict=True)):
+            self._atlas = albedo_atlas.pack(images) if images else None
+            self.albedo_atlas = albedo_atlas.upload(self.backend, self._atlas)
+            self._atlas_images = list(images)  # held, so their ids cannot be reused by new arrays
+        return self._atlas
 
     def _sun_shadow_slot(self, slot: int) -> tuple[dict, object]:
         if slot not in self._sun_shadows:
