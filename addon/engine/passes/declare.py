@@ -76,6 +76,8 @@ OCCLUDERS = Port("scene", "occluders", "RGBA32F", "table",
                  "the corners (m) of the triangles the RSMs draw, OCCLUDER_ROW triangles of 3 texels per row")
 BVH = Port("scene", "bvh", "RGBA32F", "table",
            "bvh.py's hierarchy over the occluders: node bounds (m) in heap order, triangles in leaf order")
+ALBEDO_ATLAS = Port("scene", "albedo_atlas", "RGBA32F", "table",
+                    "the Base Color images read per pixel (linear), packed by passes/albedo_atlas.py")
 EMITTERS = Port("scene", "emitters", "RGBA32F", "table",
                 "per polygon of an emitter with its shape: vertices (m), radiance (W/m^2/sr), sidedness")
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 from ..backends.base import Backend, Sampler, ShaderSpec, Texture, Var
 from ..scene import Camera
 from . import zero
-from .declare import GBUFFER, TRIANGLES, PassDecl
+from .declare import ALBEDO_ATLAS, GBUFFER, TRIANGLES, PassDecl
 
 SPEC = ShaderSpec(
     name="gbuffer",
@@ -37,7 +37,7 @@ SPEC = ShaderSpec(
 CHANNELS = tuple(port.name for port in GBUFFER)  # the outputs' textures, in order
 
 
-DECL = PassDecl("gbuffer", "camera", (TRIANGLES,), GBUFFER, "the scene rasterized from the camera")
+DECL = PassDecl("gbuffer", "camera", (TRIANGLES, ALBEDO_ATLAS), GBUFFER, "the scene rasterized from the camera")
 
 
 def run(backend: Backend, target, textures: dict, mesh, camera: Camera, albedo_atlas: Texture) -> None:

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..backends.base import Backend, Sampler, ShaderSpec, Texture, Var
-from .declare import LIGHT_VIEWS, RSM, TRIANGLES, PassDecl
+from .declare import ALBEDO_ATLAS, LIGHT_VIEWS, RSM, TRIANGLES, PassDecl
 from .light_views import LightView
 
 SPEC = ShaderSpec(
@@ -58,7 +58,7 @@ def occluder_table(positions_m: np.ndarray) -> np.ndarray:
     return table.reshape(rows, OCCLUDER_ROW * 3, 4)
 
 
-DECL = PassDecl("rsm", "solve", (TRIANGLES, LIGHT_VIEWS), RSM, "the scene seen from one light face")
+DECL = PassDecl("rsm", "solve", (TRIANGLES, ALBEDO_ATLAS, LIGHT_VIEWS), RSM, "the scene seen from one light face")
 
 
 def run(backend: Backend, target, mesh, view: LightView, albedo_atlas: Texture) -> None:

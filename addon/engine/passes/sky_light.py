@@ -35,7 +35,7 @@ from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_coun
 from ..scene import Light
 from ..world import power_shares
 from . import direct_light, rsm
-from .declare import BVH, DIRECT, GBUF_NORMAL, GBUF_POSITION, TRIANGLES, PassDecl, Port
+from .declare import ALBEDO_ATLAS, BVH, DIRECT, GBUF_NORMAL, GBUF_POSITION, TRIANGLES, PassDecl, Port
 from .light_views import views_for
 
 TABLE_TEXELS = 6  # then RsmConfig.sky_rays texels of rays, when it asks for them
@@ -145,7 +145,7 @@ SHADOW_DECL = PassDecl("sky_shadow", "solve", (TRIANGLES, SKY_TABLE), (SKY_DEPTH
                        "every sky direction's small shadow map, into its tile of one atlas")
 BOUNDS_DECL = PassDecl("sky_bounds", "solve", (SKY_DEPTH,), (SKY_BOUNDS,),
                        "the atlas's depth bounds per block: most directions settled in one fetch")
-RSM_DECL = PassDecl("sky_rsm", "solve", (TRIANGLES, SKY_TABLE), SKY_RSM,
+RSM_DECL = PassDecl("sky_rsm", "solve", (TRIANGLES, ALBEDO_ATLAS, SKY_TABLE), SKY_RSM,
                     "every sky direction's RSM into its tile: the world's VPLs (vct)")
 DIRECT_DECL = PassDecl("sky_direct", "gather", (GBUF_POSITION, GBUF_NORMAL, SKY_DEPTH, SKY_BOUNDS, SKY_TABLE, BVH),
                        (DIRECT,), "the sky's shadowed direct light of every direction, in one pass (with rays: "
