@@ -12,9 +12,9 @@ void main() {
     out_position = vec4(p, 1.0);  // w = 1 marks geometry (coverage)
     out_normal = vec4(n, 0.0);
     // A textured Base Color: the texel under the pixel's centre times the material's other factors.
-    vec3 albedo = v_albedo_rect.z > 0.0
-        ? clamp(albedo_texture(albedo_atlas, v_albedo_rect, v_albedo_sampling, v_albedo_uv) * v_albedo_scale,
-                0.0, 1.0)
+    // (A textured triangle's v_albedo is that factor.)
+    vec3 albedo = v_albedo_rect.z != 0.0
+        ? clamp(albedo_texture(albedo_atlas, v_albedo_rect, v_albedo_uv) * v_albedo, 0.0, 1.0)
         : v_albedo;
     out_albedo = vec4(albedo, 1.0);
     out_specular = v_specular;

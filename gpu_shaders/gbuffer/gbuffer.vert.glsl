@@ -7,7 +7,5 @@ void main() {
     v_albedo = albedo;
     v_specular = specular;
     v_albedo_rect = albedo_rect;
-    v_albedo_sampling = albedo_sampling;
     v_albedo_uv = albedo_uv;
-    v_albedo_scale = albedo_scale;
 }

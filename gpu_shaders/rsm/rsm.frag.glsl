@@ -14,9 +14,8 @@ void main() {
     vec3 n = normalize(v_normal_ws);
     // A textured Base Color reflects the texel under the texel's centre (times the material's other
     // factors toward a diffuse surface); a flat one its albedo.
-    vec3 albedo = v_albedo_rect.z > 0.0
-        ? clamp(albedo_texture(albedo_atlas, v_albedo_rect, v_albedo_sampling, v_albedo_uv) * v_albedo_scale,
-                0.0, 1.0)
+    vec3 albedo = v_albedo_rect.z != 0.0
+        ? clamp(albedo_texture(albedo_atlas, v_albedo_rect, v_albedo_uv) * v_albedo, 0.0, 1.0)
         : v_albedo;
     vec3 flux;
     float area_m2;

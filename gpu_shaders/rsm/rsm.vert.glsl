@@ -4,9 +4,7 @@ void main() {
     v_pos_ws = pos_ws;
     v_plane_ws = plane_ws;
     v_normal_ws = normal_ws;
-    v_albedo = bounce_albedo;  // what it reflects toward other surfaces (Scene.bounce_albedo)
+    v_albedo = bounce_albedo;  // toward other surfaces (Scene.bounce_albedo; textured: its texels' factor)
     v_albedo_rect = albedo_rect;
-    v_albedo_sampling = albedo_sampling;
     v_albedo_uv = albedo_uv;
-    v_albedo_scale = albedo_bounce_scale;
 }

@@ -41,6 +41,12 @@ def test_halved_keeps_single_texel_sides_and_drops_an_odd_last_row():
 
 
 def test_triangle_attributes_name_each_triangles_rect_and_leave_flat_ones_zero():
+    # The rect's w is negative for Closest, its h for Extend; a flat triangle's rect is 0. The G-buffer's
+    # albedo and the RSMs' bounce albedo of a textured triangle are its texels' factors; a flat one keeps
+    # its own, and the probes' capture (which takes no texture) the per-triangle mean.
+    from addon.engine.methods.direct import triangle_attributes
+    from addon.engine.passes import gbuffer, probe_capture, rsm
+
     images = [np.ones((2, 4, 3), np.float32), np.ones((8, 8, 3), np.float32)]
     atlas = albedo_atlas.pack(images, width=16)
     uv = np.arange(4 * 3 * 2, dtype=np.float32).reshape(4, 3, 2)
@@ -50,11 +56,18 @@ def test_triangle_attributes_name_each_triangles_rect_and_leave_flat_ones_zero()
     select = np.array([True, True, True, False])
     attrs = albedo_atlas.triangle_attributes(textures, atlas, select)
     rect = attrs["albedo_rect"][::3]
-    np.testing.assert_array_equal(rect, [atlas.rects[1], [0, 0, 0, 0], atlas.rects[0]])
-    np.testing.assert_array_equal(attrs["albedo_sampling"][::3], [[0, 1], [0, 0], [1, 0]])
+    np.testing.assert_array_equal(rect, [atlas.rects[1] * [1, 1, 1, -1], [0, 0, 0, 0], atlas.rects[0] * [1, 1, -1, 1]])
     np.testing.assert_array_equal(attrs["albedo_uv"].reshape(3, 3, 2)[[0, 2]], uv[[0, 2]])
-    np.testing.assert_array_equal(attrs["albedo_scale"][::3], [[0.5] * 3, [0] * 3, [0.5] * 3])
-    np.testing.assert_array_equal(attrs["albedo_bounce_scale"][::3], [[0.25] * 3, [0] * 3, [0.25] * 3])
+
+    tris = np.array([[[0, 0, k], [1, 0, k], [0, 1, k]] for k in range(4)], np.float32)
+    scene = Scene(tris, np.zeros_like(tris), np.full((4, 3), 0.7, np.float32), np.zeros((4, 3), np.float32),
+                  bounce_albedo=np.full((4, 3), 0.9, np.float32), albedo_textures=textures)
+    seen = triangle_attributes(scene, gbuffer.SPEC, select, np.zeros((4, 4), np.float32), atlas)
+    np.testing.assert_allclose(seen["albedo"][::3], [[0.5] * 3, [0.7] * 3, [0.5] * 3])
+    lit = triangle_attributes(scene, rsm.SPEC, select, np.zeros((4, 4), np.float32), atlas)
+    np.testing.assert_allclose(lit["bounce_albedo"][::3], [[0.25] * 3, [0.9] * 3, [0.25] * 3])
+    captured = triangle_attributes(scene, probe_capture.SPEC, select, np.zeros((4, 4), np.float32), atlas)
+    np.testing.assert_allclose(captured["bounce_albedo"][::3], [[0.9] * 3] * 3)
 
 
 def test_prepared_keeps_each_kept_triangles_texture():

@@ -134,9 +134,21 @@ def triangle_attributes(scene: Scene, spec: ShaderSpec, select: np.ndarray | Non
         "specular": lambda: np.repeat(np.c_[scene.specular_f0()[sel], scene.glossy_roughness()[sel]], 3, axis=0),
     }
     names = [a.name for a in spec.attributes]
-    if any(name.startswith("albedo_") for name in names):
+    textures = scene.albedo_textures
+    if "albedo_rect" in names:
         build.update({name: (lambda array=array: array) for name, array in
-                      albedo_atlas.triangle_attributes(scene.albedo_textures, atlas, sel).items()})
+                      albedo_atlas.triangle_attributes(textures, atlas, sel).items()})
+        if textures is not None and atlas is not None:
+            # A pass that samples the texture reads a textured triangle's albedo as its texels' factor.
+            on = textures.index[sel] >= 0
+
+            def factor(flat: np.ndarray, scale: np.ndarray) -> np.ndarray:
+                out = np.asarray(flat[sel], np.float32).copy()
+                out[on] = scale[sel][on]
+                return np.repeat(out, 3, axis=0)
+
+            build["albedo"] = lambda: factor(scene.albedo, textures.scale)
+            build["bounce_albedo"] = lambda: factor(scene.bounce_reflectance(), textures.bounce_scale)
     return {name: build[name]() for name in names}
 
 

@@ -3,9 +3,10 @@ packed into one texture: a raster pass binds one sampler however many images the
 
 Inputs: Scene.albedo_textures (linear RGB images, row 0 = v 0; per triangle: image index, corner UVs,
 scales). Output: an RGBA32F texture (ATLAS_WIDTH wide, as tall as the packing needs) and per triangle
-the attributes `albedo_rect` (x0, y0, w, h in atlas texels; w = 0: a flat albedo), `albedo_sampling`
-(nearest, clamp: 1 or 0), `albedo_uv` and the scales. gbuffer/gbuffer.frag.glsl and rsm/rsm.frag.glsl
-sample it (common/albedo_texture.glsl) as Cycles' Image Texture node does at a ray's hit point: Closest reads
+the attributes `albedo_rect` (x0, y0, w, h in atlas texels, w negative for Closest and h for Extend;
+w = 0: a flat albedo) and `albedo_uv`; a textured triangle's albedo attribute holds its scale.
+gbuffer/gbuffer.frag.glsl and rsm/rsm.frag.glsl sample it (common/albedo_texture.glsl) as Cycles'
+Image Texture node does at a ray's hit point: Closest reads
 the texel the UV falls in, Linear interpolates the four around it (texel centres at (i + 0.5) / w),
 Repeat wraps, Extend clamps. The filtering is done by hand with texelFetch, so texels of one image
 never blend into another's (and there is no mip chain: Python-made textures have none, and Cycles'
@@ -87,23 +88,17 @@ def upload(backend: Backend, atlas: Atlas | None) -> Texture:
 
 def triangle_attributes(textures: AlbedoTextures | None, atlas: Atlas | None,
                         select: np.ndarray) -> dict[str, np.ndarray]:
-    """Per-vertex arrays (three vertices per selected triangle) of `albedo_rect`, `albedo_sampling`,
-    `albedo_uv` and the factors a texel is multiplied by: `albedo_scale` (the camera's, the G-buffer)
-    and `albedo_bounce_scale` (toward other surfaces, the RSMs); unused where the rect's width is 0."""
+    """Per-vertex arrays (three vertices per selected triangle) of `albedo_rect`, the image's (x0, y0,
+    w, h) in the atlas with w negative for Closest and h negative for Extend (0: a flat albedo), and
+    `albedo_uv`. A textured triangle's albedo attribute carries the factor its texels are multiplied by
+    (methods/direct.triangle_attributes)."""
     count = int(select.sum())
     rect = np.zeros((count, 4), np.float32)
-    sampling = np.zeros((count, 2), np.float32)
     uv = np.zeros((count, 3, 2), np.float32)
-    scale, bounce_scale = np.zeros((count, 3), np.float32), np.zeros((count, 3), np.float32)
     if textures is not None and atlas is not None:
         index = textures.index[select]
         on = index >= 0
-        rect[on] = atlas.rects[index[on]]
-        flags = np.c_[np.asarray(textures.nearest, np.float32), np.asarray(textures.clamp, np.float32)]
-        sampling[on] = flags[index[on]]
+        signs = np.c_[np.where(textures.nearest, -1.0, 1.0), np.where(textures.clamp, -1.0, 1.0)]
+        rect[on] = atlas.rects[index[on]] * np.c_[np.ones((len(signs), 2)), signs][index[on]]
         uv[on] = textures.uv[select][on]
-        scale[on] = textures.scale[select][on]
-        bounce_scale[on] = textures.bounce_scale[select][on]
-    return {"albedo_rect": np.repeat(rect, 3, axis=0), "albedo_sampling": np.repeat(sampling, 3, axis=0),
-            "albedo_uv": uv.reshape(-1, 2), "albedo_scale": np.repeat(scale, 3, axis=0),
-            "albedo_bounce_scale": np.repeat(bounce_scale, 3, axis=0)}
+    return {"albedo_rect": np.repeat(rect, 3, axis=0), "albedo_uv": uv.reshape(-1, 2)}

@@ -1,11 +1,11 @@
 """G-buffer pass: rasterize the scene from the camera.
 
 Inputs: the scene's triangles (mesh attributes pos_ws, plane_ws (methods/direct.face_planes), normal_ws,
-albedo, specular, and the Base Color texture's albedo_rect, albedo_sampling, albedo_uv, albedo_scale:
-passes/albedo_atlas.py) and the albedo atlas (sampler). Uniforms: view_projection, camera_pos_ws.
+albedo, specular, and the Base Color texture's albedo_rect and albedo_uv: passes/albedo_atlas.py) and
+the albedo atlas (sampler). Uniforms: view_projection, camera_pos_ws.
 Outputs (RGBA32F, camera resolution, GL row 0 = bottom): position (world, m, on its triangle's plane;
 w = 1 where geometry), normal (world, unit, flipped towards the camera), albedo (diffuse, linear: the
-texel times albedo_scale where the triangle has a texture, else its flat albedo), specular (rgb = the
+texel times the albedo attribute where the triangle has a texture, else that albedo), specular (rgb = the
 glossy lobe's F0, a = roughness; Scene.specular). Depth: 32F.
 """
 
@@ -23,12 +23,10 @@ SPEC = ShaderSpec(
     uniforms=(Var("view_projection", "mat4"), Var("camera_pos_ws", "vec3")),
     samplers=(Sampler("albedo_atlas", "2D"),),
     attributes=(Var("pos_ws", "vec3"), Var("plane_ws", "vec4"), Var("normal_ws", "vec3"), Var("albedo", "vec3"),
-                Var("specular", "vec4"), Var("albedo_rect", "vec4"), Var("albedo_sampling", "vec2"),
-                Var("albedo_uv", "vec2"), Var("albedo_scale", "vec3")),
+                Var("specular", "vec4"), Var("albedo_rect", "vec4"), Var("albedo_uv", "vec2")),
     varyings=(Var("v_pos_ws", "vec3"), Var("v_plane_ws", "vec4", "flat"), Var("v_normal_ws", "vec3"),
               Var("v_albedo", "vec3"), Var("v_specular", "vec4"), Var("v_albedo_rect", "vec4", "flat"),
-              Var("v_albedo_sampling", "vec2", "flat"), Var("v_albedo_uv", "vec2"),
-              Var("v_albedo_scale", "vec3", "flat")),
+              Var("v_albedo_uv", "vec2")),
     outputs=(Var("out_position", "vec4"), Var("out_normal", "vec4"), Var("out_albedo", "vec4"),
              Var("out_specular", "vec4")),
 )

@@ -1,13 +1,13 @@
 """Reflective shadow map pass (Dachsbacher & Stamminger 2005): the scene seen from one light face.
 
 Inputs: scene triangles (pos_ws, plane_ws (methods/direct.face_planes: which side the light sees),
-normal_ws, bounce_albedo, and a Base Color texture's albedo_rect, albedo_sampling, albedo_uv,
-albedo_bounce_scale: passes/albedo_atlas.py), the albedo atlas (sampler), a LightView
+normal_ws, bounce_albedo, and a Base Color texture's albedo_rect and albedo_uv: passes/albedo_atlas.py),
+the albedo atlas (sampler), a LightView
 (light_views.py). Outputs (RGBA32F, resolution^2, GL row 0 = bottom): position (world, m; w = 1 where
 geometry), normal (world, flipped where the light sees its triangle's back), flux (W reflected by the
 texel's surfel: albedo x I(w) x texel solid angle, or albedo x sun irradiance x texel area; the albedo
-the texel under the texel's centre times albedo_bounce_scale on a textured triangle, else
-bounce_albedo). The flux sums to the light's reflected power (tested against
+the texel under the texel's centre times bounce_albedo on a textured triangle, which holds the
+texels' factor there, else bounce_albedo). The flux sums to the light's reflected power (tested against
 the analytic cone integral). With Light.occluder_radius_m (an emissive mesh's lamp: the emitter's own
 surface) the flux is reduced by the view factor from the surfel to that disc,
 light_views.disc_view_factor: what the surfel sends back at the emitter stops there.
@@ -35,11 +35,9 @@ SPEC = ShaderSpec(
     ),
     samplers=(Sampler("albedo_atlas", "2D"),),
     attributes=(Var("pos_ws", "vec3"), Var("plane_ws", "vec4"), Var("normal_ws", "vec3"),
-                Var("bounce_albedo", "vec3"), Var("albedo_rect", "vec4"), Var("albedo_sampling", "vec2"),
-                Var("albedo_uv", "vec2"), Var("albedo_bounce_scale", "vec3")),
+                Var("bounce_albedo", "vec3"), Var("albedo_rect", "vec4"), Var("albedo_uv", "vec2")),
     varyings=(Var("v_pos_ws", "vec3"), Var("v_plane_ws", "vec4", "flat"), Var("v_normal_ws", "vec3"),
-              Var("v_albedo", "vec3"), Var("v_albedo_rect", "vec4", "flat"), Var("v_albedo_sampling", "vec2", "flat"),
-              Var("v_albedo_uv", "vec2"), Var("v_albedo_scale", "vec3", "flat")),
+              Var("v_albedo", "vec3"), Var("v_albedo_rect", "vec4", "flat"), Var("v_albedo_uv", "vec2")),
     outputs=(Var("out_position", "vec4"), Var("out_normal", "vec4"), Var("out_flux", "vec4")),
 )
 
