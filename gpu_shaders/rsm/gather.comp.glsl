@@ -1,10 +1,11 @@
 // RSM indirect gather (Dachsbacher & Stamminger 2005), no visibility: every pixel sums the light of
 // VPLs drawn from one RSM face, added to `indirect` in Cycles' Diffuse Indirect unit (E / pi).
 //
-// Sampling: the RSM is split into strata_per_side^2 = k^2 blocks; each pixel makes k^2 strata draws
-// (its own hash, so the estimate is unbiased and the noise is per-pixel, not structured), each in a
-// block picked with the probability block_pdf gives it and then uniformly within the block, weighted by
-// 1 / (expected draws per texel) (refinement gathers step along a sequence, below). block_pdf is the
+// Sampling: the RSM is split into strata_per_side^2 = k^2 blocks; each pixel makes k^2 strata draws,
+// each in a block picked with the probability block_pdf gives it and then uniformly within the block,
+// weighted by 1 / (expected draws per texel). A draw's random numbers are the image's for that draw plus
+// the pixel pattern (common/pixel_pattern.glsl), which steps along a sequence in refinement gathers:
+// uniform at each pixel, so its estimate is unbiased, and spread over the pixels the filter averages. block_pdf is the
 // blocks' view importance (rsm/importance*.comp.glsl): the mean over receivers spread across the
 // G-buffer of the share of each one's light the block holds, half of it uniform; uniform, it is one
 // draw per block. Under Sponza's sun 7 % of the map's texels can light anything the camera sees (the
@@ -42,7 +43,11 @@
 // half-cell steps through the voxelizer's occupancy).
 
 #include "common/hash.glsl"
+#include "common/pixel_pattern.glsl"
 #include "rsm/vpl.glsl"
+
+// The hash's first key for the image's random numbers (each draw's, shared by every pixel).
+const uint IMAGE_ID = 0xffffffffu;
 
 // The near squares' sides in blocks: a quarter block, a block, four blocks (below).
 const vec3 NEAR_SIDE_BLOCKS = vec3(0.25, 1.0, 4.0);
@@ -108,7 +113,6 @@ void main() {
     vec2 block = vec2(rsm_size) / float(strata_per_side);
     float weight = block.x * block.y;
     float disk_share = DISK_SHARE * weight;
-    uint pixel_id = uint(px.y * 65536 + px.x);
     // The receiver's own texel. No near draws where it lies behind the light's view (a cube face's
     // back) or far off the map (where the texel would overflow an int): a choice per pixel, so the
     // densities stay those of the draws made.
@@ -121,13 +125,11 @@ void main() {
     int near_draws = near_strata * near_strata;
     // No near draws: no near density either, so every draw keeps the strata's weight alone.
     vec3 densities = near ? float(near_draws) / vec3(sides * sides) : vec3(0.0);
-    // Progressive refinement: the n-th gather (sample_index) keeps the update's draws and moves each
-    // by n x the R2 sequence's steps (Roberts 2018) within its block, and its block choice by n x the
-    // golden ratio, so a pixel's draws over the samples form one low-discrepancy set (each still drawn
-    // with the same densities: unbiased). Cornell 128 px, 16 samples: noise 0.012 with a fresh seed per
-    // sample, 0.0058 so.
-    vec2 sample_step = float(sample_index) * vec2(0.75487767, 0.56984029) + set_shift;
-    float choice_step = float(sample_index) * 0.61803399 + set_shift;
+    // The pixel's offsets to the image's random numbers: the pattern, whose n-th refinement gather
+    // (sample_index) steps each pixel's draws along a sequence of their own (each still drawn with the
+    // same densities: unbiased), and the draw set's shift. Cornell 128 px, 16 samples: noise 0.012 with
+    // a fresh seed per sample, 0.0058 with the per-pixel hash stepped along R2 that preceded the pattern.
+    vec3 offset = pixel_pattern(px, sample_index) + set_shift;
     // The strata, draws [row_begin k, row_end k) of k^2. Unguided (block_pdf.y = 0, the same in every
     // block): draw s = j k + i takes a texel uniformly in block (i, j). Guided: draw s picks its block by
     // inverting block_pdf's running sum at (s + v) / k^2, one draw per interval of equal probability,
@@ -145,7 +147,7 @@ void main() {
         ivec2 texels = block_lo(i + 1, rsm_size) - lo;
         for (int s = row_begin * strata_per_side; s < row_end * strata_per_side; ++s) {
             uint stratum = uint(s);
-            float v = fract(random01(pixel_id, stratum + 0x40000000u, uint(seed)) + choice_step);
+            float v = fract(random01(IMAGE_ID, stratum + 0x40000000u, uint(seed)) + offset.z);
             float u = (float(s) + v) / float(blocks);
             if (cdf_end <= u) {
                 while (cdf_end <= u && b < blocks - 1) {
@@ -160,8 +162,8 @@ void main() {
             if (any(equal(texels, ivec2(0)))) {
                 continue;  // a map of fewer texels than blocks a side: this block holds none
             }
-            vec2 w = fract(vec2(random01(pixel_id, stratum, uint(seed) * 2u),
-                                random01(pixel_id, stratum, uint(seed) * 2u + 1u)) + sample_step);
+            vec2 w = fract(vec2(random01(IMAGE_ID, stratum, uint(seed) * 2u),
+                                random01(IMAGE_ID, stratum, uint(seed) * 2u + 1u)) + offset.xy);
             ivec2 t = lo + min(ivec2(w * vec2(texels)), texels - 1);
             // strata_density(t) without its look-ups: t lies in block i, drawn with probability pdf.
             float density = float(blocks) * pdf / float(texels.x * texels.y);
@@ -171,8 +173,8 @@ void main() {
         for (int j = row_begin; j < row_end; ++j) {
             for (int i = 0; i < strata_per_side; ++i) {
                 uint stratum = uint(j * strata_per_side + i);
-                vec2 w = fract(vec2(random01(pixel_id, stratum, uint(seed) * 2u),
-                                    random01(pixel_id, stratum, uint(seed) * 2u + 1u)) + sample_step);
+                vec2 w = fract(vec2(random01(IMAGE_ID, stratum, uint(seed) * 2u),
+                                    random01(IMAGE_ID, stratum, uint(seed) * 2u + 1u)) + offset.xy);
                 ivec2 t = min(ivec2((vec2(i, j) + w) * block), rsm_size - 1);
                 float density = 1.0 / weight + near_density(t, centre, sides, densities);
                 irradiance += vpl_light(t, x, n, disk_share) / density;
@@ -186,8 +188,8 @@ void main() {
             vec2 cell = vec2(float(side) / float(near_strata));
             for (int s = 0; s < near_draws; ++s) {
                 uint draw = uint(strata_per_side * strata_per_side + k * near_draws + s);
-                vec2 u = fract(vec2(random01(pixel_id, draw, uint(seed) * 2u),
-                                    random01(pixel_id, draw, uint(seed) * 2u + 1u)) + sample_step);
+                vec2 u = fract(vec2(random01(IMAGE_ID, draw, uint(seed) * 2u),
+                                    random01(IMAGE_ID, draw, uint(seed) * 2u + 1u)) + offset.xy);
                 vec2 within = (vec2(s % near_strata, s / near_strata) + u) * cell;
                 ivec2 t = centre - side / 2 + min(ivec2(within), ivec2(side - 1));
                 if (any(lessThan(t, ivec2(0))) || any(greaterThanEqual(t, rsm_size))) {

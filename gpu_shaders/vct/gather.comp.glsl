@@ -4,20 +4,8 @@
 // pixel of its scale x scale block (upsample.comp.glsl brings them back to full size).
 #include "vct/diffuse.glsl"
 #include "vct/source_pixel.glsl"
+#include "common/pixel_pattern.glsl"
 
-// The sampling pattern's per-pixel steps (main): pixel (x, y) adds x * column 0 + y * column 1 to the
-// image's random (jitter, rotation / 2 pi, dither), modulo 1. The constants are the inverse powers of the
-// plastic number p (p^-1 .. p^-4) and of the 3-dimensional R sequence's root (1.2207...^-1), whose
-// multiples are far from each other modulo 1 (Roberts 2018: the R-sequence dither masks).
-const vec2 JITTER_STEP = vec2(0.7548776662, 0.5698402910);
-const vec2 ROTATION_STEP = vec2(0.5698402910, 0.3247179572);
-const vec2 DITHER_STEP = vec2(0.3247179572, 0.8191725134);
-// The step of the n-th gather of a progressive refinement (sample_index): each pixel's samples form a
-// Kronecker sequence of their own. Chosen among random steps for two things at once: the first 16
-// points are spread out (nearest pair 0.15 apart in (jitter, rotation) / 2 pi, R2's 0.17) and no
-// n x step (n < 16) comes within 0.02 of the pattern's offset to a pixel within 8 px, so no pixel
-// repeats a neighbour's cones (R2's steps are the pattern's own: sample n at x is sample 0 at x + n).
-const vec3 SAMPLE_STEP = vec3(0.758266, 0.824043, 0.956173);
 // The streams of the image's three random numbers: random01(stream, stream, seed).
 const uvec3 PATTERN_STREAMS = uvec3(0x2c1b3c6du, 0x5bd1e995u, DITHER_STREAM);
 
@@ -34,24 +22,20 @@ void main() {
         return;
     }
     vec3 n = normalize(texelFetch(gbuf_normal, src, 0).xyz);
-    // Each pixel's (jitter, rotation, dither) is the image's random numbers plus a pattern that moves
-    // by a fixed irrational step from pixel to pixel (a Kronecker lattice over the image), so each is
-    // uniform on its own (every pixel's estimate unbiased) while any neighbourhood the denoise filter
-    // averages holds well spread cone sets. Its error therefore sits at high frequencies, where the
-    // filter removes it, where 8 x 8 tiles of a 64-phase lattice with a random shift per tile
-    // (Keller & Heidrich's interleaved sampling) left independent per-tile errors that passed the filter
-    // as blotches. docs/VCT.md has the noise figures; of the steps tried, others (the 3-dimensional R
-    // sequence's, p's turned by 90 degrees, two picked by a Fourier criterion) read 0.040-0.084 on
-    // cornell at 128 px, against these 0.037-0.039.
-    // Progressive refinement: the n-th gather adds n x SAMPLE_STEP (docs/VCT.md). New random numbers
-    // per gather instead: cornell 128 px, 16 gathers, 0.0115 against 0.0081, Sponza 0.0177 against
-    // 0.0118; two other steps of the same search read 0.0131 and 0.0151 on Sponza.
+    // Each pixel's (jitter, rotation, dither): the image's random numbers plus the pixel pattern
+    // (common/pixel_pattern.glsl), which replaced 8 x 8 tiles of a 64-phase lattice with a random shift
+    // per tile (Keller & Heidrich's interleaved sampling): their per-tile errors were independent and
+    // passed the filter as blotches. docs/VCT.md has the noise figures; of the pattern's steps tried,
+    // others (the 3-dimensional R sequence's, p's turned by 90 degrees, two picked by a Fourier
+    // criterion) read 0.040-0.084 on cornell at 128 px, against these 0.037-0.039. New random numbers
+    // per refinement gather instead of the pattern's sample step: cornell 128 px, 16 gathers, 0.0115
+    // against 0.0081, Sponza 0.0177 against 0.0118; two other steps of the same search read 0.0131 and
+    // 0.0151 on Sponza.
     uint s = uint(seed) * 2u;
     vec3 image_random = vec3(random01(PATTERN_STREAMS.x, PATTERN_STREAMS.x, s),
                              random01(PATTERN_STREAMS.y, PATTERN_STREAMS.y, s),
                              random01(PATTERN_STREAMS.z, PATTERN_STREAMS.z, s));
-    vec3 u = fract(image_random + float(sample_index) * SAMPLE_STEP
-                   + vec3(dot(vec2(px), JITTER_STEP), dot(vec2(px), ROTATION_STEP), dot(vec2(px), DITHER_STEP)));
+    vec3 u = fract(image_random + pixel_pattern(px, sample_index));
     float jitter = u.x, rotation = 6.28318531 * u.y, dither = u.z;
     vec4 e = gather_diffuse(pos.xyz, n, rotation, jitter, dither);
     // Where the denoise filter will find little of the pixel's own surface around it (`support`, from
