@@ -12,6 +12,7 @@
 // (addon/engine/brdf.py; split_albedo holds A, B at (n.v, roughness)) is the reflected light. Pixels
 // whose F0 is 0 (no glossy lobe) trace nothing.
 #include "vct/cone.glsl"
+#include "common/pixel_pattern.glsl"
 
 float smith_lambda(float cos_theta, float alpha) {
     float c2 = clamp(cos_theta * cos_theta, 1e-6, 1.0);
@@ -38,10 +39,15 @@ void main() {
     vec3 tx, ty;
     tangent_frame(n, tx, ty);
     vec3 g0 = (pos.xyz - grid_origin) / cell_size + offset_cells * n;
+    // (jitter, rotation, dither): the image's random numbers plus the pixel pattern, as the diffuse
+    // gather's (common/pixel_pattern.glsl). A refinement gather comes with a new seed (gather_seed), so
+    // its numbers are new for the whole image. cornell-glossy at 128 px, the glossy product's rel_rmse
+    // between seeds 2j and 2j + 1 (j < 4, root mean square; over the pixels any seed lights): one update 0.088 -> 0.087 (its light is a few bright reflections), 16
+    // gathers 0.0258 -> 0.0212, against each pixel's own random numbers.
     uint s = uint(seed) * 2u + 1u;
-    float rotation = 6.28318531 * random01(uint(px.x), uint(px.y), s);
-    float jitter = random01(uint(px.x), uint(px.y), s + 1u);
-    float dither = random01(uint(px.x), uint(px.y), hash_u32(s ^ DITHER_STREAM));
+    vec3 draw = fract(vec3(random01(0u, 0u, s), random01(0u, 0u, s + 1u), random01(0u, 0u, hash_u32(s ^ DITHER_STREAM)))
+                   + pixel_pattern(px, 0));
+    float jitter = draw.x, rotation = 6.28318531 * draw.y, dither = draw.z;
     float lambda_v = smith_lambda(n_dot_v, alpha);
     vec3 radiance = vec3(0.0);
     float weights = 0.0;
