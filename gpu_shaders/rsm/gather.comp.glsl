@@ -5,8 +5,8 @@
 // each in a block picked with the probability block_pdf gives it and then uniformly within the block,
 // weighted by 1 / (expected draws per texel). A draw's random numbers are the image's for that draw plus
 // the pixel pattern (common/pixel_pattern.glsl), which steps along a sequence in refinement gathers:
-// uniform at each pixel, so its estimate is unbiased, and spread over the pixels the filter averages. block_pdf is the
-// blocks' view importance (rsm/importance*.comp.glsl): the mean over receivers spread across the
+// uniform at each pixel, so its estimate is unbiased, and spread over the pixels the filter averages.
+// block_pdf is the blocks' view importance (rsm/importance*.comp.glsl): the mean over receivers spread across the
 // G-buffer of the share of each one's light the block holds, half of it uniform; uniform, it is one
 // draw per block. Under Sponza's sun 7 % of the map's texels can light anything the camera sees (the
 // rest is roof facing the sky), so uniform draws mostly miss. One dispatch handles draws

@@ -42,11 +42,13 @@ void main() {
     // (jitter, rotation, dither): the image's random numbers plus the pixel pattern, as the diffuse
     // gather's (common/pixel_pattern.glsl). A refinement gather comes with a new seed (gather_seed), so
     // its numbers are new for the whole image. cornell-glossy at 128 px, the glossy product's rel_rmse
-    // between seeds 2j and 2j + 1 (j < 4, root mean square; over the pixels any seed lights): one update 0.088 -> 0.087 (its light is a few bright reflections), 16
-    // gathers 0.0258 -> 0.0212, against each pixel's own random numbers.
+    // between seeds 2j and 2j + 1 (j < 4, root mean square; over the pixels any seed lights): one
+    // update 0.088 -> 0.087 (its light is a few bright reflections), 16 gathers 0.0258 -> 0.0212,
+    // against each pixel's own random numbers.
     uint s = uint(seed) * 2u + 1u;
-    vec3 draw = fract(vec3(random01(0u, 0u, s), random01(0u, 0u, s + 1u), random01(0u, 0u, hash_u32(s ^ DITHER_STREAM)))
-                   + pixel_pattern(px, 0));
+    vec3 image_random = vec3(random01(0u, 0u, s), random01(0u, 0u, s + 1u),
+                             random01(0u, 0u, hash_u32(s ^ DITHER_STREAM)));
+    vec3 draw = fract(image_random + pixel_pattern(px, 0));
     float jitter = draw.x, rotation = 6.28318531 * draw.y, dither = draw.z;
     float lambda_v = smith_lambda(n_dot_v, alpha);
     vec3 radiance = vec3(0.0);
