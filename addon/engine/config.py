@@ -175,7 +175,7 @@ class VctConfig(_Validated):
     """Voxel cone tracing (method `vct`): docs/VCT.md derives the units and measures the settings."""
 
     voxel_cells: int = _num(64, 8, 256, "voxel grid cells along the scene's longest side")
-    diffuse_cones: int = _num(16, 3, 32, "cones per gather point, each 2 pi / n sr of the hemisphere")
+    diffuse_cones: int = _num(16, 3, 32, "cones per gather point, each 1 / n of the cosine-weighted hemisphere")
     bounce_cones: int = _num(6, 3, 32, "cones per voxel side for bounces after the first (smoother light)")
     step_ratio: float = _num(1.0, 0.1, 2.0, "march step as a fraction of the sampled voxel's size")
     offset_cells: float = _num(1.5, 0.0, 4.0, "cone origins moved off their surface along the normal, in cells")
