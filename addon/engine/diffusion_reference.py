@@ -133,17 +133,37 @@ def inject(grid, positions_m: np.ndarray, normals: np.ndarray, flux_w: np.ndarra
     return plus, minus
 
 
+EVERY_CLASS = -1  # emit / add: every side, no emitter class singled out
+
+
+def emitter_class(normal: np.ndarray) -> np.ndarray:
+    """The emitter class of sides with these normals (..., 3): the dominant signed axis, numbered as
+    AXES (ties go to the lower axis)."""
+    a = np.abs(np.asarray(normal, np.float64))
+    axis = np.where((a[..., 0] >= a[..., 1]) & (a[..., 0] >= a[..., 2]), 0, np.where(a[..., 1] >= a[..., 2], 1, 2))
+    negative = np.take_along_axis(np.asarray(normal), axis[..., None], -1)[..., 0] < 0.0
+    return 2 * axis + negative
+
+
 def emit(flux_plus: np.ndarray, flux_minus: np.ndarray, normal: np.ndarray, occupied: np.ndarray,
-         albedo: np.ndarray | float = 1.0) -> np.ndarray:
+         albedo: np.ndarray | float = 1.0, emitter_class_only: int = EVERY_CLASS) -> np.ndarray:
     """The field of Lambertian emitters (z, y, x, 4): each side of a cell's plane reflects albedo x its
     flux (W) as a clamped-cosine lobe about its normal, albedo x flux / pi x cosine_lobe(+-n) (flux
     exactly albedo x flux); an empty cell (a VPL whose surface fell in no occupied cell) emits it
-    isotropically."""
+    isotropically. With `emitter_class_only` (0..5), one emitter class's propagation: only the sides of
+    that class emit, and an empty cell 1/5 of its light (a side takes in five classes' light, all but
+    its own, so it receives all of an empty cell's)."""
     fp = np.asarray(flux_plus, np.float64) * albedo
     fm = np.asarray(flux_minus, np.float64) * albedo
+    share = 1.0
+    if emitter_class_only != EVERY_CLASS:
+        fp = fp * (emitter_class(normal) == emitter_class_only)
+        fm = fm * (emitter_class(-np.asarray(normal)) == emitter_class_only)
+        share = 0.2
     lobes = (fp[..., None] * sh.cosine_lobe_l1(normal) + fm[..., None] * sh.cosine_lobe_l1(-np.asarray(normal)))
     iso = np.zeros_like(lobes)
-    iso[..., 0] = (fp + fm) / FLUX_PER_C0
+    iso[..., 0] = share * (np.asarray(flux_plus, np.float64) + np.asarray(flux_minus, np.float64)) * albedo \
+        / FLUX_PER_C0
     return np.where(np.asarray(occupied)[..., None], lobes / np.pi, iso)
 
 

@@ -127,9 +127,11 @@ def test_propagation_steps_are_the_twins(gl, transfer):
         np.testing.assert_allclose(got_minus[..., ch], minus[ch], rtol=0, atol=RTOL * minus.max())
 
 
-def test_emitters_are_the_twins(gl):
+@pytest.mark.parametrize("emitter_class", [ref.EVERY_CLASS, 0, 5])
+def test_emitters_are_the_twins(gl, emitter_class):
     # From the injection atlas (no albedo: the VPLs' flux is reflected light already) and from absorbed
-    # flux volumes times the voxels' albedo; empty cells emit isotropically; every cell is written.
+    # flux volumes times the voxels' albedo; empty cells emit isotropically; every cell is written. One
+    # emitter class's emitters: the sides of that class alone, and 1/5 of an empty cell's light.
     rng = np.random.default_rng(3)
     voxels = random_voxels(rng, GRID)
     textures, cells = gpu_cells(gl, voxels)
@@ -149,12 +151,13 @@ def test_emitters_are_the_twins(gl):
     for source, albedo in ((tiles, None), (volumes, voxels["vox_albedo"])):
         out = sh_volumes(gl, GRID, [np.full(zyx(GRID), 9.0, np.float32)] * 3)
         if albedo is None:
-            diffusion_inject.emit(gl, source, cells, out, GRID, atlas=atlas)
+            diffusion_inject.emit(gl, source, cells, out, GRID, atlas=atlas, emitter_class=emitter_class)
         else:
-            diffusion_inject.emit(gl, source, cells, out, GRID, vox_albedo=textures["vox_albedo"])
+            diffusion_inject.emit(gl, source, cells, out, GRID, vox_albedo=textures["vox_albedo"],
+                                  emitter_class=emitter_class)
         for ch, c in enumerate("rgb"):
             a = 1.0 if albedo is None else albedo[..., ch]
-            want = ref.emit(fp[..., ch], fm[..., ch], cell["normal"], cell["occupied"], a)
+            want = ref.emit(fp[..., ch], fm[..., ch], cell["normal"], cell["occupied"], a, emitter_class)
             np.testing.assert_allclose(gl.read(out[f"sh_{c}"]), want, rtol=0, atol=RTOL * np.abs(want).max())
 
 
@@ -206,12 +209,35 @@ def test_injection_is_the_twins(gl):
 def test_add_sums_bounces(gl):
     rng = np.random.default_rng(5)
     a, b = (rng.random(zyx(GRID)).astype(np.float32) for _ in range(2))
+    _, cells = gpu_cells(gl, random_voxels(rng, GRID))
     bounce = {k: gl.texture(GRID.dims, "RGBA32F", a) for k in ("flux_plus", "flux_minus")}
     total = {k: gl.texture(GRID.dims, "RGBA32F", b) for k in ("flux_plus", "flux_minus")}
-    diffusion_propagate.add(gl, bounce, total, GRID, first=True)
+    diffusion_propagate.add(gl, bounce, total, GRID, first=True, cell_normal=cells["cell_normal"])
     np.testing.assert_array_equal(gl.read(total["flux_plus"]), a)
-    diffusion_propagate.add(gl, bounce, total, GRID, first=False)
+    diffusion_propagate.add(gl, bounce, total, GRID, first=False, cell_normal=cells["cell_normal"])
     np.testing.assert_allclose(gl.read(total["flux_minus"]), 2 * a, rtol=1e-7)
+
+
+@pytest.mark.parametrize("skip_class", [0, 3])
+def test_add_skips_the_sides_of_the_propagated_class(gl, skip_class):
+    # One emitter class's propagation reaches every side but those of its own class (the dominant signed
+    # axis of the side's normal: the plus side's n, the minus side's -n): those keep their total, and
+    # with first=True start from 0.
+    rng = np.random.default_rng(6)
+    voxels = random_voxels(rng, GRID, share=1.0)
+    _, cells = gpu_cells(gl, voxels)
+    normal = gl.read(cells["cell_normal"])[..., :3]
+    a, b = (rng.random(zyx(GRID)).astype(np.float32) for _ in range(2))
+    bounce = {k: gl.texture(GRID.dims, "RGBA32F", a) for k in ("flux_plus", "flux_minus")}
+    for first in (True, False):
+        total = {k: gl.texture(GRID.dims, "RGBA32F", b) for k in ("flux_plus", "flux_minus")}
+        diffusion_propagate.add(gl, bounce, total, GRID, first=first, cell_normal=cells["cell_normal"],
+                                skip_class=skip_class)
+        for side, n in (("flux_plus", normal), ("flux_minus", -normal)):
+            skipped = (ref.emitter_class(n) == skip_class)[..., None]
+            assert skipped.any() and not skipped.all()
+            kept = 0.0 if first else b
+            np.testing.assert_allclose(gl.read(total[side]), np.where(skipped, kept, kept + a), rtol=1e-7)
 
 
 def test_lookup_is_the_twins(gl):

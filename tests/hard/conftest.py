@@ -107,14 +107,6 @@ VCT_KNOWN_DEFECTS = {
 # closed shape smaller than two cells has no empty inside for its inner faces' light.
 DIFFUSION = "diffusion: "
 DIFFUSION_KNOWN_DEFECTS = {
-    "test_one_triangle[diffusion]": "indirect 0.11 where the exact answer is 0: the lit plane's light diffuses "
-                                    "back onto it (cone 0.44)",
-    "test_km_terrain_under_sun[diffusion]": "indirect 0.040 of direct on a flat terrain that cannot light itself "
-                                            "(its own light diffused back; cone 0.073)",
-    "test_million_triangle_floor[diffusion]": "indirect up to 0.014 on a lone floor that cannot light itself "
-                                              "(its own light diffused back; cone 0.10)",
-    "test_two_hundred_lights[diffusion]": "indirect 0.014 on a lone plane that cannot receive a bounce (its own "
-                                          "light diffused back; cone 0.055)",
     "test_thin_wall_between_rooms[diffusion]": "indirect in the dark room 0.017 of the lit room's mean direct "
                                                 "(bound 0.01): it passed (0) while the lookup read every "
                                                 "occupied side; skipping the sides no light can reach lets some "

@@ -3,11 +3,13 @@
 Passes: those of `direct` (G-buffer, per light face: rsm, direct_light); once per geometry change the
 shared voxelizer (voxelize) and diffusion_cells (each cell's plane, absorption and open faces); per RSM
 face diffusion_inject (its VPLs' flux onto the sides of their cells' planes); once per update, for each
-bounce: diffusion_emit (the sides' flux as Lambertian L1 SH lobes about their normals: the injected
-direct light, then each bounce's absorbed flux times albedo), steps x diffusion_propagate (gather form,
-ping-pong, absorbed flux accumulated per side), and the bounce added to the light field
-(diffusion_propagate.add); the gather: diffusion_lookup -> `indirect` (Cycles' Diffuse Indirect). The
-light field does not depend on the camera: a camera move re-runs only the lookup.
+bounce and emitter class (six with DiffusionConfig.emitter_class_passes, else one): diffusion_emit (the
+sides' flux as Lambertian L1 SH lobes about their normals: the injected direct light, then each bounce's
+absorbed flux times albedo), steps x diffusion_propagate (gather form, ping-pong, absorbed flux
+accumulated per side), the class's light added to the bounce's at every side of another class, and the
+bounce added to the light field (diffusion_propagate.add); the gather: diffusion_lookup -> `indirect`
+(Cycles' Diffuse Indirect). The light field does not depend on the camera: a camera move re-runs only
+the lookup.
 docs/DIFFUSION.md derives the transport and measures it; diffusion_reference.py is its numpy twin.
 
 Products: direct, indirect, albedo.
@@ -67,8 +69,12 @@ class DiffusionMethod(OneBounceMethod):
             self.cells = diffusion_cells.textures(be, grid)
             self.atlas, self.injected, self._inject_target = diffusion_inject.atlas_target(be, grid)
             self.snapshots = [{f"sh_{c}": be.texture(grid.dims) for c in "rgb"} for _ in range(2)]
-            self.absorbed = diffusion_propagate.sides(be, grid)  # one bounce's
-            self.accumulated = diffusion_propagate.sides(be, grid) if self.gi.bounces > 1 else self.absorbed
+            self.absorbed = diffusion_propagate.sides(be, grid)  # one propagation's
+            # One bounce's flux, every class's but each side's own (the last bounce's emits the next), or
+            # the propagation's itself when there is one class.
+            self.bounce_flux = ([diffusion_propagate.sides(be, grid) for _ in range(min(2, self.gi.bounces))]
+                                if self.diffusion_config.emitter_class_passes else [self.absorbed])
+            self.accumulated = diffusion_propagate.sides(be, grid) if self.gi.bounces > 1 else self.bounce_flux[0]
             self._points = atlas.texel_points(be, self.rsm_config.resolution, diffusion_inject.SPEC)
         self.voxels = self.voxelizer.run()
         diffusion_cells.run(be, self.voxels, self.cells, self.grid)
@@ -82,24 +88,37 @@ class DiffusionMethod(OneBounceMethod):
                                  self.cells["cell_normal"])
 
     def finish_solve(self, timings: dict[str, float]) -> None:
-        """Each bounce: emitters (the injected light, then the last bounce's absorbed flux x albedo), its
-        propagation into `absorbed`, added to `accumulated` (the same volumes with one bounce)."""
-        be, grid = self.backend, self.grid
+        """Each bounce: per emitter class, its emitters (the injected light, then the last bounce's
+        absorbed flux x albedo) and their propagation into `absorbed`, added to the bounce's flux at the
+        sides of the other classes; the bounce added to `accumulated` (the same volumes with one bounce)."""
+        be, grid, cells = self.backend, self.grid, self.cells
         steps = steps_per_bounce(self.diffusion_config, grid, self.gi.bounces)
         transfer = self.diffusion_config.transfer
+        classes = (diffusion_inject.EMITTER_CLASSES if self.diffusion_config.emitter_class_passes
+                   else (diffusion_inject.EVERY_CLASS,))
+        previous = None  # the last bounce's flux, which the next one re-emits
         for bounce in range(1, self.gi.bounces + 1):
-            with self.step(timings, diffusion_inject.EMIT_DECL):
-                if bounce == 1:
-                    diffusion_inject.emit(be, self.injected, self.cells, self.snapshots[0], grid, atlas=self.atlas)
-                else:
-                    diffusion_inject.emit(be, self.absorbed, self.cells, self.snapshots[0], grid,
-                                          vox_albedo=self.voxels["vox_albedo"])
-            with self.step(timings, diffusion_propagate.DECL):
-                for i in range(steps):
-                    diffusion_propagate.run(be, self.snapshots[i % 2], self.snapshots[(i + 1) % 2], self.absorbed,
-                                            self.cells, grid, first_step=i == 0, transfer=transfer)
-                if self.accumulated is not self.absorbed:
-                    diffusion_propagate.add(be, self.absorbed, self.accumulated, grid, first=bounce == 1)
+            flux = self.bounce_flux[bounce % len(self.bounce_flux)]
+            for k in classes:
+                with self.step(timings, diffusion_inject.EMIT_DECL):
+                    if previous is None:
+                        diffusion_inject.emit(be, self.injected, cells, self.snapshots[0], grid, atlas=self.atlas,
+                                              emitter_class=k)
+                    else:
+                        diffusion_inject.emit(be, previous, cells, self.snapshots[0], grid,
+                                              vox_albedo=self.voxels["vox_albedo"], emitter_class=k)
+                with self.step(timings, diffusion_propagate.DECL):
+                    for i in range(steps):
+                        diffusion_propagate.run(be, self.snapshots[i % 2], self.snapshots[(i + 1) % 2], self.absorbed,
+                                                cells, grid, first_step=i == 0, transfer=transfer)
+                    if flux is not self.absorbed:
+                        diffusion_propagate.add(be, self.absorbed, flux, grid, first=k == classes[0],
+                                                cell_normal=cells["cell_normal"], skip_class=k)
+            if self.accumulated is not flux:
+                with self.step(timings, diffusion_propagate.DECL):
+                    diffusion_propagate.add(be, flux, self.accumulated, grid, first=bounce == 1,
+                                            cell_normal=cells["cell_normal"])
+            previous = flux
 
     def gather_pixels(self, timings: dict[str, float]) -> None:
         with self.step(timings, diffusion_lookup.DECL):

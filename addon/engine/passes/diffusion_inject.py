@@ -7,7 +7,8 @@ its surface (or half a cell behind it when that one is empty), on the side its n
 `emit` (once per bounce): the flux on each side -> the snapshot `sh_r/g/b` (RGBA32F 3D, L1 SH of
 radiant intensity W/sr by direction of travel): flux / pi x the clamped-cosine lobe about that side's
 normal, times the voxels' albedo for later bounces (whose flux is what the surfaces absorbed); an empty
-cell emits isotropically. Twin: diffusion_reference.inject / emit.
+cell emits isotropically. With an `emitter_class` only that class's sides emit (the propagation of one
+emitter class, docs/DIFFUSION.md "Emitter classes"). Twin: diffusion_reference.inject / emit.
 """
 
 from __future__ import annotations
@@ -20,6 +21,10 @@ from .diffusion_cells import CELL_BLOCK, CELL_NORMAL
 
 INJECTED = Port("diffusion", "injected", "RGBA32F", "atlas",
                 "VPL flux (W) on each side of a cell's plane, by layer tile")
+# Emitter classes (diffusion/cell.glsl): a side's class is its normal's dominant signed axis, 0..5.
+EVERY_CLASS = -1
+EMITTER_CLASSES = tuple(range(6))
+
 SNAPSHOT = Port("diffusion", "snapshots", "RGBA32F", "grid", "L1 SH of radiant intensity (W/sr) in each cell")
 
 SPEC = splat_spec("diffusion_inject", "diffusion/inject.vert.glsl", "diffusion/inject.frag.glsl",
@@ -35,7 +40,7 @@ def _emit_spec(atlas: bool) -> ShaderSpec:
     dim = "2D" if atlas else "3D"
     samplers = (Sampler("flux_plus", dim), Sampler("flux_minus", dim), Sampler("cell_normal", "3D"),
                 Sampler("cell_block", "3D"))
-    uniforms = (Var("dims", "ivec3"),)
+    uniforms = (Var("dims", "ivec3"), Var("emitter_class", "int"))
     if atlas:
         uniforms += (Var("tiles_x", "int"),)
     else:
@@ -66,12 +71,14 @@ def run(backend: Backend, target, points, rsm: dict, grid: Grid, atlas: Atlas, c
 
 
 def emit(backend: Backend, flux: dict, cells: dict, snapshot: dict, grid: Grid, atlas: Atlas | None = None,
-         vox_albedo=None) -> None:
+         vox_albedo=None, emitter_class: int = EVERY_CLASS) -> None:
     """snapshot (sh_r/g/b) := the emitters of `flux` (flux_plus / flux_minus): the injection atlases
-    (`atlas` given), or volumes of absorbed flux re-emitted times `vox_albedo`. Every cell written."""
+    (`atlas` given), or volumes of absorbed flux re-emitted times `vox_albedo`; of the sides of
+    `emitter_class` alone (0..5: the dominant signed axis of the side's normal, as the faces +x -x +y -y
+    +z -z) unless it is EVERY_CLASS. Every cell written."""
     spec = EMIT_SPECS[atlas is not None]
     samplers = {"flux_plus": flux["flux_plus"], "flux_minus": flux["flux_minus"], **cells}
-    uniforms = {"dims": grid.dims}
+    uniforms = {"dims": grid.dims, "emitter_class": emitter_class}
     if atlas is not None:
         uniforms["tiles_x"] = atlas.tiles_x
     else:

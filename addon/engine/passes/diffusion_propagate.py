@@ -6,7 +6,8 @@ the cells (diffusion_cells). Outputs: the next snapshot `dst_r/g/b` and `acc_plu
 gpu_shaders/diffusion/propagate.comp.glsl has the step (Mavridis et al., seeds 000): the paper's face
 transfer normalised by 3 / (2 pi) (`cone`), or LPV's improved transfer (`directional`, light keeps its
 direction); diffusion_reference.step is its twin and docs/DIFFUSION.md derives and measures both.
-`add` sums one bounce's absorbed flux into the light field's total.
+`add` sums one bounce's absorbed flux into the light field's total (with `skip_class`, one emitter
+class's propagation, into every side but those of that class).
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_coun
 from ..grid import Grid
 from .declare import PassDecl, Port
 from .diffusion_cells import CELL_BLOCK, CELL_NORMAL
-from .diffusion_inject import SNAPSHOT
+from .diffusion_inject import EVERY_CLASS, SNAPSHOT
 from .lpv_propagate import improved_constants
 
 ABSORBED = Port("diffusion", "absorbed", "RGBA32F", "grid", "one bounce's flux (W) absorbed on each side of a plane")
@@ -45,9 +46,9 @@ ADD = ShaderSpec(
     name="diffusion_add",
     compute="diffusion/add.comp.glsl",
     local_size=(4, 4, 4),
-    samplers=(Sampler("bounce_plus", "3D"), Sampler("bounce_minus", "3D")),
+    samplers=(Sampler("bounce_plus", "3D"), Sampler("bounce_minus", "3D"), Sampler("cell_normal", "3D")),
     images=(Image("total_plus", "3D", "RGBA32F", "read_write"), Image("total_minus", "3D", "RGBA32F", "read_write")),
-    uniforms=(Var("dims", "ivec3"), Var("first", "int")),
+    uniforms=(Var("dims", "ivec3"), Var("first", "int"), Var("skip_class", "int")),
 )
 
 DECL = PassDecl("diffusion_propagate", "solve", (SNAPSHOT, CELL_NORMAL, CELL_BLOCK), (SNAPSHOT, ABSORBED, ACCUMULATED),
@@ -74,9 +75,13 @@ def run(backend: Backend, src: dict, dst: dict, absorbed: dict, cells: dict, gri
                              "acc_minus": absorbed["flux_minus"]})
 
 
-def add(backend: Backend, bounce: dict, total: dict, grid: Grid, first: bool) -> None:
-    """total := bounce (first) or total + bounce, per side."""
+def add(backend: Backend, bounce: dict, total: dict, grid: Grid, first: bool, cell_normal,
+        skip_class: int = EVERY_CLASS) -> None:
+    """total := bounce (first) or total + bounce, per side; the sides of `skip_class` (their normal's
+    dominant signed axis in `cell_normal`, diffusion_inject.EMITTER_CLASSES) keep their total (first:
+    0), unless it is EVERY_CLASS."""
     backend.dispatch(backend.program(ADD), group_count(grid.dims, ADD.local_size),
-                     uniforms={"dims": grid.dims, "first": int(first)},
-                     samplers={"bounce_plus": bounce["flux_plus"], "bounce_minus": bounce["flux_minus"]},
+                     uniforms={"dims": grid.dims, "first": int(first), "skip_class": skip_class},
+                     samplers={"bounce_plus": bounce["flux_plus"], "bounce_minus": bounce["flux_minus"],
+                               "cell_normal": cell_normal},
                      images={"total_plus": total["flux_plus"], "total_minus": total["flux_minus"]})
