@@ -22,6 +22,7 @@ import numpy as np
 
 from . import sh
 from .lpv_reference import gpu_improved_transfer
+from .passes import lpv_inject
 
 AXES = ((0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0), (2, 1.0), (2, -1.0))
 DIRECTIONS = np.array([np.eye(3)[axis] * sign for axis, sign in AXES])  # (6, 3)
@@ -137,12 +138,9 @@ EVERY_CLASS = -1  # emit / add: every side, no emitter class singled out
 
 
 def emitter_class(normal: np.ndarray) -> np.ndarray:
-    """The emitter class of sides with these normals (..., 3): the dominant signed axis, numbered as
-    AXES (ties go to the lower axis)."""
-    a = np.abs(np.asarray(normal, np.float64))
-    axis = np.where((a[..., 0] >= a[..., 1]) & (a[..., 0] >= a[..., 2]), 0, np.where(a[..., 1] >= a[..., 2], 1, 2))
-    negative = np.take_along_axis(np.asarray(normal), axis[..., None], -1)[..., 0] < 0.0
-    return 2 * axis + negative
+    """The emitter class of sides with these normals (..., 3): lpv's (the dominant signed axis, numbered
+    as AXES)."""
+    return lpv_inject.emitter_class(np.asarray(normal))
 
 
 def emit(flux_plus: np.ndarray, flux_minus: np.ndarray, normal: np.ndarray, occupied: np.ndarray,

@@ -12,8 +12,8 @@ void main() {
     vec4 m = texelFetch(bounce_minus, c, 0);
     if (skip_class != DIFFUSION_EVERY_CLASS) {
         vec3 n = texelFetch(cell_normal, c, 0).xyz;
-        p *= float(diffusion_class(n) != skip_class);
-        m *= float(diffusion_class(-n) != skip_class);
+        p *= float(emitter_class(n) != skip_class);
+        m *= float(emitter_class(-n) != skip_class);
     }
     if (first == 0) {
         p += imageLoad(total_plus, c);

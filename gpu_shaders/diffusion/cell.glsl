@@ -42,13 +42,8 @@ bool diffusion_inside(ivec3 c) {
 }
 
 // Emitter classes (DiffusionConfig.emitter_class_passes, docs/DIFFUSION.md "Emitter classes"): a side of a
-// cell's plane belongs to the class of its normal's dominant signed axis, numbered as the faces. Light
-// is propagated once per class, and a side takes in what every class but its own brought it: a surface
-// cannot light another that faces its way, but light leaving a plane diffuses back onto it.
+// cell's plane belongs to lpv's emitter_class of its normal (its dominant signed axis, numbered as the
+// faces). Light is propagated once per class, and a side takes in what every class but its own brought
+// it: a surface cannot light another that faces its way, but light leaving a plane diffuses back onto it.
+#include "lpv/emitter_class.glsl"
 const int DIFFUSION_EVERY_CLASS = -1;
-
-int diffusion_class(vec3 n) {
-    vec3 a = abs(n);
-    int axis = (a.x >= a.y && a.x >= a.z) ? 0 : (a.y >= a.z ? 1 : 2);
-    return 2 * axis + (n[axis] < 0.0 ? 1 : 0);
-}

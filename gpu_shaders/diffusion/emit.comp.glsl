@@ -2,7 +2,7 @@
 // reflects (ALBEDO: times the voxels' albedo) its flux as a clamped-cosine lobe about its normal,
 // flux / pi x sh_cosine_lobe(+-n) W/sr, whose integral is the flux; an empty cell emits isotropically.
 // ATLAS: the fluxes come from the injection atlases (layer z = tile z, passes/atlas.py), else from volumes.
-// emitter_class >= 0 (cell.glsl's emitter classes): only the sides of that class emit; an empty cell, which
+// emitting_class >= 0 (cell.glsl's emitter classes): only the sides of that class emit; an empty cell, which
 // has no side, emits 1/5 of its light in each of the six passes, so that every side, which takes in five
 // of them, receives all of it.
 #include "common/sh.glsl"
@@ -32,9 +32,9 @@ void main() {
     vec4 r, g, b;
     if (diffusion_occupied(texelFetch(cell_block, c, 0))) {
         vec3 n = texelFetch(cell_normal, c, 0).xyz;
-        if (emitter_class != DIFFUSION_EVERY_CLASS) {
-            fp *= float(diffusion_class(n) == emitter_class);
-            fm *= float(diffusion_class(-n) == emitter_class);
+        if (emitting_class != DIFFUSION_EVERY_CLASS) {
+            fp *= float(emitter_class(n) == emitting_class);
+            fm *= float(emitter_class(-n) == emitting_class);
         }
         vec4 lp = sh_cosine_lobe(n) * (1.0 / SH_A0);
         vec4 lm = sh_cosine_lobe(-n) * (1.0 / SH_A0);
@@ -42,7 +42,7 @@ void main() {
         g = fp.g * lp + fm.g * lm;
         b = fp.b * lp + fm.b * lm;
     } else {
-        float share = emitter_class == DIFFUSION_EVERY_CLASS ? 1.0 : 0.2;
+        float share = emitting_class == DIFFUSION_EVERY_CLASS ? 1.0 : 0.2;
         vec3 c0 = share * (fp + fm) / DIFFUSION_FLUX_PER_C0;
         r = vec4(c0.r, 0.0, 0.0, 0.0);
         g = vec4(c0.g, 0.0, 0.0, 0.0);

@@ -40,7 +40,7 @@ def _emit_spec(atlas: bool) -> ShaderSpec:
     dim = "2D" if atlas else "3D"
     samplers = (Sampler("flux_plus", dim), Sampler("flux_minus", dim), Sampler("cell_normal", "3D"),
                 Sampler("cell_block", "3D"))
-    uniforms = (Var("dims", "ivec3"), Var("emitter_class", "int"))
+    uniforms = (Var("dims", "ivec3"), Var("emitting_class", "int"))
     if atlas:
         uniforms += (Var("tiles_x", "int"),)
     else:
@@ -78,7 +78,7 @@ def emit(backend: Backend, flux: dict, cells: dict, snapshot: dict, grid: Grid, 
     +z -z) unless it is EVERY_CLASS. Every cell written."""
     spec = EMIT_SPECS[atlas is not None]
     samplers = {"flux_plus": flux["flux_plus"], "flux_minus": flux["flux_minus"], **cells}
-    uniforms = {"dims": grid.dims, "emitter_class": emitter_class}
+    uniforms = {"dims": grid.dims, "emitting_class": emitter_class}
     if atlas is not None:
         uniforms["tiles_x"] = atlas.tiles_x
     else:
