@@ -23,6 +23,8 @@ import numpy as np
 from . import sh
 from .lpv_reference import gpu_improved_transfer
 from .passes import lpv_inject
+from .passes.diffusion_propagate import flux_cross
+from .passes.lpv_propagate import improved_constants
 
 AXES = ((0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0), (2, 1.0), (2, -1.0))
 DIRECTIONS = np.array([np.eye(3)[axis] * sign for axis, sign in AXES])  # (6, 3)
@@ -190,8 +192,13 @@ TRANSFERS = ("cone", "directional")
 
 def directional_matrices() -> np.ndarray:
     """(6, 4, 4) M_d of the `directional` transfer: LPV's improved transfer (lpv_reference.
-    gpu_improved_transfer, docs/LPV.md), the L1 projection of L(w) max(0, w.d) / |w|_1; sum_d M_d = 1."""
-    return np.array(gpu_improved_transfer()[0])
+    gpu_improved_transfer, docs/LPV.md), the L1 projection of L(w) max(0, w.d) / |w|_1, with the flux's
+    row weighting the face axis's coefficient by diffusion_propagate.flux_cross instead of m_cross (exact
+    for a Lambertian lobe's flux); sum_d M_d = 1."""
+    m = np.array(gpu_improved_transfer()[0])
+    scale = flux_cross() / improved_constants()["m_cross"]
+    m[:, 0, 1:] *= scale  # only the face's own axis is nonzero in that row
+    return m
 
 
 def face_transport(field: np.ndarray, transfer: str) -> tuple[np.ndarray, np.ndarray]:

@@ -9,13 +9,14 @@
 #include "diffusion/cell.glsl"
 
 #ifdef DIRECTIONAL
-// M_d L for face f (lpv/transfer.glsl's symmetric form: M00 = 1/6, m_cross between c0 and the face
-// axis's coefficient, m_along on it, m_side on the two others).
+// M_d L for face f (lpv/transfer.glsl's symmetric form: M00 = 1/6, m_cross from c0 to the face axis's
+// coefficient, m_along on it, m_side on the two others; the flux's row weighs the axis's coefficient by
+// flux_cross, diffusion_propagate.flux_cross: exact for a Lambertian lobe's flux).
 vec4 directional(vec4 c, int f) {
     int slot = (f >> 1) == 0 ? 3 : (f >> 1);  // x, y, z -> coefficient 3, 1, 2 of (1, y, z, x)
     float s = (f & 1) == 0 ? 1.0 : -1.0;
     vec4 m = m_side * c;
-    m.x = c.x / 6.0 + s * m_cross * c[slot];
+    m.x = c.x / 6.0 + s * flux_cross * c[slot];
     m[slot] = s * m_cross * c.x + m_along * c[slot];
     return m;
 }
@@ -23,10 +24,10 @@ vec4 directional(vec4 c, int f) {
 
 // The raw flux of channel c through the six faces, as two vec3 (+x +y +z, -x -y -z): both transfers'
 // are k0 c0 +- k1 c_axis (cone: <L, T_d> = c0 sqrt(pi) / 3 +- c1 c_axis; directional: 2 sqrt(pi) x
-// (M_d L)_0 = 2 sqrt(pi) (c0 / 6 +- m_cross c_axis)).
+// (M_d L)_0 = 2 sqrt(pi) (c0 / 6 +- flux_cross c_axis)).
 #ifdef DIRECTIONAL
 #define RAW_K0 (DIFFUSION_FLUX_PER_C0 / 6.0)
-#define RAW_K1 (DIFFUSION_FLUX_PER_C0 * m_cross)
+#define RAW_K1 (DIFFUSION_FLUX_PER_C0 * flux_cross)
 #else
 #define RAW_K0 DIFFUSION_CONE_C0
 #define RAW_K1 DIFFUSION_CONE_C1
@@ -57,7 +58,7 @@ float channel_outflow(vec4 c, vec3 open_plus, vec3 open_minus, int face, out vec
     vec3 k_axis = kp + km;
     float kept = dot(k_axis, vec3(1.0));
     vec4 residual;  // c - sum over the carrying faces of M_f c, in closed form (`directional`)
-    residual.x = c.x * (1.0 - kept / 6.0) - m_cross * dot(kp - km, along);
+    residual.x = c.x * (1.0 - kept / 6.0) - flux_cross * dot(kp - km, along);
     residual.wyz = along * (1.0 - m_side * kept - (m_along - m_side) * k_axis) - m_cross * c.x * (kp - km);
     carried = through > 0.0 && total > 0.0 ? directional(c, face) + (through / sum) * residual : vec4(0.0);
 #else

@@ -86,6 +86,22 @@ def test_diffusion_box_prints_both_transfers():
     out = tool("tools/diffusion_box.py", "--cells", "12")
     for transfer in ("cone", "directional"):
         assert f"{transfer}: closed box of 12 cells" in out and f"{transfer}: point source" in out
+        assert f"{transfer}: an upward Lambertian lobe's shares" in out
+    assert "exact 0.138 0.138 0.138 0.138 0.449 0.000   L1 0.138 0.138 0.138 0.138 0.449 0.000" in out
+
+
+def test_surface_error_prints_each_surface_of_a_room(cornell, tmp_path):
+    # lpv's image against rsm's (a stand-in for a reference of the same size): the box's floor, ceiling,
+    # back wall and side walls each get a line, and together the groups hold the whole squared error
+    # less the groups under 1 % of the pixels (the boxes' tops and sides facing other ways).
+    tool("-m", "addon", "render", str(cornell), "--method", "rsm", "--resolution", "32", "--out",
+         str(tmp_path / "rsm"), "--quiet")
+    out = tool("tools/surface_error.py", str(cornell), "--reference", str(tmp_path / "rsm" / "indirect.exr"),
+               "--method", "lpv", "--res", "32")
+    rows = {r["group"]: r for r in map(json.loads, (line for line in out.splitlines() if line.startswith("{")))}
+    assert rows["all"]["pixels"] == 32 * 32
+    assert {"+x", "-x", "-y", "+z", "-z"} <= set(rows)
+    assert 0.9 <= sum(r["share"] for g, r in rows.items() if g != "all") <= 1.005  # shares rounded to 1e-3
 
 
 def test_diffusion_step_time_prints_each_method():

@@ -12,6 +12,11 @@ class's propagation, into every side but those of that class).
 
 from __future__ import annotations
 
+import functools
+
+import numpy as np
+
+from .. import sh
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
 from .declare import PassDecl, Port
@@ -34,7 +39,8 @@ def _spec(transfer: str) -> ShaderSpec:
         images=(*(Image(f"dst_{c}", "3D", "RGBA32F", "write") for c in "rgb"),
                 Image("acc_plus", "3D", "RGBA32F", "read_write"), Image("acc_minus", "3D", "RGBA32F", "read_write")),
         uniforms=(Var("dims", "ivec3"), Var("first_step", "int"))
-        + ((Var("m_cross", "float"), Var("m_along", "float"), Var("m_side", "float")) if directional else ()),
+        + ((Var("m_cross", "float"), Var("m_along", "float"), Var("m_side", "float"), Var("flux_cross", "float"))
+           if directional else ()),
         defines=(("DIRECTIONAL", "1"),) if directional else (),
     )
 
@@ -55,6 +61,31 @@ DECL = PassDecl("diffusion_propagate", "solve", (SNAPSHOT, CELL_NORMAL, CELL_BLO
                 "propagation steps, each bounce's absorbed flux summed into the total")
 
 
+@functools.cache
+def flux_cross() -> float:
+    """The `directional` transfer's weight of a field's band-1 coefficient along a face's axis in the flux
+    through that face, raw = 2 sqrt(pi) (c0 / 6 +- flux_cross c_axis) (LPV's M_d has m_cross there).
+
+    The L1 field of a Lambertian lobe is broader than the lobe: with m_cross an upward lobe in an open
+    cell sends 0.370 of its flux up and 0.158 through each side, where its directions w, each through
+    face d by max(0, w.d) / |w|_1 (the partition M_d projects), send 0.449 up and 0.138 sideways
+    (tools/diffusion_box.py). The light then spreads sideways at every step: above a lit floor patch
+    the walls took what the ceiling should have. This weight makes the partition exact for a Lambertian
+    lobe, as it is for an isotropic field (c_axis = 0: unchanged). Only the flux's row of M_d changes,
+    so sum_d M_d is still 1 (its +-d entries cancel) and the faces still carry the field itself.
+    With the lobe's coefficients a = c0 / 6 and b = m_cross c_up, its down face clamped (a < b) and the
+    faces scaled to its flux, the up share is (a + k b) / (5 a + k b); equal to the exact share s when
+    k = a (5 s - 1) / (b (1 - s)) (1.681): flux_cross = k m_cross."""
+    dirs, weights = sh.sphere_quadrature(1024, 2048)
+    up = np.maximum(dirs[:, 2], 0.0)
+    exact_up_share = float(np.sum(weights * up / np.pi * dirs[:, 2] / np.abs(dirs).sum(axis=1)))
+    m_cross = improved_constants()["m_cross"]
+    lobe = sh.cosine_lobe_l1(np.array([0.0, 0.0, 1.0]))
+    a, b = lobe[0] / 6.0, m_cross * lobe[2]
+    k = a * (5.0 * exact_up_share - 1.0) / (b * (1.0 - exact_up_share))
+    return float(k * m_cross)
+
+
 def sides(backend: Backend, grid: Grid) -> dict:
     """A pair of per-side flux volumes, keyed flux_plus / flux_minus."""
     return {k: backend.texture(grid.dims) for k in ("flux_plus", "flux_minus")}
@@ -68,7 +99,7 @@ def run(backend: Backend, src: dict, dst: dict, absorbed: dict, cells: dict, gri
     uniforms = {"dims": grid.dims, "first_step": int(first_step)}
     if transfer == "directional":
         c = improved_constants()
-        uniforms.update(m_cross=c["m_cross"], m_along=c["m_along"], m_side=c["m_side"])
+        uniforms.update(m_cross=c["m_cross"], m_along=c["m_along"], m_side=c["m_side"], flux_cross=flux_cross())
     backend.dispatch(backend.program(spec), group_count(grid.dims, spec.local_size), uniforms=uniforms,
                      samplers={**{f"src_{c}": src[f"sh_{c}"] for c in "rgb"}, **cells},
                      images={**{f"dst_{c}": dst[f"sh_{c}"] for c in "rgb"}, "acc_plus": absorbed["flux_plus"],
