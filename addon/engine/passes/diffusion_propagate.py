@@ -75,7 +75,7 @@ def flux_cross() -> float:
     so sum_d M_d is still 1 (its +-d entries cancel) and the faces still carry the field itself.
     With the lobe's coefficients a = c0 / 6 and b = m_cross c_up, its down face clamped (a < b) and the
     faces scaled to its flux, the up share is (a + k b) / (5 a + k b); equal to the exact share s when
-    k = a (5 s - 1) / (b (1 - s)) (1.681): flux_cross = k m_cross."""
+    k = a (5 s - 1) / (b (1 - s)) (1.680): flux_cross = k m_cross."""
     dirs, weights = sh.sphere_quadrature(1024, 2048)
     up = np.maximum(dirs[:, 2], 0.0)
     exact_up_share = float(np.sum(weights * up / np.pi * dirs[:, 2] / np.abs(dirs).sum(axis=1)))
