@@ -9,7 +9,13 @@ For each transfer (cone, the paper's; directional):
 2. An isotropic point source in an empty grid: r^2 x the irradiance on the +x axis at 2..12 cells
    (exact: 1 / (4 pi) at every r).
 
-Run: .venv/bin/python tools/diffusion_box.py [--cells 32]  (both transfers; about a minute at 32 cells)
+`--alternatives`: sharper angular models than L1 tried on the same twin, carried as `directional` is
+(docs/DIFFUSION.md, "Sharper angular models"): L2 with its exact face matrices, and a positive closure
+of the L1 field (M1-like). The ceiling's share from a 2 x 2 and a 10 x 10 lit patch, and the point
+source at 4 and 8 cells (about four minutes at 16 cells: the closure integrates per cell).
+
+Run: .venv/bin/python tools/diffusion_box.py [--cells 32] [--alternatives]  (both transfers; about a
+minute at 32 cells)
 """
 
 from __future__ import annotations
@@ -26,13 +32,14 @@ from addon.engine import diffusion_reference as ref  # noqa: E402
 from addon.engine import sh  # noqa: E402
 
 
-def ceiling_view_factor(n: int, samples: int = 1_000_000) -> float:
-    """The exact share of the lit patch's Lambertian light that reaches the ceiling of `closed_box_cells`
-    (planes at the walls' cell centres: a cube of n - 3 cells; the patch 10 cells wide about n / 2),
-    by Monte Carlo over cosine-distributed directions (seeded; its standard error about 4e-4)."""
+def ceiling_view_factor(n: int, half: int = 5, samples: int = 1_000_000) -> float:
+    """The exact share of a lit floor patch's Lambertian light that reaches the ceiling of
+    `closed_box_cells` (planes at the walls' cell centres: a cube of n - 3 cells; the patch 2 x half
+    cells wide about n / 2), by Monte Carlo over cosine-distributed directions (seeded; its standard
+    error about 4e-4 at a million samples)."""
     rng = np.random.default_rng(0)
     side = n - 3.0
-    x, y = (rng.uniform(n / 2 - 5 - 1.5, n / 2 + 5 - 1.5, samples) for _ in range(2))  # from the wall plane
+    x, y = (rng.uniform(n / 2 - half - 1.5, n / 2 + half - 1.5, samples) for _ in range(2))  # from the wall plane
     u, phi = rng.random(samples), 2 * np.pi * rng.random(samples)
     reach = side / np.sqrt(1 - u)  # the ray's length to the ceiling's plane, times sin(theta) below
     hx, hy = x + np.sqrt(u) * np.cos(phi) * reach, y + np.sqrt(u) * np.sin(phi) * reach
@@ -83,10 +90,126 @@ def point_source_figures(transfer: str, steps: int = 120, size: int = 41) -> Non
     print("  ".join(f"r={k}: {v:.2f}" for k, v in zip(r, 4 * np.pi * r**2 * through[r], strict=True)))
 
 
+# -- sharper angular models (--alternatives) -------------------------------------------------------------
+def _sphere(count: int) -> np.ndarray:
+    """`count` near-uniform unit directions (a Fibonacci spiral), each standing for 4 pi / count sr."""
+    i = np.arange(count) + 0.5
+    z = 1.0 - 2.0 * i / count
+    phi = np.pi * (1.0 + 5.0**0.5) * i
+    r = np.sqrt(1.0 - z * z)
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=-1)
+
+
+def _face_partition(w: np.ndarray) -> np.ndarray:
+    """(K, 6): the share of direction w crossing each face, max(0, w.d) / |w|_1 (the partition M_d projects)."""
+    return np.maximum(w @ ref.DIRECTIONS.T, 0.0) / np.abs(w).sum(-1, keepdims=True)
+
+
+def l2_transfer():
+    """L2 (9 coefficients) with the exact face matrices M_d = <Y_i, Y_j max(0, w.d) / |w|_1> (no flux
+    row factor: L2 holds a Lambertian lobe's partition to 0.002)."""
+    dirs, weights = sh.sphere_quadrature(256, 512)
+    basis = sh.basis_l2(dirs)
+    m = np.einsum("k,ki,kj,kd->dij", weights, basis, basis, _face_partition(dirs))
+
+    def transport(field: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        moved = np.einsum("dij,...j->...di", m, field)
+        raw = ref.FLUX_PER_C0 * moved[..., 0]
+        return raw, moved / np.where(raw > 0.0, raw, 1.0)[..., None]
+    return transport
+
+
+def closure_transfer(count: int = 2000, rho_max: float = 0.97):
+    """A positive closure of the L1 field: per cell the lobe of a one-parameter family with the field's
+    flux and mean direction (rho = |mean of w| in [0, 1)) is split by `_face_partition`, each face
+    carrying its part's flux and first moment. The family: rho <= 1/3 the L1 function itself (positive
+    there), up to 2/3 max(0, b + w.u), from 2/3 the cosine power max(0, w.u)^p, p = (2 rho - 1) / (1 -
+    rho) (a Lambertian lobe at rho = 2/3, so its partition is exact). Every face flux is >= 0 and the
+    faces carry the field's moments: no clamp, no flux row."""
+    w = _sphere(count)
+    part = _face_partition(w)
+    b_grid = np.linspace(1e-4, 1.0, 4001)
+    a = 1.0 / b_grid  # max(0, b + t) is max(0, 1 + a t) / a
+    rho_grid = (0.5 * (1 - a**-2) + a / 3 + a**-2 / 3) / ((a + 1) ** 2 / (2 * a))  # from 2/3 down to 1/3
+
+    def lobe(rho: np.ndarray, u: np.ndarray) -> np.ndarray:
+        t = u @ w.T
+        rho = rho[:, None]
+        linear = 1.0 + 3.0 * np.minimum(rho, 1.0 / 3.0) * t
+        b = np.interp(rho[:, 0], rho_grid[::-1], b_grid[::-1])[:, None]
+        power = np.maximum((2.0 * rho - 1.0) / (1.0 - np.maximum(rho, 2.0 / 3.0)), 1.0)
+        f = np.where(rho <= 1.0 / 3.0, linear,
+                     np.where(rho < 2.0 / 3.0, np.maximum(0.0, b + t), np.maximum(t, 0.0) ** power))
+        return f / f.sum(-1, keepdims=True)
+
+    def transport(field: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        flat = field.reshape(-1, 4)
+        flux = ref.FLUX_PER_C0 * flat[:, 0]
+        mean = flat[:, [3, 1, 2]] / sh.Y1  # the intensity's first moment, x y z
+        raw = np.zeros((len(flat), 6))
+        moved = np.zeros((len(flat), 6, 4))
+        lit = np.flatnonzero(flux > 1e-30)
+        for start in range(0, len(lit), 1024):
+            idx = lit[start:start + 1024]
+            length = np.linalg.norm(mean[idx], axis=-1)
+            u = np.where(length[:, None] > 0.0, mean[idx] / np.maximum(length, 1e-30)[:, None], (0.0, 0.0, 1.0))
+            f = lobe(np.clip(length / flux[idx], 0.0, rho_max), u)
+            share = f @ part
+            moment = np.einsum("nk,kd,kc->ndc", f, part, w)
+            raw[idx] = flux[idx, None] * share
+            moved[idx, :, 0] = sh.Y00 * raw[idx]
+            moved[idx, :, 1:] = sh.Y1 * flux[idx, None, None] * moment[..., [1, 2, 0]]
+        raw, moved = raw.reshape(*field.shape[:-1], 6), moved.reshape(*field.shape[:-1], 6, 4)
+        return raw, moved / np.where(raw > 0.0, raw, 1.0)[..., None]
+    return transport
+
+
+def alternative_figures(n: int) -> None:
+    models = (("directional", "directional", 4), ("L2", l2_transfer(), 9), ("closure", closure_transfer(), 4))
+    cell = ref.closed_box_cells(n)
+    print(f"sharper angular models, closed box of {n} cells: per lit patch the share on the ceiling "
+          "(exact: its view factor) and on the floor itself (exact 0); a point source's 4 pi r^2 E after 24 "
+          "steps (exact 1 once all of its light has arrived)")
+    print("model        up share  ceiling 2x2  floor 2x2  ceiling 10x10  floor 10x10  r=4   r=8")
+    exact = [ceiling_view_factor(n, half) for half in (1, 5)]
+    print(f"exact           0.449  {exact[0]:11.3f}  {0:9.3f}  {exact[1]:13.3f}  {0:11.3f}  1.00  1.00")
+    up = np.array([0.0, 0.0, 1.0])
+    for name, transfer, coefficients in models:
+        lobe = sh.cosine_lobe_l1(up) if coefficients == 4 else sh.cosine_lobe_l2(up)
+        single = (lobe / np.pi).reshape(1, 1, 1, -1)
+        share = ref.face_fluxes(single, np.ones((1, 1, 1, 6)), transfer)[0, 0, 0, 4] / ref.flux_w(single)
+        row = [f"{name:12s} {share:8.3f}"]
+        for half, width in ((1, 11), (5, 13)):
+            lit = np.zeros((n, n, n))
+            lit[1, n // 2 - half:n // 2 + half, n // 2 - half:n // 2 + half] = 1.0
+            lobes = sh.cosine_lobe_l1(cell["normal"]) if coefficients == 4 else sh.cosine_lobe_l2(cell["normal"])
+            field = lit[..., None] * lobes / np.pi
+            total = ref.flux_w(field)
+            _, plus, minus = ref.propagate(field, cell, 2 * n, transfer)
+            absorbed = plus + minus
+            row.append(f"{absorbed[n - 2, 2:-2, 2:-2].sum() / total:{width}.3f}  "
+                       f"{absorbed[1, 2:-2, 2:-2].sum() / total:{width - 2}.3f}")
+        size, centre = 21, 10
+        empty = ref.cells(np.zeros((size,) * 3, bool), np.zeros((size,) * 3 + (3,)), np.zeros((size,) * 3 + (3,)))
+        field = np.zeros((size,) * 3 + (coefficients,))
+        field[centre, centre, centre, 0] = 1.0 / ref.FLUX_PER_C0
+        through = np.zeros(size)
+        for _ in range(24):
+            through += ref.inflow(ref.face_fluxes(field, empty["open"], transfer))[centre, centre, :, 0]
+            field, _, _ = ref.step(field, empty, transfer)
+        row.append("  ".join(f"{4 * np.pi * r**2 * through[centre + r]:.2f}" for r in (4, 8)))
+        print("  ".join(row))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cells", type=int, default=32)
+    parser.add_argument("--alternatives", action="store_true",
+                        help="only the sharper angular models (L2, a positive closure) beside directional")
     args = parser.parse_args()
+    if args.alternatives:
+        alternative_figures(args.cells)
+        return
     for transfer in ref.TRANSFERS:
         lambertian_face_shares(transfer)
         box_figures(args.cells, transfer)

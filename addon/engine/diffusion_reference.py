@@ -18,6 +18,8 @@ is in W, areas in cells^2 (x h^2 for m^2).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from . import sh
@@ -201,11 +203,15 @@ def directional_matrices() -> np.ndarray:
     return m
 
 
-def face_transport(field: np.ndarray, transfer: str) -> tuple[np.ndarray, np.ndarray]:
+def face_transport(field: np.ndarray, transfer: str | Callable) -> tuple[np.ndarray, np.ndarray]:
     """(raw face fluxes (z, y, x, 6) W, the SH each face carries (z, y, x, 6, 4) per W of them).
     cone (the paper's, normalised): the flux through the face's cone, <L, T_d>, arriving as the uniform
     cone 3 / (2 pi) T_d. directional: the flux of M_d L, arriving as M_d L itself (the light keeps its
-    direction within the face's share)."""
+    direction within the face's share). A callable field -> (raw, shape) stands for another angular
+    model, carried as directional is (tools/diffusion_box.py --alternatives tries more bands and a
+    positive closure of the L1 field this way)."""
+    if callable(transfer):
+        return transfer(field)
     if transfer == "cone":
         shape = (*field.shape[:-1], 6, 4)
         return field @ CONES.T, np.broadcast_to(TRANSFER_NORM * CONES, shape)

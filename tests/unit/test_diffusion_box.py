@@ -1,0 +1,67 @@
+"""tools/diffusion_box.py's sharper angular models (--alternatives) hold what the comparison assumes:
+each conserves flux, adds nothing, and leaves a Lambertian lobe by its exact face shares, so the twin
+compares angular models and nothing else."""
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+
+from addon.engine import diffusion_reference as ref
+from addon.engine import sh
+
+ROOT = Path(__file__).resolve().parents[2]
+_spec = importlib.util.spec_from_file_location("diffusion_box", ROOT / "tools" / "diffusion_box.py")
+diffusion_box = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(diffusion_box)
+
+# An upward Lambertian lobe's exact share through the top face: the mean of w_z / |w|_1 over the
+# cosine lobe (diffusion_propagate.flux_cross integrates it: 0.44946).
+LAMBERTIAN_UP_SHARE = 0.44946
+
+
+def realizable_fields(count: int, seed: int = 0) -> np.ndarray:
+    """(count, 1, 1, 4) L1 fields of positive light: a few Lambertian lobes and an isotropic part each."""
+    rng = np.random.default_rng(seed)
+    fields = np.zeros((count, 1, 1, 4))
+    for i in range(count):
+        normals = rng.normal(size=(3, 3))
+        normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+        weights = rng.random(3) * rng.random()
+        fields[i, 0, 0] = (weights[:, None] * sh.cosine_lobe_l1(normals)).sum(0) / np.pi
+        fields[i, 0, 0, 0] += rng.random() * 0.3
+    return fields
+
+
+def test_the_closure_partitions_flux_and_direction():
+    fields = realizable_fields(40)
+    raw, shape = diffusion_box.closure_transfer()(fields)
+    flux = ref.FLUX_PER_C0 * fields[..., 0]
+    assert raw.min() >= 0.0  # a positive lobe's parts are positive: nothing to clamp
+    np.testing.assert_allclose(raw.sum(-1), flux, rtol=1e-12)  # shares of a normalised lobe
+    # The faces carry the field's direction: exact for the family, up to the 2000-direction spiral's
+    # quadrature of the lobe's first moment (1.2e-5 of the flux on these fields).
+    carried = (shape * raw[..., None]).sum(-2)
+    np.testing.assert_allclose(carried, fields, atol=1e-4 * flux.max())
+
+
+def test_the_alternatives_leave_a_lambertian_lobe_by_its_exact_shares():
+    up = np.array([0.0, 0.0, 1.0])
+    open_faces = np.ones((1, 1, 1, 6))
+    for transfer, lobe, tolerance in ((diffusion_box.closure_transfer(), sh.cosine_lobe_l1(up), 1e-3),
+                                      (diffusion_box.l2_transfer(), sh.cosine_lobe_l2(up), 3.5e-3)):
+        # closure: the cosine power p = 1 itself, to the spiral's quadrature (it reads 0.44948); L2: its
+        # projection of the clamped cosine rings below the horizon and leaves 0.4467 up.
+        field = (lobe / np.pi).reshape(1, 1, 1, -1)
+        shares = ref.face_fluxes(field, open_faces, transfer)[0, 0, 0] / ref.flux_w(field)
+        assert abs(shares[4] - LAMBERTIAN_UP_SHARE) < tolerance
+        assert shares[5] < 1e-9  # nothing goes down
+
+
+def test_a_callable_transfer_is_carried_as_directional_is():
+    cell = ref.closed_box_cells(6)
+    field = realizable_fields(6 ** 3, seed=1).reshape(6, 6, 6, 4) * cell["occupied"][..., None]
+    named = ref.step(field, cell, "directional")
+    called = ref.step(field, cell, lambda f: ref.face_transport(f, "directional"))
+    for a, b in zip(named, called, strict=True):
+        np.testing.assert_array_equal(a, b)
