@@ -10,9 +10,10 @@ For each transfer (cone, the paper's; directional):
    (exact: 1 / (4 pi) at every r).
 
 `--alternatives`: sharper angular models than L1 tried on the same twin, carried as `directional` is
-(docs/DIFFUSION.md, "Sharper angular models"): L2 with its exact face matrices, and a positive closure
-of the L1 field (M1-like). The ceiling's share from a 2 x 2 and a 10 x 10 lit patch, and the point
-source at 4 and 8 cells (about four minutes at 16 cells: the closure integrates per cell).
+(docs/DIFFUSION.md, "Small bright patches, and sharper angular models"): L2 with its exact face
+matrices, and a positive closure of the L1 field (M1-like). The ceiling's share from a 2 x 2 and a
+10 x 10 lit patch, and the point source at 4 and 8 cells (about four minutes at 16 cells: the closure
+integrates per cell).
 
 Run: .venv/bin/python tools/diffusion_box.py [--cells 32] [--alternatives]  (both transfers; about a
 minute at 32 cells)
@@ -46,6 +47,11 @@ def ceiling_view_factor(n: int, half: int = 5, samples: int = 1_000_000) -> floa
     return float(np.mean((hx > 0) & (hx < side) & (hy > 0) & (hy < side)))
 
 
+def _face_partition(w: np.ndarray) -> np.ndarray:
+    """(K, 6): the share of direction w crossing each face, max(0, w.d) / |w|_1 (the partition M_d projects)."""
+    return np.maximum(w @ ref.DIRECTIONS.T, 0.0) / np.abs(w).sum(-1, keepdims=True)
+
+
 def lambertian_face_shares(transfer: str, samples: int = 1_000_000) -> None:
     """Where one step sends an upward Lambertian lobe in an empty cell (every face open): the transfer's
     face fluxes of its L1 field against the exact shares of its directions w through each face,
@@ -54,7 +60,7 @@ def lambertian_face_shares(transfer: str, samples: int = 1_000_000) -> None:
     rng = np.random.default_rng(0)
     u, phi = rng.random(samples), 2 * np.pi * rng.random(samples)
     w = np.stack([np.sqrt(u) * np.cos(phi), np.sqrt(u) * np.sin(phi), np.sqrt(1 - u)], axis=-1)
-    exact = (np.maximum(w @ ref.DIRECTIONS.T, 0.0) / np.abs(w).sum(-1, keepdims=True)).mean(axis=0)
+    exact = _face_partition(w).mean(axis=0)
     field = (sh.cosine_lobe_l1(np.array([0.0, 0.0, 1.0])) / np.pi).reshape(1, 1, 1, 4)
     ours = ref.face_fluxes(field, np.ones((1, 1, 1, 6)), transfer)[0, 0, 0] / ref.flux_w(field)
     print(f"{transfer}: an upward Lambertian lobe's shares through the faces +x -x +y -y +z -z")
@@ -98,11 +104,6 @@ def _sphere(count: int) -> np.ndarray:
     phi = np.pi * (1.0 + 5.0**0.5) * i
     r = np.sqrt(1.0 - z * z)
     return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=-1)
-
-
-def _face_partition(w: np.ndarray) -> np.ndarray:
-    """(K, 6): the share of direction w crossing each face, max(0, w.d) / |w|_1 (the partition M_d projects)."""
-    return np.maximum(w @ ref.DIRECTIONS.T, 0.0) / np.abs(w).sum(-1, keepdims=True)
 
 
 def l2_transfer():
