@@ -273,11 +273,13 @@ def test_first_face_replaces_what_the_texture_holds(gl):
     """accumulate=False (the probes' first light face of a solve): every pixel that sees geometry gets
     that face's light in place of what `direct` held, so the faces after it, added, give exactly the
     image of a zeroed texture with every face added (the same sums in the same order: bit for bit);
-    pixels that see nothing are not written. A point light: six faces, each shading the pixels it owns."""
+    pixels that see nothing are not written. A point light among the geometry (between the floor and the
+    occluder: one outside the scene's bounds gets fewer views, light_views): six faces, each shading the
+    pixels it owns."""
     from addon.engine.passes import direct_light
 
     method = DirectMethod(gl, GIConfig(), RsmConfig(resolution=64))
-    scene = make_scene(Light("POINT", [0, 0, H], [0, 0, -1], [1, 1, 1], power_w=300.0))
+    scene = make_scene(Light("POINT", [0, 0, 0.5], [0, 0, -1], [1, 1, 1], power_w=300.0))
     method.set_scene(scene)
     expected = method.run().images["direct"][::-1]  # back to texture row order
     junk = np.full((SIZE, SIZE, 4), 7.0, np.float32)

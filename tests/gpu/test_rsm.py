@@ -56,6 +56,56 @@ def test_rsm_flux_sums_to_the_cone_integral(gl):
     np.testing.assert_allclose(flux, expected, rtol=1e-3)
 
 
+
+def test_a_far_lamps_rsm_is_fitted_to_the_scene(gl):
+    # A 300 W point light 30 m above a 2 x 2 m floor of albedo 0.5. The floor subtends
+    # 4 asin(a b / sqrt((a^2 + h^2)(b^2 + h^2))) sr (half sides a = b = 1 m, height h = 30 m), 3.8 degrees
+    # across: a 90-degree cube face of 256 texels would put it on about 9 x 9 texels. One view fitted to
+    # the scene's bounds (widened by 12 texels a side) fills most of its texels with the floor instead,
+    # and their flux sums to 0.5 P / (4 pi) x that solid angle. 1 %: each texel is counted whole or not
+    # at all, so each edge of the floor may be off by up to half a texel of the ~230 across it (0.2 %
+    # an edge).
+    light = Light("POINT", [0, 0, 30], [0, 0, -1], [1, 1, 1], power_w=300.0)
+    cam = Camera(look_along([0, 0, 5], [0, 0, -1], [0, 1, 0]), perspective(np.radians(30), 0.1, 100), 8, 8)
+    scene = scene_of([rect([-1, -1, 0], [2, 0, 0], [0, 2, 0])], [[0.5] * 3], light, cam)
+    method = RsmMethod(gl, GIConfig(method="rsm"), RsmConfig(resolution=256))
+    method.set_scene(scene)
+    method.run()
+    assert [v.face_index for v in method.light_views()] == [-1]
+    rsm_flux = gl.read(method.rsm["flux"])
+    covered = np.count_nonzero(rsm_flux[..., 3])  # w: the triangle seen + 1, 0 where none
+    assert covered > 0.75 * 256 * 256
+    solid_angle = 4 * np.arcsin(1.0 / (1 + 30.0**2))
+    np.testing.assert_allclose(rsm_flux[..., :3].sum(axis=(0, 1)), 0.5 * 300.0 / (4 * np.pi) * solid_angle,
+                               rtol=1e-2)
+
+
+def test_a_face_that_sees_nothing_is_skipped_and_changes_no_image(gl, monkeypatch):
+    # A lamp 1 m above a floor, a wall and a 0.4 m occluder (the scene's bounds end at z = 1):
+    # too wide a view for one fitted view, so cube faces, and the +z face sees none of the scene. Without
+    # it every image is bit for bit the one with all six faces: that face's RSM holds no surfel, so it
+    # adds exactly 0 to every pixel's direct and indirect light.
+    from addon.engine.passes import light_views
+
+    light = Light("POINT", [0, 0, 2], [0, 0, -1], [1, 1, 1], power_w=300.0)
+    cam = Camera(look_along([0.3, -0.2, 4], [0, 0, -1], [0, 1, 0]), perspective(np.radians(40), 0.1, 100), 32, 32)
+    scene = scene_of([rect([-1, -1, 0], [2, 0, 0], [0, 2, 0]), rect([0.3, 0.3, 1], [0.4, 0, 0], [0, 0.4, 0]),
+                      rect([-1, -1, 0], [0, 2, 0], [0, 0, 1])],  # a wall at x = -1: the floor's bounce
+                     [[0.5] * 3, [0.7] * 3, [0.6] * 3], light, cam)
+    images, faces = [], []
+    for every_face in (False, True):
+        if every_face:
+            monkeypatch.setattr(light_views, "face_meets", lambda axis, corners: True)
+        method = RsmMethod(gl, GIConfig(method="rsm"), RsmConfig(resolution=64, vpl_samples=32))
+        method.set_scene(scene)
+        images.append(method.run().images)
+        faces.append([v.face_index for v in method.light_views()])
+    assert faces == [[0, 1, 2, 3, 5], [0, 1, 2, 3, 4, 5]]
+    for key in ("direct", "indirect"):
+        assert images[0][key][..., :3].max() > 0.0, key
+        np.testing.assert_array_equal(images[0][key], images[1][key], err_msg=key)
+
+
 def exact_wall_indirect(y0, z0, albedo, sun, n=1500):
     """Diffuse Indirect (E / pi) at wall point (0, y0, z0) facing +x from the floor [0, 2] x [-1, 1]
     lit by a vertical sun: E = rho E_s / pi * integral z0 x / r^4 dx dy (midpoint rule, n^2 cells)."""

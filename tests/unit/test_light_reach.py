@@ -1,10 +1,12 @@
-"""Only what the scene needs: light_views.reaches decides which lights get light views at all."""
+"""Only what the scene needs: light_views.reaches decides which lights get light views at all, and
+views_for spends a light's views on the bounds."""
 
 import numpy as np
 import pytest
 
-from addon.engine.passes.light_views import reaches
+from addon.engine.passes.light_views import bounds_cone, face_meets, reaches, views_for
 from addon.engine.scene import Light
+from addon.engine.transforms import box_corners
 
 BOUNDS = (np.array([-1.0, -1.0, 0.0]), np.array([1.0, 1.0, 2.0]))  # sphere: centre (0, 0, 1), radius sqrt(3)
 
@@ -55,3 +57,72 @@ def test_points_and_suns_that_emit_reach():
     assert reaches(Light("POINT", np.array([0.0, 0.0, 50.0]), np.array([0.0, 0.0, -1.0]), np.ones(3), power_w=1.0),
                    BOUNDS)
     assert reaches(Light("SUN", np.zeros(3), np.array([0.0, 0.0, 1.0]), np.ones(3), sun_strength=1.0), BOUNDS)
+
+
+# -- a light's views spend their texels on the bounds (light_views.views_for) ---------------------------
+
+def lamp(position, kind="POINT", direction=(0, 0, -1), **kw):
+    return Light(kind, np.array(position, float), np.array(direction, float), np.ones(3), power_w=100.0, **kw)
+
+
+def points_in(bounds, n=4000, seed=0):
+    lo, hi = bounds
+    return lo + np.random.default_rng(seed).random((n, 3)) * (hi - lo)
+
+
+def in_view(view, points):
+    """(n,) bool: which world points the view's frustum holds (w > 0, |x|, |y| <= w in clip space)."""
+    clip = np.c_[points, np.ones(len(points))] @ view.view_projection.T
+    return (clip[:, 3] > 0) & np.all(np.abs(clip[:, :2]) <= clip[:, 3:4], axis=1)
+
+
+def test_a_lamp_among_the_geometry_keeps_six_faces():
+    views = views_for(lamp((0.2, -0.3, 1.0)), 0, BOUNDS, 256)
+    assert [v.face_index for v in views] == [0, 1, 2, 3, 4, 5]
+
+
+@pytest.mark.parametrize("position", [(0, 0, 30), (25, 10, 1), (-6, 0, -4)])
+def test_a_far_lamp_gets_one_view_fitted_to_the_bounds(position):
+    # The 2 x 2 x 2 m bounds seen from 30 m span about 5.4 degrees: a cube face would give them a few
+    # per cent of its texels; the fitted view holds every point of them (and the widened margin) in a
+    # frustum far narrower than a face.
+    (view,) = views_for(lamp(position), 0, BOUNDS, 256)
+    assert view.face_index == -1
+    lo, hi = BOUNDS
+    assert in_view(view, points_in((lo - 0.05, hi + 0.05))).all()
+    fov_deg = np.degrees(2 * np.arctan(np.sqrt(view.texel_scale) * 256 / 2))
+    distance = np.linalg.norm(np.array(position, float) - (lo + hi) / 2)
+    assert fov_deg < np.degrees(2 * np.arcsin(np.sqrt(3) * 1.2 / distance))  # the bounds' sphere, 20 % wider
+
+
+def test_a_lamp_just_outside_a_wall_skips_the_faces_that_see_nothing():
+    # 0.5 m beyond the face x = 1 the bounds span 140 degrees, too wide for one view: cube faces remain
+    # (the bounds widened by 12 texels of 256 at the far distance, 0.27 m, still exclude the lamp); the +x face
+    # looks away from them and is skipped, and every point of the bounds lies in a face that is kept
+    # (the face a direct-light lookup picks for it, the major axis of its direction).
+    position = np.array([1.5, 0.0, 1.0])
+    views = views_for(lamp(position), 0, BOUNDS, 256)
+    kept = {v.face_index for v in views}
+    assert kept == {1, 2, 3, 4, 5}
+    d = points_in(BOUNDS) - position
+    major = np.argmax(np.abs(d), axis=1)
+    face = 2 * major + (d[np.arange(len(d)), major] < 0)
+    assert set(face.tolist()) <= kept
+
+
+def test_a_spot_keeps_its_own_cone_where_it_is_the_narrower():
+    spot_view = views_for(spot((0, 0, 30), (0, 0, -1), size_deg=3.0), 0, BOUNDS, 256)[0]
+    assert np.degrees(2 * np.arctan(np.sqrt(spot_view.texel_scale) * 256 / 2)) == pytest.approx(3.06)
+    wide_view = views_for(spot((0, 0, 30), (0, 0, -1), size_deg=100.0), 0, BOUNDS, 256)[0]
+    assert np.degrees(2 * np.arctan(np.sqrt(wide_view.texel_scale) * 256 / 2)) < 10.0
+
+
+def test_the_bounds_cone_and_the_face_test_are_exact_on_simple_boxes():
+    corners = box_corners(np.array([-1.0, -1.0, 4.0]), np.array([1.0, 1.0, 6.0]))
+    axis, half = bounds_cone(corners)
+    np.testing.assert_allclose(axis, [0, 0, 1])
+    assert half == pytest.approx(np.arctan(1 / 4))  # a square view: the near corners (+-1, +-1, 4) on its edges
+    assert bounds_cone(corners - np.array([0.0, 0.0, 5.0])) is None  # the origin inside the box
+    assert face_meets(np.array([0.0, 0.0, 1.0]), corners)
+    assert not face_meets(np.array([0.0, 0.0, -1.0]), corners)
+    assert not face_meets(np.array([1.0, 0.0, 0.0]), corners)  # x <= 1 < z everywhere in the box

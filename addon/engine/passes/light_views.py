@@ -1,6 +1,15 @@
 """Where each light's RSM looks from: one perspective face for a spot, six cube faces for a point or
 area light, one orthographic view fitted to the scene bounds for a sun. Pure numpy.
 
+Only what the scene needs: a light outside the scene's bounds spends its texels on the bounds. When
+a square view fitted to the bounds has texels at most half as wide as the light's own views (a cube
+face, or a spot's face), the light gets that one view instead (a lamp 30 m from a 2 m room: the room's
+4 degrees filled at full resolution rather than a few texels of one face). Otherwise a cube face whose
+90-degree pyramid misses the bounds is skipped. The bounds
+are widened by FIT_MARGIN_TEXELS texels at the far distance first: the direct pass lifts a receiver
+off its surface by a few texels before it looks the receiver up, and the lifted point must still lie in
+a view.
+
 An area light's RSM looks from its centre as a Lambertian point, I(w) = P / pi * cos: its VPLs. A
 light with a shape (area_light.split_area_light's patches, emissive triangles: Light.emitter) is lit
 exactly in the direct pass from its polygons and shadowed from its position.
@@ -19,6 +28,14 @@ from ..transforms import box_corners, look_along, orthographic, perspective
 KIND_CODE = {"POINT": 0, "SPOT": 0, "SUN": 1, "AREA": 2}
 CUBE_AXES = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], np.float64)
 SINGLE_FACE_MAX_SPOT_RAD = np.radians(120.0)  # wider spots use cube faces (a 90-degree face each)
+# How far the bounds are widened before a view is fitted to them or a face is skipped, in the view's
+# texels at the far distance: the direct pass's receiver lift (1.5 texels, or EXACT_LIFT_TEXELS plus
+# the shadow bias, at most 8) with room to spare.
+FIT_MARGIN_TEXELS = 12.0
+# A view is fitted to the bounds only where its texels come out at most 1 / FIT_MIN_GAIN as wide as
+# those of the view the light has otherwise (its spot's face, or a cube face): a lamp just outside a
+# wall keeps its cube faces, which waste few texels on it, and only the faces that see nothing go.
+FIT_MIN_GAIN = 2.0
 
 
 @dataclass(frozen=True)
@@ -165,15 +182,62 @@ def views_for(light: Light, index: int, bounds: tuple[np.ndarray, np.ndarray], r
     # bounds, half the distance to them clips nothing; inside, far / 1000 (32-bit depth, ~1e-4 relative).
     outside_m = float(np.linalg.norm(np.maximum(np.maximum(lo - light.position_m, light.position_m - hi), 0.0)))
     near = max(far * 1e-3, 0.5 * outside_m)
+    def widened(tan_half: float) -> np.ndarray:  # the bounds' corners from the light, FIT_MARGIN_TEXELS wider
+        margin_m = FIT_MARGIN_TEXELS * (2.0 * tan_half / resolution) * far + 1e-6 * float(np.linalg.norm(hi - lo))
+        return box_corners(lo - margin_m, hi + margin_m) - light.position_m
+
+    own_fov = light.spot_size_rad * 1.02 if light.kind == "SPOT" else np.inf
+    cone = bounds_cone(corners - light.position_m)  # None: the light is among the bounds
+    if cone is not None:
+        cone = bounds_cone(widened(np.tan(cone[1])))  # in the fitted view's own texels
+    # the view the light would have otherwise: its spot's face, or a 90-degree cube face
+    other_half = min(own_fov, SINGLE_FACE_MAX_SPOT_RAD) / 2.0 if own_fov <= SINGLE_FACE_MAX_SPOT_RAD else np.pi / 4.0
+    if cone is not None and np.tan(cone[1]) * FIT_MIN_GAIN <= np.tan(other_half):
+        return [_perspective_view(light, index, cone[0], -1, 2.0 * cone[1], near, far, resolution)]
+    wide = widened(1.0)  # in a cube face's texels
     if light.kind == "SPOT" and light.spot_size_rad <= SINGLE_FACE_MAX_SPOT_RAD:
-        fov = min(light.spot_size_rad * 1.02, SINGLE_FACE_MAX_SPOT_RAD)
+        fov = min(own_fov, SINGLE_FACE_MAX_SPOT_RAD)
         return [_perspective_view(light, index, light.direction, -1, fov, near, far, resolution)]
     views = []
     for face, axis in enumerate(CUBE_AXES):
         if light.kind == "AREA" and np.dot(axis, light.direction) < -0.5:
             continue  # the face behind a one-sided emitter receives nothing
+        if not face_meets(axis, wide):
+            continue  # nothing of the scene lies in this face's pyramid
         views.append(_perspective_view(light, index, axis, face, np.pi / 2.0, near, far, resolution))
     return views
+
+
+def bounds_cone(corners: np.ndarray) -> tuple[np.ndarray, float] | None:
+    """(axis, half field of view in rad) of the square perspective view from the origin, along the
+    direction to the box's centre, that holds the box of these corners (relative to the light), as
+    _perspective_view orients it (look_along); None when the origin lies in the box or some corner lies
+    at or behind the origin's plane across that direction."""
+    lo, hi = corners.min(axis=0), corners.max(axis=0)
+    if np.all(lo <= 0.0) and np.all(hi >= 0.0):
+        return None
+    centre = (lo + hi) / 2.0
+    axis = centre / np.linalg.norm(centre)
+    local = corners @ look_along(np.zeros(3), axis)[:3, :3].T  # view space: -z along the axis
+    depth = -local[:, 2]
+    if np.min(depth) <= 0.0:
+        return None
+    return axis, float(np.arctan(np.max(np.abs(local[:, :2]) / depth[:, None])))
+
+
+def face_meets(axis: np.ndarray, corners: np.ndarray) -> bool:
+    """Whether the cube face along `axis` (its 90-degree pyramid from the origin: the points whose
+    coordinate along the axis is positive and at least each other coordinate's magnitude) can meet the
+    box of these corners (relative to the light). False only when every corner lies outside one of the
+    pyramid's five planes (so the box does); it may say True of a box that misses."""
+    along = corners @ axis
+    if np.all(along < 0.0):
+        return False
+    for other in np.flatnonzero(axis == 0.0):
+        for sign in (1.0, -1.0):
+            if np.all(sign * corners[:, other] > along):
+                return False
+    return True
 
 
 def _common_uniforms(light: Light, emit_axis: np.ndarray, texel_scale: float) -> dict:
