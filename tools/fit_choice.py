@@ -32,13 +32,15 @@ from addon.engine import choice  # noqa: E402
 BUDGETS = (0.1, 0.2, 0.3)
 # A row predicted at E / margin is measured within E on this share of held-out rows. Choosing the fastest
 # row expected within E trades the budget met against time: swept on the held-out judgement below (so
-# these figures flatter the pick a little), met / within 2x of the fastest row at E = 0.1, 0.2, 0.3 of
-# 15 scenes (errors against the choice run's references at --ref-noise 0.03): 0.6 (x1.12) 10/5, 9/7,
-# 12/11; 0.7 (x1.24) 9/2, 10/7, 12/11; 0.8 (x1.46) 11/3, 11/5, 13/6. `--verify`, which checks its
-# choice on the scene and is what the product runs (choice.VERIFY_LOOSEN 1), met / within 2x / its
-# estimate within 1.5x: 0.6 12/6/10, 12/9/10, 14/13/13; 0.7 12/3/7, 12/9/10, 14/13/13; 0.8 12/3/7,
-# 12/6/10, 14/7/12: 0.6 is at least as good as the others for it at every budget.
-MARGIN_QUANTILE = 0.6
+# these figures flatter the pick a little), on the choice run of every registry row (benchmarks/choice/
+# rows, against its references at --ref-noise 0.03). `--verify`, which checks its choice on the scene
+# and is what the product runs (choice.VERIFY_LOOSEN 1), met / within 2x of the fastest row meeting
+# the budget / its estimate within 1.5x, of 15 scenes, at E = 0.1, 0.2, 0.3: 0.5 (x1.01) 9/4/11,
+# 11/9/10, 14/13/13; 0.6 (x1.12) 10/4/11, 11/9/11, 14/13/13; 0.7 (x1.25) 12/3/6, 12/9/11, 14/13/13;
+# 0.8 (x1.48) 12/3/7, 13/8/10, 14/11/12. 0.7 is the least that meets the budget on 12 scenes at every E
+# (the first target; at E = 0.1 only 12 scenes have a row within it); the model's own choice
+# then met 9, 10, 13.
+MARGIN_QUANTILE = 0.7
 ESTIMATE_FACTOR = 1.5
 
 
@@ -200,7 +202,7 @@ def verified_figures(rows: list[dict], budget: float) -> dict:
                                         <= r["estimate"] / r["measured"] <= ESTIMATE_FACTOR)}
 
 
-SWEEP = {"VERIFY_LOOSEN": (1.0, 1.5, 2.0), "VERIFY_MAX_TRIES": (4, 6), "VERIFY_ACCEPT": (1.0, 0.9, 0.8)}
+SWEEP = {"VERIFY_LOOSEN": (1.0, 1.5, 2.0, 3.0), "VERIFY_MAX_TRIES": (4, 6), "VERIFY_ACCEPT": (1.0, 0.9)}
 
 
 def sweep_verify(models: dict, features: dict, agreed: list[dict]) -> str:

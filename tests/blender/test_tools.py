@@ -77,7 +77,7 @@ def test_fit_choice_fits_judges_and_writes(tmp_path):
     table = tool("tools/fit_choice.py", str(results), "--cache", str(cache), "--out", str(out), "--model",
                  str(model), "--sweep-verify").strip().splitlines()
     combos = [line for line in table if line.startswith("| ") and line[2].isdigit()]
-    assert len(combos) == 3 * 2 * 3  # fit_choice.SWEEP: loosenings x try counts x acceptances
+    assert len(combos) == 4 * 2 * 2  # fit_choice.SWEEP: loosenings x try counts x acceptances
     assert all(line.split(" | ")[-2] == "3 / 3 / 0.0 / 3" for line in combos)  # E = 0.2
     assert not model.exists()
 
