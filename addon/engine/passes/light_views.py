@@ -182,22 +182,22 @@ def views_for(light: Light, index: int, bounds: tuple[np.ndarray, np.ndarray], r
     # bounds, half the distance to them clips nothing; inside, far / 1000 (32-bit depth, ~1e-4 relative).
     outside_m = float(np.linalg.norm(np.maximum(np.maximum(lo - light.position_m, light.position_m - hi), 0.0)))
     near = max(far * 1e-3, 0.5 * outside_m)
+
     def widened(tan_half: float) -> np.ndarray:  # the bounds' corners from the light, FIT_MARGIN_TEXELS wider
         margin_m = FIT_MARGIN_TEXELS * (2.0 * tan_half / resolution) * far + 1e-6 * float(np.linalg.norm(hi - lo))
         return box_corners(lo - margin_m, hi + margin_m) - light.position_m
 
-    own_fov = light.spot_size_rad * 1.02 if light.kind == "SPOT" else np.inf
+    spot_face = light.kind == "SPOT" and light.spot_size_rad <= SINGLE_FACE_MAX_SPOT_RAD
+    # the field of view the light has otherwise: its spot's face, or a cube face's
+    own_fov = min(light.spot_size_rad * 1.02, SINGLE_FACE_MAX_SPOT_RAD) if spot_face else np.pi / 2.0
     cone = bounds_cone(corners - light.position_m)  # None: the light is among the bounds
     if cone is not None:
         cone = bounds_cone(widened(np.tan(cone[1])))  # in the fitted view's own texels
-    # the view the light would have otherwise: its spot's face, or a 90-degree cube face
-    other_half = min(own_fov, SINGLE_FACE_MAX_SPOT_RAD) / 2.0 if own_fov <= SINGLE_FACE_MAX_SPOT_RAD else np.pi / 4.0
-    if cone is not None and np.tan(cone[1]) * FIT_MIN_GAIN <= np.tan(other_half):
+    if cone is not None and np.tan(cone[1]) * FIT_MIN_GAIN <= np.tan(own_fov / 2.0):
         return [_perspective_view(light, index, cone[0], -1, 2.0 * cone[1], near, far, resolution)]
+    if spot_face:
+        return [_perspective_view(light, index, light.direction, -1, own_fov, near, far, resolution)]
     wide = widened(1.0)  # in a cube face's texels
-    if light.kind == "SPOT" and light.spot_size_rad <= SINGLE_FACE_MAX_SPOT_RAD:
-        fov = min(own_fov, SINGLE_FACE_MAX_SPOT_RAD)
-        return [_perspective_view(light, index, light.direction, -1, fov, near, far, resolution)]
     views = []
     for face, axis in enumerate(CUBE_AXES):
         if light.kind == "AREA" and np.dot(axis, light.direction) < -0.5:
