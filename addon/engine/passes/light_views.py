@@ -5,10 +5,9 @@ Only what the scene needs: a light outside the scene's bounds spends its texels 
 a square view fitted to the bounds has texels at most half as wide as the light's own views (a cube
 face, or a spot's face), the light gets that one view instead (a lamp 30 m from a 2 m room: the room's
 4 degrees filled at full resolution rather than a few texels of one face). Otherwise a cube face whose
-90-degree pyramid misses the bounds is skipped. The bounds
-are widened by FIT_MARGIN_TEXELS texels at the far distance first: the direct pass lifts a receiver
-off its surface by a few texels before it looks the receiver up, and the lifted point must still lie in
-a view.
+90-degree pyramid misses the bounds is skipped. The bounds are widened by FIT_MARGIN_TEXELS texels at
+the far distance first: the direct pass lifts a receiver off its surface by a few texels before it
+looks the receiver up, and the lifted point must still lie in a view.
 
 An area light's RSM looks from its centre as a Lambertian point, I(w) = P / pi * cos: its VPLs. A
 light with a shape (area_light.split_area_light's patches, emissive triangles: Light.emitter) is lit
