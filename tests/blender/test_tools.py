@@ -77,9 +77,27 @@ def test_fit_choice_fits_judges_and_writes(tmp_path):
     table = tool("tools/fit_choice.py", str(results), "--cache", str(cache), "--out", str(out), "--model",
                  str(model), "--sweep-verify").strip().splitlines()
     combos = [line for line in table if line.startswith("| ") and line[2].isdigit()]
-    assert len(combos) == 4 * 2 * 2  # fit_choice.SWEEP: loosenings x try counts x acceptances
+    assert len(combos) == 4 * 2 * 2  # fit_choice.SWEEP: stagings x try counts x acceptances
     assert all(line.split(" | ")[-2] == "3 / 3 / 0.0 / 3" for line in combos)  # E = 0.2
     assert not model.exists()
+    # An earlier fit's run-time differences in place of the images: 0.12 for the 0.1 row, 0.25 for the
+    # 0.3 row on every scene. --verify then renders the 0.1 row alone at E = 0.2 (within, taken); the
+    # bound's order is by measured time: the 10 ms row first, taken at E = 0.3 (0.25 <= 0.3, measured 0.3),
+    # passed over at E = 0.2 for the 0.1 row; nothing's estimate is within E = 0.1.
+    judged = tmp_path / "judged.json"
+    agreed = [{"scene": s, "row": row, "against": "-", "measured": e, "model": e, "agree": d, "blend": e}
+              for s in scenes for row, e, d in (("rsm vpl_samples=256", 0.1, 0.12), ("lpv grid_cells=16", 0.3, 0.25))]
+    judged.write_text(json.dumps({"agreement": agreed}))
+    args = (str(results), "--cache", str(cache), "--out", str(out), "--model", str(model), "--agreement", str(judged))
+    summary = json.loads(tool("tools/fit_choice.py", *args).strip().splitlines()[-1])
+    assert summary["0.2"]["verified_mean_tries"] == 1.0 and summary["0.2"]["self_check_within_1.5x"] == 3
+    assert summary["0.2"]["verified_met"] == 3 and summary["0.2"]["verified_estimate_within_1.5x"] == 3
+    assert "E = 0.1: 0 / 0, E = 0.2: 3 / 3, E = 0.3: 3 / 3" in tool("tools/fit_choice.py", *args, "--sweep-verify")
+    # Differences of other results (another measured error) are refused, not silently judged.
+    agreed[0]["measured"] = 0.2
+    judged.write_text(json.dumps({"agreement": agreed}))
+    done = subprocess.run([sys.executable, "tools/fit_choice.py", *args], cwd=ROOT, capture_output=True, text=True)
+    assert done.returncode != 0 and "is of other results" in done.stderr
 
 
 def test_diffusion_box_prints_both_transfers():
