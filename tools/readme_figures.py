@@ -22,7 +22,6 @@ ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
 UPDATES_JSON = ROOT / "benchmarks" / "updates" / "results.json"
 DEFAULTS_JSON = ROOT / "benchmarks" / "defaults" / "results.json"
-EEVEE_JSON = ROOT / "benchmarks" / "eevee" / "results.json"
 LPV_DOC = ROOT / "docs" / "LPV.md"
 OCTREE_JSON = ROOT / "benchmarks" / "octree" / "results.json"
 DIFFUSION_DOC = ROOT / "docs" / "DIFFUSION.md"
@@ -199,20 +198,20 @@ def _cycles_time(s: dict | None) -> str:
     return {"=": "", "<": "<= ", ">": ">= "}[s["bound"]] + _seconds(s["cycles_time_s"])
 
 
-def headline_block(results: dict, eevee_results: dict) -> str:
+def headline_block(results: dict) -> str:
     """Table: per scene, our most accurate method at its defaults (indirect light) with its time, and what
-    the anchors need for the same rel_rmse_8: raw Cycles and Cycles + OIDN along their curves of the same
-    run, and EEVEE's render at its best GI setting (a separate run on the same machine: its time and
-    error, since an EEVEE render is not a curve)."""
-    eevee = {sc["name"]: sc.get("eevee") for sc in eevee_results["scenes"]}
+    the anchors of the same run need for the same rel_rmse_8: raw Cycles and Cycles + OIDN along their
+    curves, and EEVEE's render at its best GI setting (its time and error, since an EEVEE render is not a
+    curve; `bench --anchors oidn,eevee`)."""
+    eevee = {sc["name"]: sc.get("eevee") for sc in results["scenes"]}
     records = [r for r in _default_records(results) if r["product"] == "indirect" and r["rel_rmse_8"] is not None]
     lines = ["**Our time at equal error**: per scene, the most accurate method at its defaults and what the "
              "anchors need to match it.", "",
              "Ours and Cycles (raw, and with Open Image Denoise: the time Cycles needs for the same rel_rmse_8 along "
              "its curve of the same run; <= where our error is above its fastest point). " + _produced_by(results)
              + f" {results['res']} px long side, indirect light against Cycles at {_spp(results)}.", "",
-             "EEVEE (one render at its best GI setting: its time and rel_rmse_8; EEVEE / ours = its time over ours "
-             "where our error is at most its own). " + _produced_by(eevee_results), "",
+             "EEVEE: one render per scene at its best GI setting in the same run, its time and rel_rmse_8 against "
+             "the same reference; EEVEE / ours = its time over ours where our error is at most its own.", "",
              "| scene | method | rel_rmse_8 | ours | Cycles | Cycles + OIDN | EEVEE | EEVEE / ours |",
              "| --- | --- | --- | --- | --- | --- | --- | --- |"]
     for scene in dict.fromkeys(r["scene"] for r in records):
@@ -416,7 +415,7 @@ def gpu_block(*runs: dict) -> str:
 
 # block name -> (the file it is in, its results.json file(s), the function that formats them)
 BLOCKS: dict[str, tuple[Path, tuple[Path, ...], Callable[..., str]]] = {
-    "headline": (README, (DEFAULTS_JSON, EEVEE_JSON), headline_block),
+    "headline": (README, (DEFAULTS_JSON,), headline_block),
     "update-costs": (README, (UPDATES_JSON,), update_costs_block),
     "gpu": (README, GPU_JSON, gpu_block),
     "accuracy": (README, (DEFAULTS_JSON,), accuracy_block),
