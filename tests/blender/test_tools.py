@@ -92,6 +92,7 @@ def test_fit_choice_fits_judges_and_writes(tmp_path):
     summary = json.loads(tool("tools/fit_choice.py", *args).strip().splitlines()[-1])
     assert summary["0.2"]["verified_mean_tries"] == 1.0 and summary["0.2"]["self_check_within_1.5x"] == 3
     assert summary["0.2"]["verified_met"] == 3 and summary["0.2"]["verified_estimate_within_1.5x"] == 3
+    assert "met / within 2x: E = 0.1: 0 / 0, E = 0.2: 3 / 3, E = 0.3: 3 / 3." in (out / "REPORT.md").read_text()
     assert "E = 0.1: 0 / 0, E = 0.2: 3 / 3, E = 0.3: 3 / 3" in tool("tools/fit_choice.py", *args, "--sweep-verify")
     # Differences of other results (another measured error) are refused, not silently judged.
     agreed[0]["measured"] = 0.2
