@@ -245,14 +245,11 @@ def sweep_verify(models: dict, features: dict, agreed: list[dict]) -> str:
     finally:
         for n, v in saved.items():
             setattr(choice, n, v)
-    lines += ["", "What the estimate allows however the tries are ordered: every row tried, fastest first by its "
-              "measured time, no cap, the first whose estimate is within the budget; met / within 2x at " +
-              ", ".join(f"E = {b:g}: {met} / {fast}" for b, (met, fast) in estimate_bound(models, agreed).items())]
-    return "\n".join(lines)
+    return "\n".join([*lines, "", bound_line(estimate_bound(models, agreed))])
 
 
-def estimate_bound(models: dict, agreed: list[dict]) -> dict[float, tuple[int, int]]:
-    """Per budget: (met, within 2x of the fastest row meeting it) over the held-out scenes when every row
+def estimate_bound(models: dict, agreed: list[dict]) -> dict[str, dict[str, int]]:
+    """Per budget: {met, within_2x of the fastest row meeting it} over the held-out scenes when every row
     with a run-time estimate is tried in order of its measured time and the first whose estimate is
     within the budget is taken; an ordering no model can better, so what the estimate alone bounds."""
     estimates = {(a["scene"], a["row"]): a["agree"] for a in agreed}
@@ -267,8 +264,15 @@ def estimate_bound(models: dict, agreed: list[dict]) -> dict[float, tuple[int, i
                 met += 1
                 fast += pick["total_ms"] <= 2.0 * min(r["total_ms"] for r in measured.values()
                                                       if r["rel_rmse_8"] <= budget)
-        out[budget] = met, fast
+        out[str(budget)] = {"met": met, "within_2x": fast}
     return out
+
+
+def bound_line(bound: dict[str, dict[str, int]]) -> str:
+    """`estimate_bound`'s figures as the report and the sweep state them."""
+    return ("What the self-check estimate allows in any order of tries (`estimate_bound`: every row tried "
+            "fastest first by its measured time, no cap, the first whose estimate is within the budget taken), "
+            "met / within 2x: " + ", ".join(f"E = {b}: {v['met']} / {v['within_2x']}" for b, v in bound.items()) + ".")
 
 
 def summary(judged: dict) -> dict:
@@ -340,11 +344,7 @@ def report(results_path: str, arguments: str, judged: dict, summ: dict, model: c
     lines += ["", f"Every measured row's estimate within a factor 1.5: {summ['all_rows_estimate_within_1.5x']:.0%}.",
               ""]
     if judged.get("agreement"):
-        bound = judged["estimate_bound"]
-        lines += ["What the self-check estimate allows in any order of tries (`estimate_bound`: every row tried "
-                  "fastest first by its measured time, no cap, the first whose estimate is within the budget "
-                  "taken), met / within 2x: " + ", ".join(f"E = {b}: {v['met']} / {v['within_2x']}"
-                                                          for b, v in bound.items()) + ".", ""]
+        lines += [bound_line(judged["estimate_bound"]), ""]
     if "run_time_agree_within_1.5x" in summ:
         lines += ["Estimates of every row within a factor 1.5 of its measured error, held-out scenes: the model "
                   f"{summ['run_time_model_within_1.5x']:.0%}; the difference from the row of another method the "
@@ -383,8 +383,8 @@ def main(argv=None) -> int:
     p.add_argument("--ridge", type=float, default=1.0)
     p.add_argument("--agreement", type=Path,
                    help="take the run-time estimates from this judged.json, an earlier fit's on the same "
-                        "results, instead of the rows' images in the cache (a later bench into the cache "
-                        "overwrites them)")
+                        "results and --ridge, instead of the rows' images in the cache (a later bench into the "
+                        "cache overwrites them)")
     p.add_argument("--sweep-verify", action="store_true",
                    help="print `--verify`'s held-out figures over a grid of choice.VERIFY_STAGES, "
                         "VERIFY_MAX_TRIES and VERIFY_ACCEPT, and write nothing")
@@ -411,8 +411,7 @@ def main(argv=None) -> int:
         print(sweep_verify(models, features, judged["agreement"]))
         return 0
     judged["verified"] = verified(models, features, judged["agreement"])
-    judged["estimate_bound"] = {str(b): {"met": met, "within_2x": fast}
-                                for b, (met, fast) in estimate_bound(models, judged["agreement"]).items()}
+    judged["estimate_bound"] = estimate_bound(models, judged["agreement"])
     summ = summary(judged)
     model = choice.fit(records, features, args.ridge)
     model.margin = margin_of(records, features, args.ridge)
