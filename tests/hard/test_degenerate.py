@@ -102,28 +102,43 @@ def test_non_finite_vertex_in_engine_scene(gl, figures, name, bad):
     _same(got, ref)
 
 
+def tiled_floor(quads_per_side: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A 20 x 20 m floor at z = 0 cut into quads_per_side^2 quads (two triangles each), albedo 0.7."""
+    xs = np.linspace(-10, 10, quads_per_side + 1)
+    gx, gy = np.meshgrid(xs, xs, indexing="ij")
+    v = np.stack([gx, gy, np.zeros_like(gx)], -1)
+    q0, q1, q2, q3 = v[:-1, :-1], v[1:, :-1], v[1:, 1:], v[:-1, 1:]
+    tris = np.concatenate([np.stack([q0, q1, q2], -2).reshape(-1, 3, 3), np.stack([q0, q2, q3], -2).reshape(-1, 3, 3)])
+    return tris, np.broadcast_to(np.array([0, 0, 1.0]), tris.shape), np.full((len(tris), 3), 0.7)
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ALL_METHODS)
 def test_million_triangle_floor(gl, figures, name):
     # A 20 x 20 m floor cut into 708^2 quads = 1,002,528 triangles under a 100 W light at 1 m: the same
     # plane as two triangles, so the same image (the G-buffer and RSM positions are interpolated on the same
-    # plane; 1e-4 of the mean allows the fp32 rounding of 1e6 small triangles' edges). Timed: one
-    # set_scene + run must stay well under the suite's budget on llvmpipe (<= 20 s measured 2 s here).
-    k = 708
-    xs = np.linspace(-10, 10, k + 1)
-    gx, gy = np.meshgrid(xs, xs, indexing="ij")
-    v = np.stack([gx, gy, np.zeros_like(gx)], -1)
-    q0, q1, q2, q3 = v[:-1, :-1], v[1:, :-1], v[1:, 1:], v[:-1, 1:]
-    tris = np.concatenate([np.stack([q0, q1, q2], -2).reshape(-1, 3, 3), np.stack([q0, q2, q3], -2).reshape(-1, 3, 3)])
-    assert len(tris) >= 1_000_000
-    nrm = np.broadcast_to(np.array([0, 0, 1.0]), tris.shape)
+    # plane; 1e-4 of the mean allows the fp32 rounding of 1e6 small triangles' edges). Its cost must grow
+    # about as the triangle count: one set_scene + run of the floor against the same of a quarter of its
+    # triangles (354^2 quads) in the same process. A fixed cost a plus b per triangle gives a ratio
+    # (a + 4 b n) / (a + b n) <= 4, a sort of the vertices (scene.first_copies) 4.4; measured 1.6-6.6 on
+    # the 2-core CI machine (the larger arrays leave the caches). The bound 10 is 1.5x the most measured and
+    # catches a pass that grows with the square of the count (16). Absolute seconds are recorded, not
+    # bounded: they measure the machine (4-15 s there), and benchmarks are not timed tests.
     light = point([0.3, 0.2, 1.0], 100.0)
     cam = camera([0, -3, 2], [0, 1, -0.7], 48)
+    quarter = tiled_floor(354)
     t0 = time.perf_counter()
-    big = render(gl, name, make_scene((tris, nrm, np.full((len(tris), 3), 0.7)), [light], cam))
+    render(gl, name, make_scene(quarter, [light], cam))
+    quarter_s = time.perf_counter() - t0
+    floor = tiled_floor(708)
+    assert len(floor[0]) >= 1_000_000 and 4 * len(quarter[0]) == len(floor[0])
+    t0 = time.perf_counter()
+    big = render(gl, name, make_scene(floor, [light], cam))
     seconds = time.perf_counter() - t0
     small = render(gl, name, make_scene(parts((*rect([-10, -10, 0], [20, 0, 0], [0, 20, 0]), 0.7)), [light], cam))
-    figures("1e6-triangle floor: set_scene + run (s)", name, seconds, "< 20")
+    figures("1e6-triangle floor: set_scene + run (s)", name, seconds, "recorded")
+    figures("1e6-triangle floor: time over a quarter of its triangles'", name, seconds / quarter_s,
+            "≤ 10 (linear: ≤ 4)")
     figures("1e6-triangle floor vs 2 triangles: direct rel error", name,
             allclose_figure(big["direct"][..., :3], small["direct"][..., :3], 1e-4, 1e-4 * small["direct"].mean()),
             "≤ 1e-4 (atol 1e-4 mean)")
@@ -131,7 +146,7 @@ def test_million_triangle_floor(gl, figures, name):
         figures("1e6-triangle floor: max indirect (both)", name,
                 max(big["indirect"][..., :3].max(), small["indirect"][..., :3].max()), "= 0")
     assert_sane(big)
-    assert seconds < 20.0, seconds
+    assert seconds / quarter_s <= 10.0, (seconds, quarter_s)
     np.testing.assert_allclose(big["direct"][..., :3], small["direct"][..., :3], rtol=1e-4,
                                atol=1e-4 * small["direct"].mean())
     if "indirect" in big:  # a lone plane bounces nothing onto itself: exact 0 both ways
