@@ -123,7 +123,7 @@ def test_million_triangle_floor(gl, figures, name):
     # (a + 4 b n) / (a + b n) <= 4, a sort of the vertices (scene.first_copies) 4.4; measured 1.6-6.6 on
     # the 2-core CI machine (the larger arrays leave the caches). The bound 10 is 1.5x the most measured and
     # catches a pass that grows with the square of the count (16). Absolute seconds are recorded, not
-    # bounded: they measure the machine (4-15 s there), and benchmarks are not timed tests.
+    # bounded: they measure the machine (3-15 s there), and benchmarks are not timed tests.
     light = point([0.3, 0.2, 1.0], 100.0)
     cam = camera([0, -3, 2], [0, 1, -0.7], 48)
     quarter = tiled_floor(354)
