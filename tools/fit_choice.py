@@ -2,7 +2,7 @@
 scene on scenes it was not fitted on, and write the model and the report.
 
     .venv/bin/python tools/fit_choice.py RESULTS.json [MORE.json ...] [--cache out/bench] [--out benchmarks/choice]
-        [--model addon/engine/data/choice_model.json] [--agreement benchmarks/choice/judged.json] [--sweep-verify]
+        [--model addon/engine/data/choice_model.json] [--estimates benchmarks/choice/judged.json] [--sweep-verify]
 
 Each scene's features come from its .blend in the bench cache (`<cache>/scenes/<scene>.blend`, what
 bench rendered), captured as `render` captures it. The judgement is leave-one-scene-out: for every
@@ -18,7 +18,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import re
 import sys
 from pathlib import Path
 
@@ -34,12 +33,12 @@ BUDGETS = (0.1, 0.2, 0.3)
 # row expected within E trades the budget met against time: swept on the held-out judgement below (so
 # these figures flatter the pick a little), on the choice run of every registry row (benchmarks/choice/
 # rows, against its references at --ref-noise 0.03). `--verify`, which checks its choice on the scene
-# and is what the product runs (choice.VERIFY_STAGES (1, 2)), met / within 2x of the fastest row
-# meeting the budget / its estimate within 1.5x, of 15 scenes, at E = 0.1, 0.2, 0.3: 0.5 (x1.02)
-# 9/4/11, 11/9/10, 14/13/13; 0.6 (x1.11) 10/4/11, 11/9/11, 14/13/13; 0.7 (x1.26) 12/5/9, 12/9/11,
-# 14/13/13; 0.8 (x1.58) 9/5/10, 12/8/11, 14/11/12. 0.7 is the only one that meets the budget on 12
-# scenes at every E (the issue's first target; at E = 0.1 only 12 scenes have a row within it); the
-# model's own choice then met 9, 10, 13.
+# and is what the product runs (choice.VERIFY_STAGES (3), at most 40 rows, accepted below 0.95 budgets,
+# the path-traced check at CHECK_NOISE 0.25), met / within 2x of the fastest row meeting the budget /
+# mean rows tried, of 15 scenes, at E = 0.1, 0.2, 0.3: 0.5 (x1.02) 12/10/9.4, 14/13/9.6, 15/15/4.7;
+# 0.6 (x1.11) 12/10/8.9, 14/13/9.5, 15/15/4.6; 0.7 (x1.26) 12/10/8.4, 14/13/8.8, 15/15/4.5; 0.8 (x1.58)
+# 12/10/6.9, 14/12/6.8, 15/15/4.1. The margin hardly matters to the verified choice, which tries rows
+# up to 3 budgets; 0.7 is kept.
 MARGIN_QUANTILE = 0.7
 ESTIMATE_FACTOR = 1.5
 
@@ -126,66 +125,90 @@ def run_image(cache: Path, scene: str, method: str, setting: dict) -> Path:
     return bench.row_dir(cache, scene, method, bench.setting_label(setting)) / "indirect.exr"
 
 
-def agreement(records: list[dict], features: dict, cache: Path, ridge: float, ref_glob: dict[str, str]) -> list[dict]:
-    """The run-time estimate judged: for every held-out scene and row R, the rel_rmse_8 between R's
-    image and the image of the row of another method the model (fitted without the scene) expects to
-    be most accurate, B; and the estimates built from it: `agree` = that difference, `blend` = the
-    geometric mean of it and the model's prediction. Each beside the measured error."""
-    from addon.bridge import images
-    from addon.bridge.reference import reference_mask
-    from addon.engine.metrics import rel_rmse_8
+def path_traced_checks(cache: Path, scenes, res: int, bounces: int) -> dict[str, dict[str, dict]]:
+    """Per scene and budget: `render --verify`'s path-traced check of the scene (pipeline.path_traced_check,
+    resolving the budget), its Cycles renders kept under `<cache>/checks` (a second fit renders nothing)."""
+    from addon.bridge.pipeline import open_blend, path_traced_check
+    from addon.bridge.reference import render_open
 
-    out = []
-    for held in sorted(features):
-        model = choice.fit([r for r in records if r["scene"] != held],
-                           {s: f for s, f in features.items() if s != held}, ridge)
-        rows = [r for r in records if r["scene"] == held and choice.row_key(r["method"], r["setting"]) in model.rows]
-        refs = [d for d in sorted((cache / "refs").glob(f"{held}-{ref_glob[held]}"))
-                if re.fullmatch(rf"{re.escape(held)}-[0-9a-f]{{12}}-.*", d.name)]  # not cornell-sun for cornell
-        if not rows or not refs:
-            continue
-        ref = images.read_exr(refs[-1] / "indirect.exr")
-        mask = reference_mask(refs[-1] / "indirect.exr", ref)  # the pixels bench judged the rows on
-        pred = {choice.row_key(r["method"], r["setting"]): model.predict(choice.row_key(r["method"], r["setting"]),
-                                                                          features[held])[0] for r in rows}
-        for r in rows:
-            key = choice.row_key(r["method"], r["setting"])
-            others = [o for o in rows if o["method"] != r["method"]]
-            if not others:
-                continue
-            best = min(others, key=lambda o: pred[choice.row_key(o["method"], o["setting"])])
-            a, b = (run_image(cache, held, x["method"], x["setting"]) for x in (r, best))
-            if not (a.is_file() and b.is_file()):
-                continue
-            d = rel_rmse_8(images.read_exr(a)[..., :3], images.read_exr(b)[..., :3], mask)
-            out.append({"scene": held, "row": key, "against": choice.row_key(best["method"], best["setting"]),
-                        "measured": r["rel_rmse_8"], "model": pred[key], "agree": d,
-                        "blend": math.sqrt(max(d, 1e-9) * pred[key])})
+    out = {}
+    for name in scenes:
+        open_blend(cache / "scenes" / f"{name}.blend")
+
+        def render(spp: int, seed: int, name=name):
+            path = cache / "checks" / f"{name}-r{res}-b{bounces}-spp{spp}-seed{seed}.npz"
+            if not path.is_file():
+                layers, time_s, _ = render_open(spp, bounces, res, seed)
+                path.parent.mkdir(parents=True, exist_ok=True)
+                np.savez_compressed(path, indirect=layers["Diffuse Indirect"][..., :3],
+                                    alpha=layers["Combined"][..., 3], albedo=layers["Diffuse Color"][..., :3],
+                                    time_s=time_s)
+            z = np.load(path)
+            return {"Diffuse Indirect": z["indirect"], "Combined": np.dstack([z["indirect"], z["alpha"]]),
+                    "Diffuse Color": z["albedo"]}, float(z["time_s"])
+
+        out[name] = {str(budget): path_traced_check(budget, bounces, res, render) for budget in BUDGETS}
     return out
 
 
-def stored_agreement(judged_path: Path, records: list[dict]) -> list[dict]:
-    """`agreement`'s rows from an earlier judged.json, once each is checked to be of these records (the
-    same scene, row and measured error): the images they were taken from may be gone."""
-    stored = json.loads(judged_path.read_text()).get("agreement", [])
+def checked_estimates(models: dict, cache: Path, res: int, bounces: int) -> tuple[list[dict], dict]:
+    """The run-time estimate judged: for every held-out scene, row with an image in the bench's runs and
+    budget, the row's path-traced estimate (pipeline.path_traced_estimate against that budget's check)
+    beside its measured error; and per scene and budget the check's samples, noise and time. Scenes
+    without row images render no check."""
+    from addon.bridge import images
+    from addon.bridge.pipeline import path_traced_estimate
+
+    found = {held: {key: run_image(cache, held, r["method"], r["setting"]) for key, r in measured.items()}
+             for held, (_, measured) in models.items()}
+    found = {held: {k: p for k, p in paths.items() if p.is_file()} for held, paths in found.items()}
+    checks = path_traced_checks(cache, [held for held, paths in found.items() if paths], res, bounces)
+    out = []
+    stats = {held: {budget: {"spp": c["spp"], "noise": c["noise"], "time_s": c["time_s"]}
+                    for budget, c in per_budget.items() if c is not None} for held, per_budget in checks.items()}
+    for held, paths in found.items():
+        measured = models[held][1]
+        for key, path in paths.items():
+            ours = images.read_exr(path)
+            for budget, check in checks[held].items():
+                estimate = path_traced_estimate(ours, check) if check is not None else None
+                if estimate is None:
+                    continue
+                out.append({"scene": held, "row": key, "budget": budget, "measured": measured[key]["rel_rmse_8"],
+                            "estimate": estimate})
+    return out, stats
+
+
+def stored_estimates(judged_path: Path, records: list[dict]) -> tuple[list[dict], dict]:
+    """`checked_estimates`' rows and checks from an earlier judged.json, once each row is checked to be of
+    these records (the same scene, row and measured error): the images they were taken from may be gone."""
+    judged = json.loads(judged_path.read_text())
+    stored = judged.get("checked", [])
     measured = {(r["scene"], choice.row_key(r["method"], r["setting"])): r["rel_rmse_8"] for r in records}
     for a in stored:
         if measured.get((a["scene"], a["row"])) != a["measured"]:
             raise SystemExit(f"{judged_path}: its estimate of {a['scene']} {a['row']} is of other results")
-    return stored
+    return stored, judged.get("checks", {})
 
 
-def verified(models: dict, features: dict, agreed: list[dict]) -> dict:
+def lookup(checked: list[dict]) -> dict[tuple[str, str, str], float]:
+    """(scene, row, budget) -> the path-traced estimate."""
+    return {(a["scene"], a["row"], a["budget"]): a["estimate"] for a in checked}
+
+
+def verified(models: dict, features: dict, checked: list[dict]) -> dict:
     """Per budget and scene: the choice of `render --method auto --error-budget E --verify`
     (choice.verify) by a model fitted without the scene (`models`: held_out), each candidate's run-time
-    estimate taken from `agreed` (`agreement`: its image against the same check row's, from the bench's
-    runs); where no candidate's estimate is within the budget, the one tried with the least estimate
-    (choice.least_estimated), and where none could be tried the model's own choice, as `render` does."""
-    estimates = {(a["scene"], a["row"]): a["agree"] for a in agreed}
+    estimate taken from `checked` (`checked_estimates`: its image judged by the scene's path-traced check
+    for the budget); where no candidate's estimate is within the budget, the one tried with the least
+    estimate (choice.least_estimated), and where none could be tried the model's own choice, as `render`
+    does. Also the time of the rows tried over the time of the row that runs (`cost`)."""
+    estimates = lookup(checked)
     out = {str(budget): [] for budget in BUDGETS}
     for held, (model, measured) in models.items():
         for budget in BUDGETS:
-            key, tried = choice.verify(model, features[held], budget, lambda k, held=held: estimates.get((held, k)))
+            key, tried = choice.verify(model, features[held], budget,
+                                       lambda k, held=held, b=str(budget): estimates.get((held, k, b)))
             accepted = key is not None
             if not accepted:  # as render: the least estimate tried, else the model's own choice
                 key = choice.least_estimated(tried) or choice.choose(model, features[held], error_budget=budget).key
@@ -198,7 +221,8 @@ def verified(models: dict, features: dict, agreed: list[dict]) -> dict:
             out[str(budget)].append({
                 "scene": held, "choice": key, "accepted": accepted, "tries": len(tried), "estimate": estimate,
                 "measured": got["rel_rmse_8"] if got else None, "ms": got["total_ms"] if got else None,
-                "fastest_ms": min(r["total_ms"] for r in within) if within else None})
+                "fastest_ms": min(r["total_ms"] for r in within) if within else None,
+                "cost": sum(measured[t["row"]]["total_ms"] for t in tried) / got["total_ms"] if got else None})
     return out
 
 
@@ -209,12 +233,13 @@ def verified_figures(rows: list[dict], budget: float) -> dict:
     return {"met": len(met),
             "within_2x": sum(1 for r in met if r["fastest_ms"] and r["ms"] <= 2.0 * r["fastest_ms"]),
             "mean_tries": float(np.mean([r["tries"] for r in rows])),
+            "median_cost": float(np.median([r["cost"] for r in rows if r["cost"] is not None] or [0.0])),
             "estimate_within_1.5x": sum(1 for r in rows if r["measured"] and 1 / ESTIMATE_FACTOR
                                         <= r["estimate"] / r["measured"] <= ESTIMATE_FACTOR)}
 
 
-SWEEP = {"VERIFY_STAGES": ((1.0,), (1.0, 1.5), (1.0, 2.0), (1.0, 3.0)), "VERIFY_MAX_TRIES": (4, 6),
-         "VERIFY_ACCEPT": (1.0, 0.9)}
+SWEEP = {"VERIFY_STAGES": ((1.0, 2.0), (2.5,), (3.0,)), "VERIFY_MAX_TRIES": (4, 16, 40),
+         "VERIFY_ACCEPT": (1.0, 0.95)}
 
 
 def _value(v) -> str:
@@ -222,7 +247,7 @@ def _value(v) -> str:
     return ", ".join(f"{x:g}" for x in v) if isinstance(v, tuple) else f"{v:g}"
 
 
-def sweep_verify(models: dict, features: dict, agreed: list[dict]) -> str:
+def sweep_verify(models: dict, features: dict, checked: list[dict]) -> str:
     """A markdown table of `verified`'s figures at every combination of SWEEP's values of choice's
     constants: per budget, met / within 2x of the fastest row meeting it / mean rows rendered, and the
     run's estimate within ESTIMATE_FACTOR of the measured error."""
@@ -238,28 +263,28 @@ def sweep_verify(models: dict, features: dict, agreed: list[dict]) -> str:
             for n, v in zip(names, values, strict=True):
                 setattr(choice, n, v)
             cells = []
-            for budget, rows in verified(models, features, agreed).items():
+            for budget, rows in verified(models, features, checked).items():
                 f = verified_figures(rows, float(budget))
                 cells.append(f"{f['met']} / {f['within_2x']} / {f['mean_tries']:.1f} / {f['estimate_within_1.5x']}")
             lines.append("| " + " | ".join(_value(v) for v in values) + " | " + " | ".join(cells) + " |")
     finally:
         for n, v in saved.items():
             setattr(choice, n, v)
-    return "\n".join([*lines, "", bound_line(estimate_bound(models, agreed))])
+    return "\n".join([*lines, "", bound_line(estimate_bound(models, checked))])
 
 
-def estimate_bound(models: dict, agreed: list[dict]) -> dict[str, dict[str, int]]:
+def estimate_bound(models: dict, checked: list[dict]) -> dict[str, dict[str, int]]:
     """Per budget: {met, within_2x of the fastest row meeting it} over the held-out scenes when every row
     with a run-time estimate is tried in order of its measured time and the first whose estimate is
     within the budget is taken; an ordering no model can better, so what the estimate alone bounds."""
-    estimates = {(a["scene"], a["row"]): a["agree"] for a in agreed}
+    estimates = lookup(checked)
     out = {}
     for budget in BUDGETS:
         met = fast = 0
         for held, (_, measured) in models.items():
-            rows = sorted((r for k, r in measured.items() if (held, k) in estimates), key=lambda r: r["total_ms"])
-            pick = next((r for r in rows if estimates[(held, choice.row_key(r["method"], r["setting"]))]
-                         <= budget), None)
+            rows = sorted(((k, r) for k, r in measured.items() if (held, k, str(budget)) in estimates),
+                          key=lambda kr: kr[1]["total_ms"])
+            pick = next((r for k, r in rows if estimates[(held, k, str(budget))] <= budget), None)
             if pick is not None and pick["rel_rmse_8"] <= budget:
                 met += 1
                 fast += pick["total_ms"] <= 2.0 * min(r["total_ms"] for r in measured.values()
@@ -270,7 +295,7 @@ def estimate_bound(models: dict, agreed: list[dict]) -> dict[str, dict[str, int]
 
 def bound_line(bound: dict[str, dict[str, int]]) -> str:
     """`estimate_bound`'s figures as the report and the sweep state them."""
-    return ("What the self-check estimate allows in any order of tries (`estimate_bound`: every row tried "
+    return ("What the path-traced estimate allows in any order of tries (`estimate_bound`: every row tried "
             "fastest first by its measured time, no cap, the first whose estimate is within the budget taken), "
             "met / within 2x: " + ", ".join(f"E = {b}: {v['met']} / {v['within_2x']}" for b, v in bound.items()) + ".")
 
@@ -285,9 +310,9 @@ def summary(judged: dict) -> dict:
                    and r["fastest_ms"] and r["ms"] <= 2.0 * r["fastest_ms"])
         est = sum(1 for r in rows if r["measured"] and 1 / ESTIMATE_FACTOR <= r["predicted"] / r["measured"]
                   <= ESTIMATE_FACTOR)
-        checks = {(e["scene"], e["row"]): e for e in judged.get("agreement", [])}
-        self_est = sum(1 for r in rows if r["measured"] and (r["scene"], r["choice"]) in checks
-                       and 1 / ESTIMATE_FACTOR <= checks[(r["scene"], r["choice"])]["agree"] / r["measured"]
+        checks = lookup(judged.get("checked", []))
+        self_est = sum(1 for r in rows if r["measured"] and (r["scene"], r["choice"], budget) in checks
+                       and 1 / ESTIMATE_FACTOR <= checks[(r["scene"], r["choice"], budget)] / r["measured"]
                        <= ESTIMATE_FACTOR)
         s[budget] = {"scenes": n, "met": met, "possible": possible, "within_2x": fast, "estimate_within_1.5x": est,
                      "self_check_within_1.5x": self_est}
@@ -296,10 +321,13 @@ def summary(judged: dict) -> dict:
             s[budget].update({f"verified_{k}": v for k, v in verified_figures(checked, float(budget)).items()})
     ratios = [e["predicted"] / e["measured"] for e in judged["estimates"]]
     s["all_rows_estimate_within_1.5x"] = float(np.mean([1 / ESTIMATE_FACTOR <= x <= ESTIMATE_FACTOR for x in ratios]))
-    for kind in ("model", "agree", "blend"):
-        got = [1 / ESTIMATE_FACTOR <= e[kind] / e["measured"] <= ESTIMATE_FACTOR for e in judged.get("agreement", [])]
+    for budget in map(str, BUDGETS):
+        got = [1 / ESTIMATE_FACTOR <= e["estimate"] / e["measured"] <= ESTIMATE_FACTOR
+               for e in judged.get("checked", []) if e["budget"] == budget]
         if got:
-            s[f"run_time_{kind}_within_1.5x"] = float(np.mean(got))
+            s[budget]["all_rows_path_traced_within_1.5x"] = float(np.mean(got))
+            times = [c[budget]["time_s"] for c in judged.get("checks", {}).values() if budget in c]
+            s[budget]["check_time_s"] = [min(times), max(times)] if times else None
     return s
 
 
@@ -323,33 +351,37 @@ def report(results_path: str, arguments: str, judged: dict, summ: dict, model: c
              "Each scene judged by a model fitted without it. met: the choice's measured rel_rmse_8 is within the "
              "budget; possible: some measured setting is; within 2x: met, and its time at most twice the fastest "
              "setting measured within the budget; estimate: the choice's predicted error within a factor 1.5 of "
-             "its measured one; self-check: `render --self-check`'s estimate (the difference from the image of the "
-             "row of another method the model expects most accurate) within that factor; verified: the choice "
-             "of `--verify` (the first of the rows predicted within the budget, fastest first, whose self-check "
-             "estimate is within the budget; where none is, the further rows predicted within "
-             f"{', '.join(f'{x:g}' for x in choice.VERIFY_STAGES[1:]) or '-'} budgets in turn; at most "
-             f"{choice.VERIFY_MAX_TRIES} rendered; else the one rendered whose estimate is least; else the model's "
-             "choice), met and within 2x as above, and the mean number of rows it rendered besides their check "
-             "rows, and its estimate (the self-check of the row that runs, else the model's) within a factor 1.5 "
-             "of the measured error.", "",
-             "| budget | scenes | met | possible | within 2x | estimate within 1.5x | self-check within 1.5x | "
-             "verified: met | within 2x | rows tried | estimate within 1.5x |",
-             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+             "its measured one; path-traced: the estimate of `render --self-check` (the image against a pair of "
+             "few-sample Cycles renders of the scene, their own noise subtracted, as precise as the budget asks: "
+             "choice.CHECK_NOISE) within that factor; verified: the choice of `--verify` (per stage of "
+             f"{', '.join(f'{x:g}' for x in choice.VERIFY_STAGES)} budgets, the rows predicted within it and not "
+             "yet tried, fastest first, the first whose path-traced estimate is within "
+             f"{choice.VERIFY_ACCEPT:g} budget taken; at most {choice.VERIFY_MAX_TRIES} rendered; else the one "
+             "rendered whose estimate is least; else the model's choice), met and within 2x as above, the mean "
+             "number of rows it rendered, the median time of those renders over the time of the row that runs "
+             "(cost), and its estimate (the path-traced one of the row that runs, else the model's) within a "
+             "factor 1.5 of the measured error.", "",
+             "| budget | scenes | met | possible | within 2x | estimate within 1.5x | path-traced within 1.5x | "
+             "verified: met | within 2x | rows tried | cost | estimate within 1.5x |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for budget in map(str, BUDGETS):
         s = summ[budget]
         lines.append(f"| {budget} | {s['scenes']} | {s['met']} | {s['possible']} | {s['within_2x']} | "
                      f"{s['estimate_within_1.5x']} | {s['self_check_within_1.5x']} | {s.get('verified_met', '-')} | "
                      f"{s.get('verified_within_2x', '-')} | {s.get('verified_mean_tries', float('nan')):.1f} | "
+                     f"{s.get('verified_median_cost', float('nan')):.1f} | "
                      f"{s.get('verified_estimate_within_1.5x', '-')} |")
-    lines += ["", f"Every measured row's estimate within a factor 1.5: {summ['all_rows_estimate_within_1.5x']:.0%}.",
-              ""]
-    if judged.get("agreement"):
-        lines += [bound_line(judged["estimate_bound"]), ""]
-    if "run_time_agree_within_1.5x" in summ:
-        lines += ["Estimates of every row within a factor 1.5 of its measured error, held-out scenes: the model "
-                  f"{summ['run_time_model_within_1.5x']:.0%}; the difference from the row of another method the "
-                  f"model expects most accurate {summ['run_time_agree_within_1.5x']:.0%}; their geometric mean "
-                  f"{summ['run_time_blend_within_1.5x']:.0%}.", ""]
+    lines += ["", f"Every measured row's predicted error within a factor 1.5: "
+              f"{summ['all_rows_estimate_within_1.5x']:.0%}.", ""]
+    if judged.get("checked"):
+        def cell(b: str) -> str:
+            t = summ[b]["check_time_s"]
+            return (f"E = {b}: {summ[b]['all_rows_path_traced_within_1.5x']:.0%}"
+                    + (f" (Cycles pair {t[0]:.1f}-{t[1]:.1f} s with its pilot)" if t else ""))
+        lines += ["Every measured row's path-traced estimate within a factor 1.5, with the check of each budget: " +
+                  ", ".join(cell(b) for b in map(str, BUDGETS) if "all_rows_path_traced_within_1.5x" in summ[b]) + ".",
+                  "",
+                  bound_line(judged["estimate_bound"]), ""]
     for budget in map(str, BUDGETS):
         lines += [f"## Budget {budget}", "", "| scene | choice | predicted | measured | ms | fastest within | ms | "
                   "verified choice | measured | ms |", "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
@@ -371,6 +403,14 @@ def report(results_path: str, arguments: str, judged: dict, summ: dict, model: c
     return "\n".join(lines) + "\n"
 
 
+def judged_json(judged: dict) -> str:
+    """judged.json's text: indented, but each of the many path-traced estimates on one line."""
+    checked = judged.get("checked", [])
+    text = json.dumps({**judged, "checked": "CHECKED"}, indent=1)
+    rows = ",\n  ".join(json.dumps(c) for c in checked)
+    return text.replace('"CHECKED"', f"[\n  {rows}\n ]" if checked else "[]") + "\n"
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("results", type=Path, nargs="+",
@@ -381,8 +421,8 @@ def main(argv=None) -> int:
     p.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "choice")
     p.add_argument("--model", type=Path, default=choice.MODEL_PATH)
     p.add_argument("--ridge", type=float, default=1.0)
-    p.add_argument("--agreement", type=Path,
-                   help="take the run-time estimates from this judged.json, an earlier fit's on the same "
+    p.add_argument("--estimates", type=Path,
+                   help="take the path-traced estimates from this judged.json, an earlier fit's on the same "
                         "results and --ridge, instead of the rows' images in the cache (a later bench into the "
                         "cache overwrites them)")
     p.add_argument("--sweep-verify", action="store_true",
@@ -400,18 +440,13 @@ def main(argv=None) -> int:
     features = scene_features(args.cache, sorted({r["scene"] for r in records}), results["bounces"], results["res"])
     models = held_out(records, features, args.ridge)
     judged = judge(models, features)
-    # the reference each scene's errors were measured against (its spp: bench --ref-noise raises it per
-    # scene); it gives the mask of judged pixels (its geometry and albedo)
-    spp = {sc["name"]: sc["ref_spp"] for r in runs for sc in r.get("scenes", ())}
-    ref_glob = {s: f"*-r{results['res']}-spp{spp.get(s, results['ref_spp'])}-b{results['bounces']}-seed0"
-                for s in features}
-    judged["agreement"] = (stored_agreement(args.agreement, records) if args.agreement
-                           else agreement(records, features, args.cache, args.ridge, ref_glob))
+    judged["checked"], judged["checks"] = (stored_estimates(args.estimates, records) if args.estimates else
+                                           checked_estimates(models, args.cache, results["res"], results["bounces"]))
     if args.sweep_verify:
-        print(sweep_verify(models, features, judged["agreement"]))
+        print(sweep_verify(models, features, judged["checked"]))
         return 0
-    judged["verified"] = verified(models, features, judged["agreement"])
-    judged["estimate_bound"] = estimate_bound(models, judged["agreement"])
+    judged["verified"] = verified(models, features, judged["checked"])
+    judged["estimate_bound"] = estimate_bound(models, judged["checked"])
     summ = summary(judged)
     model = choice.fit(records, features, args.ridge)
     model.margin = margin_of(records, features, args.ridge)
@@ -420,9 +455,9 @@ def main(argv=None) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     results_path = " ".join(map(str, args.results))
     arguments = results_path + ("" if args.cache == default_cache else f" --cache {args.cache}") + (
-        f" --agreement {args.agreement}" if args.agreement else "")
+        f" --estimates {args.estimates}" if args.estimates else "")
     (args.out / "REPORT.md").write_text(report(results_path, arguments, judged, summ, model, results))
-    (args.out / "judged.json").write_text(json.dumps({"summary": summ, **judged}, indent=1) + "\n")
+    (args.out / "judged.json").write_text(judged_json({"summary": summ, **judged}))
     print(json.dumps(summ))
     return 0 if all(math.isfinite(r["predicted"]) for r in judged["estimates"]) else 1
 

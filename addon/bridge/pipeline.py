@@ -75,68 +75,107 @@ def render_row(be, captured, settings: dict, model, key: str) -> np.ndarray:
     return method.run().images["indirect"]
 
 
-def run_self_check(be, captured, settings: dict, decided: dict, written: dict) -> dict:
-    """The run-time estimate: the rendered indirect image against the one of the row of another method
-    the choice model expects most accurate (choice.check_row), both on the same captured scene."""
-    key = decided.get("estimate_row")
-    if key is None or "indirect" not in written:
-        return {"note": "no self-check: the choice model knows no indirect setting like this one"}
-    model = choice.load()
-    other = choice.check_row(model, decided["features"], key, registry.computing(settings["gi"].bounces))
-    if other is None:
-        return {"note": "no self-check: the choice model knows no other method"}
-    theirs = render_row(be, captured, settings, model, other)
-    ours = written["indirect"]
-    difference = metrics.rel_rmse_8(ours[..., :3], theirs[..., :3], ours[..., 3] > 0.5)
-    if difference is None:
-        return {"against": other, "note": "no self-check: the image holds no geometry"}
-    return {"against": other, "rel_rmse_8_between": difference,
-            "estimated_rel_rmse_8": choice.self_estimate(difference)}
+def path_traced_check(resolve: float, bounces: int, res: int, render=None,
+                      progress: Callable[[str], None] = lambda step: None) -> dict:
+    """The check pair of choice's path-traced check on the open scene, precise enough to resolve an error
+    of `resolve` (rel_rmse_8): a pilot pair at choice.CHECK_PILOT_SPP measures the scene's noise, then
+    a pair at choice.check_spp for a mean as noisy as choice.CHECK_NOISE x `resolve`. `render(spp, seed)`
+    -> (Cycles' layers by pass name, its time in s); default reference.render_open. Returns {"images":
+    the pair's Diffuse Indirect, "mask": the pixels with geometry and a diffuse colour (as
+    reference.reference_mask), "spp", "pilot_noise", "noise": the pair's mean's rel_noise_8, "time_s": all
+    four renders}; None where the image holds no diffuse surface."""
+    from .reference import render_open
+
+    if render is None:
+        def render(spp, seed):
+            return render_open(spp, bounces, res, seed)[:2]
+
+    def pair(spp: int, seeds) -> tuple[list, np.ndarray, float]:
+        progress(f"path-traced check: Cycles at {spp} spp, seeds {seeds[0]} and {seeds[1]}")
+        rendered = [render(spp, seed) for seed in seeds]
+        layers = rendered[0][0]
+        mask = (layers["Combined"][..., 3] > 0.5) & (layers["Diffuse Color"][..., :3].max(axis=2) > 0)
+        return [r[0]["Diffuse Indirect"][..., :3] for r in rendered], mask, sum(r[1] for r in rendered)
+
+    pilot, mask, pilot_s = pair(choice.CHECK_PILOT_SPP, choice.CHECK_SEEDS[0])
+    pilot_noise = metrics.rel_noise_8(pilot, mask)
+    if pilot_noise is None:
+        return None
+    spp = choice.check_spp(pilot_noise, choice.CHECK_NOISE * resolve)
+    checks, mask, check_s = pair(spp, choice.CHECK_SEEDS[1])
+    return {"images": checks, "mask": mask, "spp": spp, "pilot_noise": pilot_noise,
+            "noise": metrics.rel_noise_8(checks, mask), "time_s": pilot_s + check_s}
+
+
+def path_traced_estimate(ours: np.ndarray, check: dict) -> float | None:
+    """`ours` (an indirect image, RGBA) judged by a path_traced_check: its estimated rel_rmse_8 against
+    converged Cycles, over the pixels both hold."""
+    return metrics.rel_rmse_8_against_noisy(ours[..., :3], check["images"], check["mask"] & (ours[..., 3] > 0.5))
+
+
+# --self-check without a model estimate to resolve (settings no benchmark row has): the check resolves
+# errors of this size.
+SELF_CHECK_RESOLVE = 0.1
+
+
+def run_self_check(captured_settings: dict, decided: dict, written: dict, progress) -> dict:
+    """The run-time estimate of the rendered indirect image: choice's path-traced check, as precise as the
+    model's estimate of these settings asks (SELF_CHECK_RESOLVE where it has none)."""
+    if "indirect" not in written:
+        return {"note": "no self-check: the method makes no indirect light"}
+    gi = captured_settings["gi"]
+    check = path_traced_check(decided.get("estimated_rel_rmse_8") or SELF_CHECK_RESOLVE, gi.bounces, gi.resolution,
+                              progress=progress)
+    estimate = path_traced_estimate(written["indirect"], check) if check is not None else None
+    if estimate is None:
+        return {"note": "no self-check: the image holds no diffuse surface"}
+    return {"estimated_rel_rmse_8": estimate, **check_stats(check)}
+
+
+def check_stats(check: dict) -> dict:
+    """What stats.json says of a path_traced_check: its samples, its mean's noise and its time."""
+    return {"check_spp": check["spp"], "check_noise": check["noise"], "check_time_s": check["time_s"]}
 
 
 def verify_choice(be, captured, requested: dict, settings: dict, decided: dict, error_budget: float,
                   progress: Callable[[str], None]) -> tuple[dict, dict]:
-    """`--verify`: the candidates of choice.verify rendered on the captured scene, each against its
-    check row (choice.check_row), the first whose difference is within `error_budget` taken, else the
-    one whose difference is least (choice.least_estimated). Returns the settings to run (`requested`
-    with that row's setting; the model's choice, `settings`, when no candidate could be tried) and
-    `decided` with choice["verified"] = the rows tried, their estimates and the one accepted (None
-    when none was within)."""
+    """`--verify`: the candidates of choice.verify rendered on the captured scene and judged by one
+    path-traced check (path_traced_check, resolving `error_budget`), the first whose estimate is within
+    the budget taken, else the one whose estimate is least (choice.least_estimated). Returns the settings
+    to run (`requested` with that row's setting; the model's choice, `settings`, when no candidate could
+    be tried) and `decided` with choice["verified"] = the rows tried, their estimates, the one accepted
+    (None when none was within) and the check's samples, noise and time."""
     model = choice.load()
     feats = decided["features"]
     able = registry.computing(requested["gi"].bounces)
-    rendered: dict[str, np.ndarray] = {}
+    gi = requested["gi"]
+    check = path_traced_check(error_budget, gi.bounces, gi.resolution, progress=progress)
+    if check is None:
+        decided["choice"]["verified"] = {"tried": [], "accepted": None,
+                                         "note": "not verified: the image holds no diffuse surface"}
+        return settings, decided
 
-    def image(key: str) -> np.ndarray:
-        if key not in rendered:
-            progress(f"verify: rendering {key}")
-            rendered[key] = render_row(be, captured, requested, model, key)
-        return rendered[key]
+    def estimate(key: str) -> float | None:
+        progress(f"verify: rendering {key}")
+        return path_traced_estimate(render_row(be, captured, requested, model, key), check)
 
-    def difference(key: str) -> float | None:
-        other = choice.check_row(model, feats, key, able)
-        if other is None:
-            return None
-        ours, theirs = image(key), image(other)
-        return metrics.rel_rmse_8(ours[..., :3], theirs[..., :3], ours[..., 3] > 0.5)
-
-    accepted, tried = choice.verify(model, feats, error_budget, difference, able)
+    accepted, tried = choice.verify(model, feats, error_budget, estimate, able)
     # None within the budget: the row tried with the least estimate runs (choice.least_estimated).
     key = accepted if accepted is not None else choice.least_estimated(tried)
-    decided["choice"]["verified"] = {"tried": tried, "accepted": accepted}
+    decided["choice"]["verified"] = {"tried": tried, "accepted": accepted, **check_stats(check)}
     if key is None:
         return settings, decided
-    estimate = next(t["estimated_rel_rmse_8"] for t in tried if t["row"] == key)
+    found = next(t["estimated_rel_rmse_8"] for t in tried if t["row"] == key)
     # The run-time estimate, not the model's: it is the better judge on held-out scenes (REPORT.md).
-    decided.update(estimated_rel_rmse_8=choice.self_estimate(estimate), estimate_row=key, estimate_source="self-check")
+    decided.update(estimated_rel_rmse_8=found, estimate_row=key, estimate_source="path-traced check")
     if accepted is not None and key == decided["choice"]["row"]:
         return settings, decided
     row = model.rows[key]
     predicted, predicted_ms = model.predict(key, feats)
-    why = (f"fastest of the settings tried whose image is within rel_rmse_8 {error_budget:g} of its check row's: "
-           f"{estimate:.3f}" if accepted is not None else
-           f"no setting tried came within rel_rmse_8 {error_budget:g} of its check row's; this one came nearest: "
-           f"{estimate:.3f}")
+    why = (f"fastest of the settings tried whose path-traced check is within rel_rmse_8 {error_budget:g}: "
+           f"{found:.3f}" if accepted is not None else
+           f"no setting tried came within rel_rmse_8 {error_budget:g} by the path-traced check; this one came "
+           f"nearest: {found:.3f}")
     decided["choice"].update(method=row["method"], setting=row["setting"], row=key, predicted_rel_rmse_8=predicted,
                              predicted_ms=predicted_ms, meets_budget=accepted is not None, why=why)
     return choice.apply_row(requested, row["method"], row["setting"]), decided
@@ -153,10 +192,10 @@ def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
     profile_updates, stats["update_ms"] holds `update_costs` (full, lights, camera) over `repeat` runs.
     budget ({"error_budget": E} or {"time_budget_ms": T}): the method and its settings are chosen for the
     captured scene (engine/choice.py) and stats["choice"] says which and why; every render's stats carry
-    the choice model's `estimated_rel_rmse_8` where it knows the settings. self_check: also render the
-    row of another method the model expects most accurate and estimate the error from the two images'
-    difference (stats["self_check"]; that estimate becomes `estimated_rel_rmse_8`, the model's is kept
-    as `model_estimated_rel_rmse_8`; `estimate_source` says which). verify (with an error budget): the
+    the choice model's `estimated_rel_rmse_8` where it knows the settings. self_check: also estimate the
+    indirect image's error against Cycles on the scene itself (run_self_check: a few-sample Cycles pair
+    whose own noise is subtracted; stats["self_check"]; that estimate becomes `estimated_rel_rmse_8`, the
+    model's is kept as `model_estimated_rel_rmse_8`; `estimate_source` says which). verify (with an error budget): the
     choice is checked on the scene itself before it runs (verify_choice; stats["choice"]["verified"]).
     """
     settings = complete_settings(**settings)
@@ -192,13 +231,14 @@ def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
         update_ms = update_costs(method, max(repeat, 1))
     checked = None
     if self_check:
-        progress("self-check: rendering another method to compare with")
-        checked = run_self_check(be, captured, settings, decided, written)
+        progress("self-check: the path-traced check")
+        checked = run_self_check(settings, decided, written, progress)
         if checked.get("estimated_rel_rmse_8") is not None:
             # The run-time estimate replaces the model's, as with --verify: held out, it was within a factor
-            # 1.5 of the measured error on 90 % of benchmark rows, the model on 58 % (benchmarks/choice).
+            # 1.5 of the measured error on every benchmark row, the model on 58 % (benchmarks/choice).
             decided = {**decided, "model_estimated_rel_rmse_8": decided.get("estimated_rel_rmse_8"),
-                       "estimated_rel_rmse_8": checked["estimated_rel_rmse_8"], "estimate_source": "self-check"}
+                       "estimated_rel_rmse_8": checked["estimated_rel_rmse_8"],
+                       "estimate_source": "path-traced check"}
     progress(f"writing {out_dir}")
     for name, pixels in written.items():
         images.write_exr(out_dir / f"{name}.exr", pixels)

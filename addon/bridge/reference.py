@@ -161,6 +161,27 @@ def _render(bpy, exr_path) -> float:
     return elapsed
 
 
+def render_open(spp: int, bounces: int, res: int, seed: int, glossy: bool = False,
+                progress: Callable[[str], None] = lambda step: None) -> tuple[dict, float, dict]:
+    """Cycles on the scene open in this Blender session, configured as the module docstring says (its
+    render settings are changed and left so): (the render's layers by pass name, the render call's time
+    in s, the device and Cycles settings used)."""
+    import bpy
+
+    scene = bpy.context.scene
+    width, height = image_size(scene, res)
+    with tempfile.TemporaryDirectory(prefix="bounce_ref_") as tmp:
+        exr = Path(tmp) / "passes.exr"
+        info = _configure(bpy, scene, spp, bounces, width, height, seed, exr, glossy)
+        progress(f"Cycles on {info['device']}: {width} x {height} px, {spp} spp")
+        render_time = _render(bpy, exr)
+        layers = images.read_multilayer(exr)
+    missing = [p for p in (*PASSES.values(), "Combined", *(GLOSSY_PASSES if glossy else ())) if p not in layers]
+    if missing:
+        raise SceneError(f"the render has no {', '.join(missing)} pass (found {sorted(layers)})")
+    return layers, render_time, info
+
+
 def render_reference(blend_path, out_dir, spp: int = 1024, bounces: int = 1, res: int = 256,
                      seed: int = 0, glossy: bool = False, progress: Callable[[str], None] = lambda step: None) -> dict:
     """Render the Cycles reference of `blend_path` into `out_dir` (see module docstring).
@@ -175,16 +196,8 @@ def render_reference(blend_path, out_dir, spp: int = 1024, bounces: int = 1, res
     bpy, scene = _open_blend(blend_path)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    layers, render_time, info = render_open(spp, bounces, res, seed, glossy, progress)
     width, height = image_size(scene, res)
-    with tempfile.TemporaryDirectory(prefix="bounce_ref_") as tmp:
-        exr = Path(tmp) / "passes.exr"
-        info = _configure(bpy, scene, spp, bounces, width, height, seed, exr, glossy)
-        progress(f"Cycles on {info['device']}: {width} x {height} px, {spp} spp")
-        render_time = _render(bpy, exr)
-        layers = images.read_multilayer(exr)
-    missing = [p for p in (*PASSES.values(), "Combined", *(GLOSSY_PASSES if glossy else ())) if p not in layers]
-    if missing:
-        raise SceneError(f"the render has no {', '.join(missing)} pass (found {sorted(layers)})")
     alpha = layers["Combined"][:, :, 3:4]
     for name, pass_name in PASSES.items():
         images.write_exr(out / f"{name}.exr", np.concatenate([layers[pass_name][:, :, :3], alpha], axis=2))

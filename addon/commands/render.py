@@ -24,12 +24,13 @@ def add_arguments(p) -> None:
                    help="also time the three kinds of update (a geometry change: everything; every light moved 1 cm; "
                         "the camera moved 1 cm): stats.json update_ms = {full, lights, camera}, medians of --repeat")
     p.add_argument("--self-check", action="store_true",
-                   help="also render the method the choice model expects most accurate here and estimate the "
-                        "error from the two images' difference (stats.json self_check; costs that render)")
+                   help="also estimate the indirect light's rel_rmse_8 against Cycles on this scene: two Cycles "
+                        "renders of a few samples, their own noise subtracted (stats.json self_check; costs those "
+                        "renders, seconds at preview sizes)")
     p.add_argument("--verify", action="store_true",
-                   help="with --method auto --error-budget E: render the candidate settings (fastest first) and "
-                        "each one's check row on this scene, and take the first whose difference is within E "
-                        "(stats.json choice.verified; costs those renders once)")
+                   help="with --method auto --error-budget E: render the candidate settings (fastest first) on "
+                        "this scene, judge each by the --self-check's path-traced check, and take the first "
+                        "within E (stats.json choice.verified; costs those renders once)")
     add_quiet(p)
     add_config_flags(p)
     add_budget_flags(p)

@@ -88,6 +88,56 @@ def rel_rmse_8(a, b, mask=None, block: int = BLOCK) -> float | None:
     return _rel_rmse_weighted(ma, mb, counts)
 
 
+def _noisy_blocks(checks, mask, block: int):
+    """Per block of the unbiased noisy images `checks` (k >= 2, independent seeds): their mean C, the
+    estimate of var(C) from their spread, s^2 = sum (C_i - C)^2 / (k (k - 1)) (its expectation is var(C)),
+    the blocks' counts, and the first image prepared (for its shape)."""
+    if len(checks) < 2:
+        raise ConfigError(f"the noise of images needs at least 2 of them, got {len(checks)}")
+    prepared = [_prepare(c, checks[0], mask) for c in checks]
+    mask = prepared[0][2]
+    means = np.stack([box_average(p[0], mask, block)[0] for p in prepared])
+    counts = box_average(prepared[0][0], mask, block)[1]
+    k = len(checks)
+    mc = means.mean(axis=0)
+    return mc, ((means - mc) ** 2).sum(axis=0) / (k * (k - 1)), counts, mask
+
+
+def rel_noise_8(checks, mask=None, block: int = BLOCK) -> float | None:
+    """The relative noise of the mean of `checks` (unbiased renders with independent seeds) in
+    rel_rmse_8's terms: its expected rel_rmse_8 against what they converge to, from their spread alone."""
+    mc, spread, counts, _ = _noisy_blocks(checks, mask, block)
+    wsum = counts.sum() * mc.shape[2]
+    if wsum <= 0:
+        return None
+    mean_c = float((counts[:, :, None] * mc).sum() / wsum)
+    return math.sqrt(float((counts[:, :, None] * spread).sum() / wsum)) / mean_c if mean_c > 0 else None
+
+
+def rel_rmse_8_against_noisy(a, checks, mask=None, block: int = BLOCK) -> float | None:
+    """rel_rmse_8 of `a` against what the unbiased noisy images `checks` converge to, estimated from the
+    images alone; None where undefined.
+
+    `checks`: k >= 2 renders of the same image by an unbiased estimator with independent seeds (Cycles at
+    a few samples). Per block and channel, with C the checks' mean and T its expectation: E[(A - C)^2] =
+    (A - T)^2 + var(C), and var(C) is estimated without bias from the checks' spread (_noisy_blocks). So
+    D^2 - N^2 (D: A's rel_rmse_8 against C; N: rel_noise_8, both weighted as rel_rmse_8 weighs its blocks)
+    estimates A's squared error against T without bias, however noisy the checks: a check need not be
+    more accurate than the image it judges, only precise enough for that difference. Clamped at 0 (the
+    difference can fall below it where A is nearly exact)."""
+    mc, spread, counts, mask = _noisy_blocks(checks, mask, block)
+    ma = box_average(_prepare(a, checks[0], mask)[0], mask, block)[0]
+    wsum = counts.sum() * mc.shape[2]
+    if wsum <= 0:
+        return None
+    mean_c = float((counts[:, :, None] * mc).sum() / wsum)
+    if not mean_c > 0:
+        return None
+    d2 = float((counts[:, :, None] * (ma - mc) ** 2).sum() / wsum)
+    n2 = float((counts[:, :, None] * spread).sum() / wsum)
+    return math.sqrt(max(d2 - n2, 0.0)) / mean_c
+
+
 def bias(a, b, mask=None) -> float | None:
     """mean(a) / mean(b) over masked pixels and RGB channels; None if undefined."""
     a, b, mask = _prepare(a, b, mask)

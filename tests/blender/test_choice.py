@@ -63,9 +63,9 @@ def test_budget_flags_refused_alone_or_out_of_range(cornell_blend, tmp_path, cap
 
 
 def test_render_verify_runs_a_row_whose_estimate_is_within_the_budget(cornell_blend, tmp_path):
-    # --verify: the rows tried are listed with their run-time estimates; the one accepted is the first
+    # --verify: the rows tried are listed with their path-traced estimates; the one accepted is the first
     # within the budget and is what ran, with that estimate. On the Cornell box most rows are within
-    # 0.3 (benchmarks/choice/REPORT.md), so one is accepted.
+    # 0.3 (benchmarks/choice/REPORT.md), so one is accepted. The check's samples and noise are recorded.
     out = tmp_path / "verify"
     assert main(["render", str(cornell_blend), "--out", str(out), "--method", "auto", "--error-budget", "0.3",
                  "--verify", "--res", "32", "--repeat", "1", "--quiet"]) == 0
@@ -76,8 +76,9 @@ def test_render_verify_runs_a_row_whose_estimate_is_within_the_budget(cornell_bl
     assert tried[-1]["row"] == accepted == c["row"] and tried[-1]["estimated_rel_rmse_8"] <= 0.3
     assert all(t["estimated_rel_rmse_8"] > 0.3 for t in tried[:-1])
     assert stats["estimated_rel_rmse_8"] == pytest.approx(tried[-1]["estimated_rel_rmse_8"])
-    assert stats["estimate_source"] == "self-check"
+    assert stats["estimate_source"] == "path-traced check"
     assert stats["method"] == c["method"]
+    assert c["verified"]["check_spp"] >= choice.CHECK_PILOT_SPP and c["verified"]["check_noise"] > 0
 
 
 def test_render_verify_with_none_within_runs_the_least_estimate(cornell_blend, tmp_path, monkeypatch):
@@ -94,7 +95,7 @@ def test_render_verify_with_none_within_runs_the_least_estimate(cornell_blend, t
                  "--verify", "--res", "32", "--repeat", "1", "--quiet"]) == 0
     stats = json.loads((out / "stats.json").read_text())
     c = stats["choice"]
-    assert c["verified"] == {"tried": tried, "accepted": None}
+    assert c["verified"]["tried"] == tried and c["verified"]["accepted"] is None
     assert c["row"] == second and c["meets_budget"] is False and stats["estimated_rel_rmse_8"] == pytest.approx(0.3)
     assert stats["method"] == model.rows[second]["method"]
 
@@ -132,33 +133,61 @@ def test_choose_operator_sets_the_scene_and_notes_the_estimate(bounce, fresh_ble
         bounce.unregister()
 
 
-def test_self_check_compares_with_another_method(cornell_blend, tmp_path):
-    # The check renders the row of another method the model expects most accurate: its rel_rmse_8
-    # against our image is exactly the difference of the two renders, which is the estimate
-    # (choice.self_estimate).
+def test_self_check_estimates_the_error_against_cycles(cornell_blend, tmp_path):
+    # --self-check's estimate is of the error against converged Cycles: measured here against a Cycles
+    # reference of 1024 spp (its own noise ~0.01 at 64 px), it must lie within the issue's factor 1.5.
+    # Held out on the benchmark's 495 rows the estimate was within that factor on all of them
+    # (benchmarks/choice/REPORT.md); at 64 px (64 blocks, 3 channels) with a check as noisy as half
+    # the error it resolves, its spread is ~10 %.
     from addon.bridge import images
+    from addon.bridge.reference import reference_mask
     from addon.engine.metrics import rel_rmse_8
 
-    ours, theirs = tmp_path / "ours", tmp_path / "theirs"
-    assert main(["render", str(cornell_blend), "--out", str(ours), "--method", "lpv", "--res", "32",
+    ours, ref = tmp_path / "ours", tmp_path / "ref"
+    assert main(["render", str(cornell_blend), "--out", str(ours), "--method", "lpv", "--res", "64",
                  "--repeat", "1", "--self-check", "--quiet"]) == 0
+    assert main(["reference", str(cornell_blend), "--out", str(ref), "--res", "64", "--spp", "1024",
+                 "--quiet"]) == 0
     stats = json.loads((ours / "stats.json").read_text())
     check = stats["self_check"]
-    row = choice.load().rows[check["against"]]
-    assert row["method"] != "lpv"
-    def flag(key, value):
-        name = key.split(".")[1].replace("_", "-")
-        if isinstance(value, bool):
-            return f"--{'' if value else 'no-'}{name}"
-        return f"--{name}={value}"
-
-    flags = [flag(k, v) for k, v in row["setting"].items()]
-    assert main(["render", str(cornell_blend), "--out", str(theirs), "--method", row["method"], "--res", "32",
-                 "--repeat", "1", "--quiet", *flags]) == 0
-    a, b = images.read_exr(ours / "indirect.exr"), images.read_exr(theirs / "indirect.exr")
-    assert check["rel_rmse_8_between"] == pytest.approx(rel_rmse_8(a[..., :3], b[..., :3], a[..., 3] > 0.5), rel=1e-5)
-    assert check["estimated_rel_rmse_8"] == check["rel_rmse_8_between"]
+    a, b = images.read_exr(ours / "indirect.exr"), images.read_exr(ref / "indirect.exr")
+    measured = rel_rmse_8(a[..., :3], b[..., :3], reference_mask(ref / "indirect.exr", b) & (a[..., 3] > 0.5))
+    assert 1 / 1.5 <= check["estimated_rel_rmse_8"] / measured <= 1.5
+    assert check["check_spp"] >= choice.CHECK_PILOT_SPP and check["check_time_s"] > 0
     # the run-time estimate is the one reported; the model's stays beside it
-    assert stats["estimated_rel_rmse_8"] == check["estimated_rel_rmse_8"] and stats["estimate_source"] == "self-check"
+    assert stats["estimated_rel_rmse_8"] == check["estimated_rel_rmse_8"]
+    assert stats["estimate_source"] == "path-traced check"
     assert stats["model_estimated_rel_rmse_8"] == pytest.approx(
         choice.load().predict(stats["estimate_row"], stats["scene_features"])[0])
+
+
+def test_path_traced_check_sizes_its_pair_from_the_pilot():
+    # A fake renderer: an image of 2 plus Gaussian noise of sd 8 / sqrt(spp) per pixel (Monte Carlo),
+    # 64 x 64 px. The pilot pair at 4 spp: each full block's mean has sd (8 / 2) / 8 = 0.5, their mean's
+    # 0.354, rel_noise_8 0.177. To resolve 0.1 at CHECK_NOISE 0.25 the pair's mean needs 0.025: spp =
+    # 4 x (0.177 / 0.025)^2 ~ 200 (the pilot's noise is itself measured from 64 blocks x 3: +-10 %, the
+    # spp +-20 %).
+    import numpy as np
+
+    from addon.bridge.pipeline import path_traced_check, path_traced_estimate
+
+    calls = []
+
+    def render(spp, seed):
+        calls.append((spp, seed))
+        rng = np.random.default_rng(seed)
+        light = 2.0 + rng.normal(0.0, 8.0 / np.sqrt(spp), (64, 64, 3))
+        alpha = np.ones((64, 64, 4))
+        return {"Diffuse Indirect": light, "Combined": alpha, "Diffuse Color": np.ones((64, 64, 3))}, 0.5
+
+    check = path_traced_check(0.1, 1, 64, render)
+    assert calls[:2] == [(choice.CHECK_PILOT_SPP, s) for s in choice.CHECK_SEEDS[0]]
+    assert [c[1] for c in calls[2:]] == list(choice.CHECK_SEEDS[1]) and calls[2][0] == calls[3][0]
+    assert choice.CHECK_NOISE == 0.25 and 140 <= check["spp"] <= 280 and check["time_s"] == 2.0
+    assert check["noise"] == pytest.approx(0.025, rel=0.3)
+    # An image of exactly 2.2 is 10 % off the truth everywhere: the estimate reads 0.1, the checks'
+    # noise (0.025) taken out; without geometry (alpha 0) there is nothing to judge.
+    ours = np.concatenate([np.full((64, 64, 3), 2.2), np.ones((64, 64, 1))], axis=2)
+    assert path_traced_estimate(ours, check) == pytest.approx(0.1, rel=0.15)
+    ours[..., 3] = 0.0
+    assert path_traced_estimate(ours, check) is None

@@ -6,6 +6,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 pytestmark = pytest.mark.blender
@@ -58,14 +59,17 @@ def test_fit_choice_fits_judges_and_writes(tmp_path):
     model, out = tmp_path / "model.json", tmp_path / "report"
     summary = json.loads(tool("tools/fit_choice.py", str(results), "--cache", str(cache), "--out", str(out),
                               "--model", str(model)).strip().splitlines()[-1])
-    # The cache holds no rendered rows: no self-check estimate exists, so --verify renders nothing
-    # (0 tries) and falls back to the model's choice, whose estimate is the model's exact prediction.
+    # The cache holds no rendered rows: no path-traced estimate exists (and no Cycles check is rendered),
+    # so --verify renders nothing (0 tries) and falls back to the model's choice, whose estimate is the
+    # model's exact prediction.
     assert summary["0.2"] == {"scenes": 3, "met": 3, "possible": 3, "within_2x": 3, "estimate_within_1.5x": 3,
                               "self_check_within_1.5x": 0, "verified_met": 3, "verified_within_2x": 3,
-                              "verified_mean_tries": 0.0, "verified_estimate_within_1.5x": 3}
+                              "verified_mean_tries": 0.0, "verified_median_cost": 0.0,
+                              "verified_estimate_within_1.5x": 3}
     assert summary["0.3"]["met"] == 3 and summary["0.3"]["within_2x"] == 3
+    assert not (cache / "checks").exists()
     text = (out / "REPORT.md").read_text()
-    assert "| 0.2 | 3 | 3 | 3 | 3 | 3 | 0 | 3 | 3 | 0.0 | 3 |" in text
+    assert "| 0.2 | 3 | 3 | 3 | 3 | 3 | 0 | 3 | 3 | 0.0 | 0.0 | 3 |" in text
     assert "Errors against Cycles references of (spp): cornell 16, cornell-point 16, cornell-sun 32." in text
     from addon.engine import choice
 
@@ -77,28 +81,48 @@ def test_fit_choice_fits_judges_and_writes(tmp_path):
     table = tool("tools/fit_choice.py", str(results), "--cache", str(cache), "--out", str(out), "--model",
                  str(model), "--sweep-verify").strip().splitlines()
     combos = [line for line in table if line.startswith("| ") and line[2].isdigit()]
-    assert len(combos) == 4 * 2 * 2  # fit_choice.SWEEP: stagings x try counts x acceptances
+    sys.path.insert(0, str(ROOT / "tools"))
+    import fit_choice
+
+    assert len(combos) == np.prod([len(v) for v in fit_choice.SWEEP.values()])
     assert all(line.split(" | ")[-2] == "3 / 3 / 0.0 / 3" for line in combos)  # E = 0.2
     assert not model.exists()
-    # An earlier fit's run-time differences in place of the images: 0.12 for the 0.1 row, 0.25 for the
-    # 0.3 row on every scene. --verify then renders the 0.1 row alone at E = 0.2 (within, taken); the
-    # bound's order is by measured time: the 10 ms row first, taken at E = 0.3 (0.25 <= 0.3, measured 0.3),
-    # passed over at E = 0.2 for the 0.1 row; nothing's estimate is within E = 0.1.
+    # An earlier fit's path-traced estimates in place of the images: 0.12 for the 0.1 row, 0.25 for the
+    # 0.3 row on every scene at every budget. --verify at E = 0.2 (every row predicted within 3 budgets,
+    # fastest first) renders the 10 ms row (0.25: not within) and then the 0.1 row (within, taken); the
+    # bound's order is by measured time: the 10 ms row first, taken at E = 0.3 (0.25 <= 0.3,
+    # measured 0.3), passed over at E = 0.2 for the 0.1 row; nothing's estimate is within E = 0.1.
     judged = tmp_path / "judged.json"
-    agreed = [{"scene": s, "row": row, "against": "-", "measured": e, "model": e, "agree": d, "blend": e}
-              for s in scenes for row, e, d in (("rsm vpl_samples=256", 0.1, 0.12), ("lpv grid_cells=16", 0.3, 0.25))]
-    judged.write_text(json.dumps({"agreement": agreed}))
-    args = (str(results), "--cache", str(cache), "--out", str(out), "--model", str(model), "--agreement", str(judged))
+    checked = [{"scene": s, "row": row, "budget": str(b), "measured": e, "estimate": d}
+               for s in scenes for b in (0.1, 0.2, 0.3)
+               for row, e, d in (("rsm vpl_samples=256", 0.1, 0.12), ("lpv grid_cells=16", 0.3, 0.25))]
+    judged.write_text(json.dumps({"checked": checked}))
+    args = (str(results), "--cache", str(cache), "--out", str(out), "--model", str(model), "--estimates", str(judged))
     summary = json.loads(tool("tools/fit_choice.py", *args).strip().splitlines()[-1])
-    assert summary["0.2"]["verified_mean_tries"] == 1.0 and summary["0.2"]["self_check_within_1.5x"] == 3
+    assert choice.VERIFY_STAGES == (3.0,)
+    assert summary["0.2"]["verified_mean_tries"] == 2.0 and summary["0.2"]["self_check_within_1.5x"] == 3
     assert summary["0.2"]["verified_met"] == 3 and summary["0.2"]["verified_estimate_within_1.5x"] == 3
+    assert summary["0.2"]["all_rows_path_traced_within_1.5x"] == 1.0  # 0.12 / 0.1 and 0.25 / 0.3
     assert "met / within 2x: E = 0.1: 0 / 0, E = 0.2: 3 / 3, E = 0.3: 3 / 3." in (out / "REPORT.md").read_text()
     assert "E = 0.1: 0 / 0, E = 0.2: 3 / 3, E = 0.3: 3 / 3" in tool("tools/fit_choice.py", *args, "--sweep-verify")
-    # Differences of other results (another measured error) are refused, not silently judged.
-    agreed[0]["measured"] = 0.2
-    judged.write_text(json.dumps({"agreement": agreed}))
+    # Estimates of other results (another measured error) are refused, not silently judged.
+    checked[0]["measured"] = 0.2
+    judged.write_text(json.dumps({"checked": checked}))
     done = subprocess.run([sys.executable, "tools/fit_choice.py", *args], cwd=ROOT, capture_output=True, text=True)
     assert done.returncode != 0 and "is of other results" in done.stderr
+    # One row's image in the bench's runs: its scene's Cycles checks are rendered (a pair per budget and
+    # the pilot) and kept in the cache, and the row is judged at every budget.
+    from addon.bridge import bench
+
+    run = bench.row_dir(cache, "cornell", "rsm", bench.setting_label({"rsm.vpl_samples": 256}))
+    tool("-m", "addon", "render", str(cache / "scenes" / "cornell.blend"), "--out", str(run), "--method", "rsm",
+         "--vpl-samples", "256", "--res", "32", "--repeat", "1", "--quiet")
+    tool("tools/fit_choice.py", str(results), "--cache", str(cache), "--out", str(out), "--model", str(model))
+    got = json.loads((out / "judged.json").read_text())["checked"]
+    assert sorted(c["budget"] for c in got) == ["0.1", "0.2", "0.3"]
+    assert all(c["scene"] == "cornell" and c["row"] == "rsm vpl_samples=256" and 0 < c["estimate"] < 1 for c in got)
+    kept = sorted((cache / "checks").glob("cornell-r32-b1-*.npz"))
+    assert len(kept) >= 4 and all(f.stat().st_size > 0 for f in kept)
 
 
 def test_diffusion_box_prints_both_transfers():

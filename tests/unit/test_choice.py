@@ -149,13 +149,13 @@ def test_choose_the_fastest_within_an_error_budget_and_the_best_within_a_time_bu
 
 
 def recording(asked: list):
-    """estimates(values): a `difference` for choice.verify that answers from `values` and appends each
+    """estimates(values): an `estimate` for choice.verify that answers from `values` and appends each
     key asked to `asked`, so a test sees which rows were rendered and in what order."""
     def estimates(values):
-        def difference(key):
+        def estimate(key):
             asked.append(key)
             return values[key]
-        return difference
+        return estimate
     return estimates
 
 
@@ -176,6 +176,11 @@ def test_verify_takes_the_fastest_candidate_whose_estimate_is_within_the_budget(
     asked.clear()
     key, tried = choice.verify(model, f, 0.2, estimates({"m x=1": 0.35, "m x=2": 0.25, "m x=3": 0.08}))
     assert key == "m x=3" and asked == ["m x=1", "m x=2", "m x=3"]
+    # An estimate within the budget but above VERIFY_ACCEPT (0.95) of it is not taken: the estimate's own
+    # spread is a few per cent.
+    asked.clear()
+    key, _ = choice.verify(model, f, 0.2, estimates({"m x=1": 0.195, "m x=2": 0.15, "m x=3": 0.05}))
+    assert choice.VERIFY_ACCEPT == 0.95 and key == "m x=2" and asked == ["m x=1", "m x=2"]
     # None within: None, every candidate tried once. A row without an estimate is skipped, not counted.
     asked.clear()
     key, tried = choice.verify(model, f, 0.2, estimates({"m x=1": 0.5, "m x=2": None, "m x=3": 0.3}))
@@ -236,3 +241,13 @@ def test_model_round_trips_through_json():
     again = choice.Model.from_json(model.to_json())
     for k in model.rows:
         assert again.predict(k, scenes["s1"]) == model.predict(k, scenes["s1"])
+
+
+def test_check_spp_from_the_pilots_noise():
+    # Noise falls as 1 / sqrt(spp): the pilot pair's mean at CHECK_PILOT_SPP (4) reads 0.2; a mean as
+    # noisy as 0.05 needs (0.2 / 0.05)^2 = 16x the samples, 64 per render.
+    assert choice.check_spp(0.2, 0.05) == 64
+    assert choice.check_spp(0.2, 0.3) == choice.CHECK_PILOT_SPP  # never fewer than the pilot's
+    assert choice.check_spp(10.0, 0.01) == choice.CHECK_MAX_SPP
+    with pytest.raises(ConfigError):
+        choice.check_spp(0.2, 0.0)

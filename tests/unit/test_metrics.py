@@ -156,3 +156,51 @@ def test_hdr_flip():
     a[~mask] = 50.0  # differences outside the mask must not count
     assert metrics.hdr_flip(a, b, mask) == pytest.approx(0.0, abs=1e-7)
     assert metrics.hdr_flip(b * 2, b) > 0.05
+
+
+def test_error_against_noisy_checks_without_noise_is_rel_rmse_8():
+    # Two equal checks: their spread is 0, so nothing is subtracted and the estimate is rel_rmse_8 itself.
+    rng = np.random.default_rng(0)
+    a, c = rng.uniform(0.5, 1.5, (16, 24, 3)), rng.uniform(0.5, 1.5, (16, 24, 3))
+    assert metrics.rel_rmse_8_against_noisy(a, [c, c]) == pytest.approx(metrics.rel_rmse_8(a, c), rel=1e-12)
+    assert metrics.rel_noise_8([c, c]) == 0.0
+    with pytest.raises(ConfigError):
+        metrics.rel_rmse_8_against_noisy(a, [c])
+
+
+def test_error_against_noisy_checks_removes_their_noise():
+    # Truth T: a smooth field; A = T (1 + 0.1 s) with s = +-1 per 8 x 8 block, so A's rel_rmse_8 against
+    # T is exactly e0 = 0.1 sqrt(mean T_b^2) / mean T = 0.105. The checks: T plus independent Gaussian
+    # noise of sd 1 per pixel and channel, so their mean's rel_noise_8 (0.11) is as large as A's error,
+    # as the path-traced check's is by design (choice.CHECK_NOISE): against their mean A reads ~1.46 e0,
+    # with their noise subtracted e0. E[D^2 - N^2] = e0^2 exactly, so over 40 seeds the mean of the
+    # estimates' squares must lie within 4 of its standard errors (measured from the 40) of e0^2. Over
+    # these 384 blocks x 3 channels a single estimate's spread is 4.4 % of e0: each within 15 % (3.4 sd).
+    h, w = 128, 192
+    y, x = np.mgrid[0:h, 0:w]
+    t = (1.0 + 0.5 * np.sin(x / 17.0) * np.cos(y / 11.0))[:, :, None] * np.array([1.0, 0.8, 0.6])
+    blocks = np.where(((x // 8) + (y // 8)) % 2 == 0, 1.0, -1.0)[:, :, None]
+    a = t * (1.0 + 0.1 * blocks)
+    e0 = metrics.rel_rmse_8(a, t)
+    squares, naive = [], []
+    for seed in range(40):
+        rng = np.random.default_rng(seed)
+        checks = [t + rng.normal(0.0, 1.0, t.shape) for _ in range(2)]
+        e = metrics.rel_rmse_8_against_noisy(a, checks)
+        assert e == pytest.approx(e0, rel=0.15)
+        squares.append(e * e)
+        naive.append(metrics.rel_rmse_8(a, (checks[0] + checks[1]) / 2))
+    stderr = np.std(squares, ddof=1) / math.sqrt(len(squares))
+    assert abs(np.mean(squares) - e0 * e0) < 4 * stderr
+    assert np.mean(naive) > 1.3 * e0  # what the subtraction takes away
+
+
+def test_noise_of_noisy_checks():
+    # Pixels of sd 1 around a mean of 4: a full 8 x 8 block's mean has variance 1/64, the mean of two
+    # renders 1/128; rel_noise_8 = sqrt(1/128) / 4 = 0.0221. Over 48 x 64 px (48 blocks, 3 channels),
+    # its estimate from two renders has a relative sd of about 1 / sqrt(2 x 144) = 6 %: 20 % is 3 sd.
+    rng = np.random.default_rng(3)
+    checks = [4.0 + rng.normal(0.0, 1.0, (48, 64, 3)) for _ in range(2)]
+    assert metrics.rel_noise_8(checks) == pytest.approx(math.sqrt(1 / 128) / 4, rel=0.2)
+    # A mask: blocks count by their masked pixels, as rel_rmse_8 weighs them; nothing masked is None.
+    assert metrics.rel_noise_8(checks, np.zeros((48, 64), bool)) is None
