@@ -239,7 +239,7 @@ def verified_figures(rows: list[dict], budget: float) -> dict:
 
 
 SWEEP = {"VERIFY_STAGES": ((1.0, 2.0), (2.5,), (3.0,)), "VERIFY_MAX_TRIES": (4, 16, 40),
-         "VERIFY_ACCEPT": (1.0, 0.95)}
+         "VERIFY_ACCEPT": (1.0, 0.95), "VERIFY_FASTER": (0, 2, 4)}
 
 
 def _value(v) -> str:
@@ -356,7 +356,9 @@ def report(results_path: str, arguments: str, judged: dict, summ: dict, model: c
              "choice.CHECK_NOISE) within that factor; verified: the choice of `--verify` (per stage of "
              f"{', '.join(f'{x:g}' for x in choice.VERIFY_STAGES)} budgets, the rows predicted within it and not "
              "yet tried, fastest first, the first whose path-traced estimate is within "
-             f"{choice.VERIFY_ACCEPT:g} budget taken; at most {choice.VERIFY_MAX_TRIES} rendered; else the one "
+             f"{choice.VERIFY_ACCEPT:g} budget taken, then up to {choice.VERIFY_FASTER} rows predicted faster "
+             f"than {choice.VERIFY_FASTER_SHARE:g} of its time, the first within replacing it; at most "
+             f"{choice.VERIFY_MAX_TRIES} rendered; else the one "
              "rendered whose estimate is least; else the model's choice), met and within 2x as above, the mean "
              "number of rows it rendered, the median time of those renders over the time of the row that runs "
              "(cost), and its estimate (the path-traced one of the row that runs, else the model's) within a "

@@ -176,11 +176,12 @@ def test_verify_takes_the_fastest_candidate_whose_estimate_is_within_the_budget(
     asked.clear()
     key, tried = choice.verify(model, f, 0.2, estimates({"m x=1": 0.35, "m x=2": 0.25, "m x=3": 0.08}))
     assert key == "m x=3" and asked == ["m x=1", "m x=2", "m x=3"]
-    # An estimate within the budget but above VERIFY_ACCEPT (0.95) of it is not taken: the estimate's own
-    # spread is a few per cent.
+    # VERIFY_ACCEPT below 1 (swept): an estimate within the budget but above that share of it is not taken.
     asked.clear()
+    monkeypatch.setattr(choice, "VERIFY_ACCEPT", 0.95)
     key, _ = choice.verify(model, f, 0.2, estimates({"m x=1": 0.195, "m x=2": 0.15, "m x=3": 0.05}))
-    assert choice.VERIFY_ACCEPT == 0.95 and key == "m x=2" and asked == ["m x=1", "m x=2"]
+    assert key == "m x=2" and asked == ["m x=1", "m x=2"]
+    monkeypatch.setattr(choice, "VERIFY_ACCEPT", 1.0)
     # None within: None, every candidate tried once. A row without an estimate is skipped, not counted.
     asked.clear()
     key, tried = choice.verify(model, f, 0.2, estimates({"m x=1": 0.5, "m x=2": None, "m x=3": 0.3}))
@@ -196,6 +197,7 @@ def test_verify_tries_a_looser_stage_only_when_none_of_the_first_passes(monkeypa
     # E = 0.2 the first stage holds the rows predicted within 0.2 (x=2, x=3), fastest first; the 0.3 row,
     # though fastest, comes only in the second stage (within 0.4).
     monkeypatch.setattr(choice, "VERIFY_STAGES", (1.0, 2.0))
+    monkeypatch.setattr(choice, "VERIFY_FASTER", 0)  # the stages alone (the faster rows: the next test)
     model, f = three_rows(4)
     asked = []
     estimates = recording(asked)
@@ -210,6 +212,32 @@ def test_verify_tries_a_looser_stage_only_when_none_of_the_first_passes(monkeypa
     monkeypatch.setattr(choice, "VERIFY_MAX_TRIES", 2)
     key, tried = choice.verify(model, f, 0.2, estimates({"m x=1": 0.1, "m x=2": 0.25, "m x=3": 0.3}))
     assert key is None and asked == ["m x=2", "m x=3"]
+
+
+def test_verify_then_tries_rows_much_faster_than_the_one_taken(monkeypatch):
+    # The same rows (predicted 0.3 / 0.15 / 0.05 in 10 / 100 / 1000 ms), one stage of 1 budget: at E = 0.2
+    # x=2 (100 ms) is taken first; x=1, predicted faster than VERIFY_FASTER_SHARE (0.5) of its time, is
+    # then tried though the model expects it above the budget, and replaces it when within.
+    monkeypatch.setattr(choice, "VERIFY_STAGES", (1.0,))
+    model, f = three_rows(4)
+    asked = []
+    estimates = recording(asked)
+    key, tried = choice.verify(model, f, 0.2, estimates({"m x=1": 0.1, "m x=2": 0.15, "m x=3": 0.05}))
+    assert key == "m x=1" and asked == ["m x=2", "m x=1"] and len(tried) == 2
+    # Not within: the row taken first stays.
+    asked.clear()
+    key, _ = choice.verify(model, f, 0.2, estimates({"m x=1": 0.3, "m x=2": 0.15, "m x=3": 0.05}))
+    assert key == "m x=2" and asked == ["m x=2", "m x=1"]
+    # The slower row x=3 is never a "faster" one; with x=3 taken at E = 0.1 both faster rows are tried,
+    # fastest first, and the first within replaces it.
+    asked.clear()
+    key, _ = choice.verify(model, f, 0.1, estimates({"m x=1": 0.2, "m x=2": 0.08, "m x=3": 0.05}))
+    assert key == "m x=2" and asked == ["m x=3", "m x=1", "m x=2"]
+    # At most VERIFY_FASTER of them.
+    asked.clear()
+    monkeypatch.setattr(choice, "VERIFY_FASTER", 1)
+    key, _ = choice.verify(model, f, 0.1, estimates({"m x=1": 0.2, "m x=2": 0.08, "m x=3": 0.05}))
+    assert key == "m x=3" and asked == ["m x=3", "m x=1"]
 
 
 def test_verify_renders_at_most_its_cap():
