@@ -126,38 +126,35 @@ def run_image(cache: Path, scene: str, method: str, setting: dict) -> Path:
 
 
 def path_traced_checks(cache: Path, scenes, res: int, bounces: int) -> dict[str, dict[str, dict]]:
-    """Per scene and budget: `render --verify`'s path-traced check of the scene (pipeline.path_traced_check,
-    resolving the budget), its Cycles renders kept under `<cache>/checks` (a second fit renders nothing)."""
-    from addon.bridge.pipeline import open_blend, path_traced_check
-    from addon.bridge.reference import render_open
+    """Per scene and budget: `render --verify`'s path-traced check of the scene (choice.path_traced_check
+    with pipeline.camera_check_render, resolving the budget), its Cycles renders kept under `<cache>/checks`
+    (a second fit renders nothing)."""
+    from addon.bridge.pipeline import camera_check_render, open_blend
 
     out = {}
     for name in scenes:
         open_blend(cache / "scenes" / f"{name}.blend")
+        cycles = camera_check_render(bounces, res)
 
-        def render(spp: int, seed: int, name=name):
+        def render(spp: int, seed: int, name=name, cycles=cycles):
             path = cache / "checks" / f"{name}-r{res}-b{bounces}-spp{spp}-seed{seed}.npz"
             if not path.is_file():
-                layers, time_s, _ = render_open(spp, bounces, res, seed)
+                light, mask, time_s = cycles(spp, seed)
                 path.parent.mkdir(parents=True, exist_ok=True)
-                np.savez_compressed(path, indirect=layers["Diffuse Indirect"][..., :3],
-                                    alpha=layers["Combined"][..., 3], albedo=layers["Diffuse Color"][..., :3],
-                                    time_s=time_s)
+                np.savez_compressed(path, light=light, mask=mask, time_s=time_s)
             z = np.load(path)
-            return {"Diffuse Indirect": z["indirect"], "Combined": np.dstack([z["indirect"], z["alpha"]]),
-                    "Diffuse Color": z["albedo"]}, float(z["time_s"])
+            return z["light"], z["mask"], float(z["time_s"])
 
-        out[name] = {str(budget): path_traced_check(budget, bounces, res, render) for budget in BUDGETS}
+        out[name] = {str(budget): choice.path_traced_check(budget, render) for budget in BUDGETS}
     return out
 
 
 def checked_estimates(models: dict, cache: Path, res: int, bounces: int) -> tuple[list[dict], dict]:
     """The run-time estimate judged: for every held-out scene, row with an image in the bench's runs and
-    budget, the row's path-traced estimate (pipeline.path_traced_estimate against that budget's check)
+    budget, the row's path-traced estimate (choice.path_traced_estimate against that budget's check)
     beside its measured error; and per scene and budget the check's samples, noise and time. Scenes
     without row images render no check."""
     from addon.bridge import images
-    from addon.bridge.pipeline import path_traced_estimate
 
     found = {held: {key: run_image(cache, held, r["method"], r["setting"]) for key, r in measured.items()}
              for held, (_, measured) in models.items()}
@@ -171,7 +168,7 @@ def checked_estimates(models: dict, cache: Path, res: int, bounces: int) -> tupl
         for key, path in paths.items():
             ours = images.read_exr(path)
             for budget, check in checks[held].items():
-                estimate = path_traced_estimate(ours, check) if check is not None else None
+                estimate = choice.path_traced_estimate(ours, check) if check is not None else None
                 if estimate is None:
                     continue
                 out.append({"scene": held, "row": key, "budget": budget, "measured": measured[key]["rel_rmse_8"],

@@ -62,11 +62,13 @@ class ObjectResult:
     solve_ms: float = 0.0   # of the light field: only the object whose bake solved it
     gather_ms: float = 0.0  # its texels' gather from the light field
     notes: list[str] = field(default_factory=list)
+    self_check: dict | None = None  # bake --self-check: the path-traced estimate of this lightmap
 
     def to_dict(self) -> dict:
         return {"file": self.file, "size": self.size, "time_ms": round(self.time_ms, 2),
                 "solve_ms": round(self.solve_ms, 2), "gather_ms": round(self.gather_ms, 2), "status": self.status,
-                "message": self.message, "warnings": list(self.notes)}
+                "message": self.message, "warnings": list(self.notes),
+                **({"self_check": self.self_check} if self.self_check is not None else {})}
 
     def line(self) -> str:
         where = f" -> {self.file}" if self.file else ""
@@ -172,6 +174,36 @@ def pass_values(products: dict, pass_name: str) -> np.ndarray:
     out = products["direct"].copy()
     out[..., :3] += products["indirect"][..., :3]
     return out
+
+
+# Cycles' DIFFUSE bake filter for each pass (light alone, without the Color contribution)
+CYCLES_PASS_FILTER = {"indirect": {"INDIRECT"}, "direct": {"DIRECT"}, "combined": {"DIRECT", "INDIRECT"}}
+# --self-check without a model estimate to resolve (settings no benchmark row has)
+SELF_CHECK_RESOLVE = 0.1
+
+
+def bake_check_render(obj_name: str, pass_name: str, size: int, bounces: int):
+    """choice.path_traced_check's `render` for one object's lightmap: Cycles' own bake of the same pass
+    (reference.cycles_bake, the object's active UV map as ours), covering the texels its triangles touch."""
+    from .reference import cycles_bake
+
+    def render(spp: int, seed: int) -> tuple[np.ndarray, np.ndarray, float]:
+        rgba, seconds = cycles_bake(obj_name, CYCLES_PASS_FILTER[pass_name], spp, seed, size, bounces)
+        return rgba[..., :3], rgba[..., 3] > 0.5, seconds
+    return render
+
+
+def self_check(obj, values: np.ndarray, pass_name: str, size: int, bounces: int, resolve: float) -> dict:
+    """bake --self-check of one lightmap (`values`, RGBA, alpha = coverage): its rel_rmse_8 against Cycles'
+    converged bake, estimated by choice's path-traced check of the object (`resolve`: the error the check
+    must resolve); a note where it cannot be made."""
+    if not obj.material_slots or not all(slot.material and slot.material.use_nodes for slot in obj.material_slots):
+        return {"note": "no self-check: Cycles bakes only objects whose every material slot has a node material"}
+    check = choice.path_traced_check(resolve, bake_check_render(obj.name, pass_name, size, bounces))
+    estimate = choice.path_traced_estimate(values, check) if check is not None else None
+    if estimate is None:
+        return {"note": "no self-check: no texel lit in both bakes"}
+    return {"estimated_rel_rmse_8": estimate, **choice.check_stats(check)}
 
 
 def _default_camera(size: int) -> Camera:
@@ -329,13 +361,14 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
               settings: dict | None = None, pass_name: str = "indirect",
               target: str = "image", overwrite: bool = False, shard_index: int = 0, shard_count: int = 1,
               save_blend: Path | None = None, margin: int = 16, progress: bool = True, backend=None,
-              budget: dict | None = None, supersample: int = 1) -> dict:
+              budget: dict | None = None, supersample: int = 1, self_check: bool = False) -> dict:
     """Bake the objects of `blend` (see module docstring) into out_dir; returns the summary written to
     out_dir/bake.json. Per-object problems are recorded, never raised; bad arguments raise BounceError.
     size: the lightmap side (IMAGE_SIZE_TEXELS when None). settings: {group: config} (config.settings'
     form; defaults for missing groups). budget: the method chosen for the scene (Baker). supersample:
-    sub-texels per texel side of --target image (Baker.bake_image). A bake that yields no light is
-    recorded under "warnings" and told on stderr."""
+    sub-texels per texel side of --target image (Baker.bake_image). self_check (--target image): each
+    lightmap's error against Cycles' converged bake estimated by the path-traced check (`self_check`),
+    in its object's entry. A bake that yields no light is recorded under "warnings" and told on stderr."""
     from .pipeline import backend as default_backend
     from .pipeline import open_blend
 
@@ -343,6 +376,8 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
     check_choice(target, TARGETS, "--target")
     if target in VOLUME_TARGETS:
         raise ConfigError(f"--target {target} is one per scene, not per object: use bake_volume / bake_probes")
+    if self_check and target != "image":
+        raise ConfigError("--self-check judges lightmap images (--target image): Cycles bakes no vertex colours")
     size = IMAGE_SIZE_TEXELS if size is None else size
     if not 8 <= size <= 8192:
         raise ConfigError(f"--size must be in 8..8192, got {size}")
@@ -363,8 +398,9 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
     say(f"bake: capturing the scene, method {gi.method} setup")
     baker = Baker(be, bpy.context.evaluated_depsgraph_get(), settings, size, budget)
     settings, gi = baker.settings, baker.settings["gi"]
+    resolve = (baker.decided.get("estimated_rel_rmse_8") or SELF_CHECK_RESOLVE) if self_check else None
     results = _bake_objects(baker, names, out_dir, size, pass_name, target, overwrite, margin, progress,
-                            supersample)
+                            supersample, resolve)
     saved = None
     if save_blend is not None and target == "vertex-colors":
         bpy.ops.wm.save_as_mainfile(filepath=str(save_blend), copy=True, compress=False)
@@ -394,14 +430,16 @@ def _stderr_lines(enabled: bool):
 
 
 def _bake_objects(baker: Baker, names: list[str], out_dir: Path, size: int, pass_name: str, target: str,
-                  overwrite: bool, margin: int, progress: bool, supersample: int = 1) -> list[ObjectResult]:
+                  overwrite: bool, margin: int, progress: bool, supersample: int = 1,
+                  resolve: float | None = None) -> list[ObjectResult]:
     from tqdm import tqdm
 
     results, taken = [], set()
     bar = tqdm(names, desc="bake", unit="obj", file=sys.stderr, disable=not progress)
     for name in bar:
         bar.set_postfix_str(name[:30])
-        res = _bake_one(baker, name, out_dir, size, pass_name, target, overwrite, margin, taken, supersample)
+        res = _bake_one(baker, name, out_dir, size, pass_name, target, overwrite, margin, taken, supersample,
+                        resolve)
         results.append(res)
         tqdm.write(res.line(), file=sys.stdout)
     return results
@@ -420,7 +458,8 @@ def _file_warnings(scene, results: list[ObjectResult]) -> list[str]:
 
 
 def _bake_one(baker: Baker, name: str, out_dir: Path, size: int, pass_name: str, target: str, overwrite: bool,
-              margin: int, taken: set[str], supersample: int = 1) -> ObjectResult:
+              margin: int, taken: set[str], supersample: int = 1, resolve: float | None = None) -> ObjectResult:
+    """Bake one object; with `resolve` (bake --self-check) also its path-traced estimate (self_check)."""
     res = ObjectResult(name)
     t0 = time.perf_counter()
     try:
@@ -436,6 +475,8 @@ def _bake_one(baker: Baker, name: str, out_dir: Path, size: int, pass_name: str,
             values, notes = baker.bake_image(obj, size, pass_name, margin, supersample)
             images.write_exr(path, values)
             res.size = [size, size]
+            if resolve is not None:
+                res.self_check = self_check(obj, values, pass_name, size, baker.settings["gi"].bounces, resolve)
         else:
             values, notes = baker.bake_vertex_colors(obj, pass_name)
             store_vertex_colors(obj.data, attribute_name(pass_name), values)

@@ -14,7 +14,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-from ..engine import choice, methods, metrics, registry
+from ..engine import choice, methods, registry
 from ..engine.backends.moderngl_backend import ModernGLBackend
 from ..engine.config import settings as complete_settings
 from ..engine.errors import SceneError
@@ -75,42 +75,17 @@ def render_row(be, captured, settings: dict, model, key: str) -> np.ndarray:
     return method.run().images["indirect"]
 
 
-def path_traced_check(resolve: float, bounces: int, res: int, render=None,
-                      progress: Callable[[str], None] = lambda step: None) -> dict:
-    """The check pair of choice's path-traced check on the open scene, precise enough to resolve an error
-    of `resolve` (rel_rmse_8): a pilot pair at choice.CHECK_PILOT_SPP measures the scene's noise, then
-    a pair at choice.check_spp for a mean as noisy as choice.CHECK_NOISE x `resolve`. `render(spp, seed)`
-    -> (Cycles' layers by pass name, its time in s); default reference.render_open. Returns {"images":
-    the pair's Diffuse Indirect, "mask": the pixels with geometry and a diffuse colour (as
-    reference.reference_mask), "spp", "pilot_noise", "noise": the pair's mean's rel_noise_8, "time_s": all
-    four renders}; None where the image holds no diffuse surface."""
+def camera_check_render(bounces: int, res: int):
+    """choice.path_traced_check's `render` for the camera of the open scene: Cycles' Diffuse Indirect pass
+    at `res` (reference.render_open, configured as the references are); it covers the pixels with
+    geometry and a diffuse colour (as reference.reference_mask)."""
     from .reference import render_open
 
-    if render is None:
-        def render(spp, seed):
-            return render_open(spp, bounces, res, seed)[:2]
-
-    def pair(spp: int, seeds) -> tuple[list, np.ndarray, float]:
-        progress(f"path-traced check: Cycles at {spp} spp, seeds {seeds[0]} and {seeds[1]}")
-        rendered = [render(spp, seed) for seed in seeds]
-        layers = rendered[0][0]
+    def render(spp: int, seed: int) -> tuple[np.ndarray, np.ndarray, float]:
+        layers, seconds, _ = render_open(spp, bounces, res, seed)
         mask = (layers["Combined"][..., 3] > 0.5) & (layers["Diffuse Color"][..., :3].max(axis=2) > 0)
-        return [r[0]["Diffuse Indirect"][..., :3] for r in rendered], mask, sum(r[1] for r in rendered)
-
-    pilot, mask, pilot_s = pair(choice.CHECK_PILOT_SPP, choice.CHECK_SEEDS[0])
-    pilot_noise = metrics.rel_noise_8(pilot, mask)
-    if pilot_noise is None:
-        return None
-    spp = choice.check_spp(pilot_noise, choice.CHECK_NOISE * resolve)
-    checks, mask, check_s = pair(spp, choice.CHECK_SEEDS[1])
-    return {"images": checks, "mask": mask, "spp": spp, "pilot_noise": pilot_noise,
-            "noise": metrics.rel_noise_8(checks, mask), "time_s": pilot_s + check_s}
-
-
-def path_traced_estimate(ours: np.ndarray, check: dict) -> float | None:
-    """`ours` (an indirect image, RGBA) judged by a path_traced_check: its estimated rel_rmse_8 against
-    converged Cycles, over the pixels both hold."""
-    return metrics.rel_rmse_8_against_noisy(ours[..., :3], check["images"], check["mask"] & (ours[..., 3] > 0.5))
+        return layers["Diffuse Indirect"][..., :3], mask, seconds
+    return render
 
 
 # --self-check without a model estimate to resolve (settings no benchmark row has): the check resolves
@@ -124,23 +99,18 @@ def run_self_check(captured_settings: dict, decided: dict, written: dict, progre
     if "indirect" not in written:
         return {"note": "no self-check: the method makes no indirect light"}
     gi = captured_settings["gi"]
-    check = path_traced_check(decided.get("estimated_rel_rmse_8") or SELF_CHECK_RESOLVE, gi.bounces, gi.resolution,
-                              progress=progress)
-    estimate = path_traced_estimate(written["indirect"], check) if check is not None else None
+    check = choice.path_traced_check(decided.get("estimated_rel_rmse_8") or SELF_CHECK_RESOLVE,
+                                     camera_check_render(gi.bounces, gi.resolution), progress)
+    estimate = choice.path_traced_estimate(written["indirect"], check) if check is not None else None
     if estimate is None:
         return {"note": "no self-check: the image holds no diffuse surface"}
-    return {"estimated_rel_rmse_8": estimate, **check_stats(check)}
-
-
-def check_stats(check: dict) -> dict:
-    """What stats.json says of a path_traced_check: its samples, its mean's noise and its time."""
-    return {"check_spp": check["spp"], "check_noise": check["noise"], "check_time_s": check["time_s"]}
+    return {"estimated_rel_rmse_8": estimate, **choice.check_stats(check)}
 
 
 def verify_choice(be, captured, requested: dict, settings: dict, decided: dict, error_budget: float,
                   progress: Callable[[str], None]) -> tuple[dict, dict]:
     """`--verify`: the candidates of choice.verify rendered on the captured scene and judged by one
-    path-traced check (path_traced_check, resolving `error_budget`), the first whose estimate is within
+    path-traced check (choice.path_traced_check, resolving `error_budget`), the first whose estimate is within
     the budget taken, else the one whose estimate is least (choice.least_estimated). Returns the settings
     to run (`requested` with that row's setting; the model's choice, `settings`, when no candidate could
     be tried) and `decided` with choice["verified"] = the rows tried, their estimates, the one accepted
@@ -149,7 +119,7 @@ def verify_choice(be, captured, requested: dict, settings: dict, decided: dict, 
     feats = decided["features"]
     able = registry.computing(requested["gi"].bounces)
     gi = requested["gi"]
-    check = path_traced_check(error_budget, gi.bounces, gi.resolution, progress=progress)
+    check = choice.path_traced_check(error_budget, camera_check_render(gi.bounces, gi.resolution), progress)
     if check is None:
         decided["choice"]["verified"] = {"tried": [], "accepted": None,
                                          "note": "not verified: the image holds no diffuse surface"}
@@ -157,12 +127,12 @@ def verify_choice(be, captured, requested: dict, settings: dict, decided: dict, 
 
     def estimate(key: str) -> float | None:
         progress(f"verify: rendering {key}")
-        return path_traced_estimate(render_row(be, captured, requested, model, key), check)
+        return choice.path_traced_estimate(render_row(be, captured, requested, model, key), check)
 
     accepted, tried = choice.verify(model, feats, error_budget, estimate, able)
     # None within the budget: the row tried with the least estimate runs (choice.least_estimated).
     key = accepted if accepted is not None else choice.least_estimated(tried)
-    decided["choice"]["verified"] = {"tried": tried, "accepted": accepted, **check_stats(check)}
+    decided["choice"]["verified"] = {"tried": tried, "accepted": accepted, **choice.check_stats(check)}
     if key is None:
         return settings, decided
     found = next(t["estimated_rel_rmse_8"] for t in tried if t["row"] == key)

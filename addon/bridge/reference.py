@@ -296,11 +296,13 @@ def cycles_curve(blend, spp_list, bounces: int, res: int, reference_dir) -> list
     return curve
 
 
-def cycles_bake(obj_name: str, pass_filter: set, spp: int, seed: int, size: int) -> tuple[np.ndarray, float]:
+def cycles_bake(obj_name: str, pass_filter: set, spp: int, seed: int, size: int,
+                bounces: int = 1) -> tuple[np.ndarray, float]:
     """Cycles' DIFFUSE bake of one object of the open file into a size x size float image, set up as for
-    references (one diffuse bounce, no clamping, denoising or adaptive sampling); pass_filter {'INDIRECT'}
-    or {'DIRECT'} without 'COLOR' gives the light alone, in Diffuse Indirect / Direct units.
-    Returns (rgba, row 0 = top; seconds of the bake call)."""
+    references (`bounces` diffuse bounces, no clamping, denoising or adaptive sampling); pass_filter
+    {'INDIRECT'} or {'DIRECT'} without 'COLOR' gives the light alone, in Diffuse Indirect / Direct units.
+    Adds an image and an Image Texture node to the object's materials (the bake's target) and leaves the
+    render settings so. Returns (rgba, row 0 = top; seconds of the bake call)."""
     import bpy
 
     scene = bpy.context.scene
@@ -309,7 +311,7 @@ def cycles_bake(obj_name: str, pass_filter: set, spp: int, seed: int, size: int)
     c.device = "CPU"
     c.samples, c.seed = spp, seed
     c.use_adaptive_sampling = c.use_denoising = False
-    c.diffuse_bounces = c.max_bounces = 1
+    c.diffuse_bounces = c.max_bounces = bounces
     c.glossy_bounces = c.transmission_bounces = c.volume_bounces = c.transparent_max_bounces = 0
     c.sample_clamp_indirect = c.sample_clamp_direct = 0.0
     obj = bpy.data.objects[obj_name]

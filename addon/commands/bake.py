@@ -49,6 +49,10 @@ def add_arguments(p) -> None:
     p.add_argument("--supersample", type=int, default=1,
                    help="sub-texels per texel side (--target image): each texel the mean light over its "
                         "covered sub-texels, as Cycles' bake averages over the texel; N x N times the work")
+    p.add_argument("--self-check", action="store_true",
+                   help="also estimate each lightmap's rel_rmse_8 against Cycles' bake of the object: two Cycles "
+                        "bakes of a few samples, their own noise subtracted (bake.json objects.*.self_check; "
+                        "--target image)")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     add_config_flags(p)
     add_budget_flags(p)
@@ -105,6 +109,8 @@ def run(args) -> int:
         raise SceneError(f"--margin must be in 0..1024, got {args.margin}")
     if args.supersample != 1 and args.target != "image":
         raise ConfigError(f"--supersample is for --target image (got --target {args.target})")
+    if args.self_check and args.target != "image":
+        raise ConfigError(f"--self-check judges lightmap images: it is for --target image (got --target {args.target})")
     check_supersample(args.supersample, IMAGE_SIZE_TEXELS if args.size is None else args.size)
     blends = [existing_blend(b) for b in args.blend]
     if len(blends) > 1 and args.save_blend:
@@ -126,7 +132,8 @@ def run(args) -> int:
             out.mkdir(parents=True, exist_ok=True)
         summary = bake_file(blend, file_out, objects, args.size, settings, args.pass_name, args.target,
                             args.overwrite, index, count, Path(args.save_blend) if args.save_blend else None,
-                            args.margin, progress=not args.quiet, budget=chosen_for, supersample=args.supersample)
+                            args.margin, progress=not args.quiet, budget=chosen_for, supersample=args.supersample,
+                            self_check=args.self_check)
         files[str(blend)] = str(file_out / "bake.json")
         failed += [f"{blend.name}:{n}" for n, r in summary["objects"].items() if r["status"] == "error"]
     if len(blends) > 1:

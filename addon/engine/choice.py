@@ -493,3 +493,41 @@ def check_spp(pilot_noise: float, target_noise: float) -> int:
         raise ConfigError(f"the check's noise must be > 0, got {target_noise}")
     n = CHECK_PILOT_SPP * (pilot_noise / target_noise) ** 2
     return int(min(CHECK_MAX_SPP, max(CHECK_PILOT_SPP, math.ceil(n))))
+
+
+def path_traced_check(resolve: float, render, progress=lambda step: None) -> dict | None:
+    """The check pair of the path-traced check, precise enough to resolve an error of `resolve`
+    (rel_rmse_8): a pilot pair at CHECK_PILOT_SPP measures the scene's noise, then a pair at check_spp for
+    a mean as noisy as CHECK_NOISE x `resolve`. `render(spp, seed)` -> (the path tracer's light, (h, w, 3);
+    the texels or pixels it covers, (h, w) bool; its time in s): a camera image or a lightmap
+    (bridge/pipeline.camera_check_render, bridge/bake.bake_check_render). Returns {"images": the pair,
+    "mask": what the pair's first render covers, "spp", "pilot_noise", "noise": the pair's mean's
+    rel_noise_8, "time_s": all four renders}; None where nothing is covered."""
+    from .metrics import rel_noise_8
+
+    def pair(spp: int, seeds) -> tuple[list, np.ndarray, float]:
+        progress(f"path-traced check: {spp} spp, seeds {seeds[0]} and {seeds[1]}")
+        rendered = [render(spp, seed) for seed in seeds]
+        return [r[0] for r in rendered], rendered[0][1], sum(r[2] for r in rendered)
+
+    pilot, mask, pilot_s = pair(CHECK_PILOT_SPP, CHECK_SEEDS[0])
+    pilot_noise = rel_noise_8(pilot, mask)
+    if pilot_noise is None:
+        return None
+    spp = check_spp(pilot_noise, CHECK_NOISE * resolve)
+    checks, mask, check_s = pair(spp, CHECK_SEEDS[1])
+    return {"images": checks, "mask": mask, "spp": spp, "pilot_noise": pilot_noise,
+            "noise": rel_noise_8(checks, mask), "time_s": pilot_s + check_s}
+
+
+def path_traced_estimate(ours: np.ndarray, check: dict) -> float | None:
+    """`ours` (RGBA: light, alpha = what it covers) judged by a path_traced_check: its estimated rel_rmse_8
+    against the converged path tracer, over what both cover; None where nothing is."""
+    from .metrics import rel_rmse_8_against_noisy
+
+    return rel_rmse_8_against_noisy(ours[..., :3], check["images"], check["mask"] & (ours[..., 3] > 0.5))
+
+
+def check_stats(check: dict) -> dict:
+    """What stats.json and bake.json say of a path_traced_check: its samples, its mean's noise, its time."""
+    return {"check_spp": check["spp"], "check_noise": check["noise"], "check_time_s": check["time_s"]}

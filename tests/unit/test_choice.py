@@ -279,3 +279,33 @@ def test_check_spp_from_the_pilots_noise():
     assert choice.check_spp(10.0, 0.01) == choice.CHECK_MAX_SPP
     with pytest.raises(ConfigError):
         choice.check_spp(0.2, 0.0)
+
+
+def test_path_traced_check_sizes_its_pair_from_the_pilot():
+    # A fake path tracer: light 2 plus Gaussian noise of sd 8 / sqrt(spp) per pixel (Monte Carlo), 64 x 64
+    # px, every pixel covered. The pilot pair at 4 spp: each full block's mean has sd (8 / 2) / 8 = 0.5,
+    # their mean's 0.354, rel_noise_8 0.177. To resolve 0.1 at CHECK_NOISE 0.25 the pair's mean needs
+    # 0.025: spp = 4 x (0.177 / 0.025)^2 ~ 200 (the pilot's noise is itself measured from 64 blocks x 3:
+    # +-10 %, the spp +-20 %).
+    calls = []
+
+    def render(spp, seed):
+        calls.append((spp, seed))
+        rng = np.random.default_rng(seed)
+        return 2.0 + rng.normal(0.0, 8.0 / np.sqrt(spp), (64, 64, 3)), np.ones((64, 64), bool), 0.5
+
+    check = choice.path_traced_check(0.1, render)
+    assert calls[:2] == [(choice.CHECK_PILOT_SPP, s) for s in choice.CHECK_SEEDS[0]]
+    assert [c[1] for c in calls[2:]] == list(choice.CHECK_SEEDS[1]) and calls[2][0] == calls[3][0]
+    assert choice.CHECK_NOISE == 0.25 and 140 <= check["spp"] <= 280 and check["time_s"] == 2.0
+    assert check["noise"] == pytest.approx(0.025, rel=0.3)
+    assert choice.check_stats(check) == {"check_spp": check["spp"], "check_noise": check["noise"],
+                                         "check_time_s": 2.0}
+    # An image of exactly 2.2 is 10 % off the truth everywhere: the estimate reads 0.1, the checks'
+    # noise (0.025) taken out; where it covers nothing (alpha 0) there is nothing to judge.
+    ours = np.concatenate([np.full((64, 64, 3), 2.2), np.ones((64, 64, 1))], axis=2)
+    assert choice.path_traced_estimate(ours, check) == pytest.approx(0.1, rel=0.15)
+    ours[..., 3] = 0.0
+    assert choice.path_traced_estimate(ours, check) is None
+    # A path tracer that covers nothing gives no check.
+    assert choice.path_traced_check(0.1, lambda spp, seed: (np.ones((8, 8, 3)), np.zeros((8, 8), bool), 0.1)) is None
