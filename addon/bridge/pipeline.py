@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import statistics
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 import bpy
@@ -107,19 +108,33 @@ def run_self_check(captured_settings: dict, decided: dict, written: dict, progre
     return {"estimated_rel_rmse_8": estimate, **choice.check_stats(check)}
 
 
+# --verify renders its candidates and its check at most this many pixels on the long side: the choice
+# model was fitted at 128 px, and the check's Cycles samples per pixel do not fall as the pixels grow
+# (rel_rmse_8 compares 8 x 8 blocks whatever their size), so at 1920 px it would cost ~200x 128 px's.
+VERIFY_MAX_RESOLUTION = 256
+
+
 def verify_choice(be, captured, requested: dict, settings: dict, decided: dict, error_budget: float,
                   progress: Callable[[str], None]) -> tuple[dict, dict]:
     """`--verify`: the candidates of choice.verify rendered on the captured scene and judged by one
     path-traced check (choice.path_traced_check, resolving `error_budget`), the first whose estimate is within
-    the budget taken, else the one whose estimate is least (choice.least_estimated). Returns the settings
-    to run (`requested` with that row's setting; the model's choice, `settings`, when no candidate could
-    be tried) and `decided` with choice["verified"] = the rows tried, their estimates, the one accepted
-    (None when none was within) and the check's samples, noise and time."""
+    the budget taken, else the one whose estimate is least (choice.least_estimated); both at most
+    VERIFY_MAX_RESOLUTION px on the long side (the scene captured again at that size where the render is
+    larger). Returns the settings to run (`requested` with that row's setting; the model's choice,
+    `settings`, when no candidate could be tried) and `decided` with choice["verified"] = the rows tried,
+    their estimates, the one accepted (None when none was within), the size they were judged at and the
+    check's samples, noise and time."""
     model = choice.load()
     feats = decided["features"]
     able = registry.computing(requested["gi"].bounces)
     gi = requested["gi"]
-    check = choice.path_traced_check(error_budget, camera_check_render(gi.bounces, gi.resolution), progress)
+    res = min(gi.resolution, VERIFY_MAX_RESOLUTION)
+    if res < gi.resolution:
+        progress(f"verify: capturing the scene at {res} px")
+        width, height = image_size(bpy.context.scene, res)
+        captured = SceneCache().update(bpy.context.evaluated_depsgraph_get(), width, height)
+        requested = {**requested, "gi": replace(gi, resolution=res)}
+    check = choice.path_traced_check(error_budget, camera_check_render(gi.bounces, res), progress)
     if check is None:
         decided["choice"]["verified"] = {"tried": [], "accepted": None,
                                          "note": "not verified: the image holds no diffuse surface"}
@@ -132,12 +147,14 @@ def verify_choice(be, captured, requested: dict, settings: dict, decided: dict, 
     accepted, tried = choice.verify(model, feats, error_budget, estimate, able)
     # None within the budget: the row tried with the least estimate runs (choice.least_estimated).
     key = accepted if accepted is not None else choice.least_estimated(tried)
-    decided["choice"]["verified"] = {"tried": tried, "accepted": accepted, **choice.check_stats(check)}
+    decided["choice"]["verified"] = {"tried": tried, "accepted": accepted, "resolution": res,
+                                     **choice.check_stats(check)}
     if key is None:
         return settings, decided
     found = next(t["estimated_rel_rmse_8"] for t in tried if t["row"] == key)
     # The run-time estimate, not the model's: it is the better judge on held-out scenes (REPORT.md).
-    decided.update(estimated_rel_rmse_8=found, estimate_row=key, estimate_source="path-traced check")
+    decided.update(estimated_rel_rmse_8=found, estimate_row=key, estimate_source="path-traced check",
+                   **({"estimate_resolution": res} if res < gi.resolution else {}))
     if accepted is not None and key == decided["choice"]["row"]:
         return settings, decided
     row = model.rows[key]
@@ -148,7 +165,7 @@ def verify_choice(be, captured, requested: dict, settings: dict, decided: dict, 
            f"nearest: {found:.3f}")
     decided["choice"].update(method=row["method"], setting=row["setting"], row=key, predicted_rel_rmse_8=predicted,
                              predicted_ms=predicted_ms, meets_budget=accepted is not None, why=why)
-    return choice.apply_row(requested, row["method"], row["setting"]), decided
+    return choice.apply_row({**requested, "gi": gi}, row["method"], row["setting"]), decided
 
 
 def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,

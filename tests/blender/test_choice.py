@@ -81,6 +81,22 @@ def test_render_verify_runs_a_row_whose_estimate_is_within_the_budget(cornell_bl
     assert c["verified"]["check_spp"] >= choice.CHECK_PILOT_SPP and c["verified"]["check_noise"] > 0
 
 
+def test_render_verify_judges_a_large_render_at_a_preview_size(cornell_blend, tmp_path, monkeypatch):
+    # A render larger than VERIFY_MAX_RESOLUTION (here made 24 px) is verified at that size: the rows tried
+    # and the check at 24 px, the chosen row then rendered at the size asked (40 px), and stats.json says
+    # at which size the estimate was made.
+    from addon.bridge import images, pipeline
+
+    monkeypatch.setattr(pipeline, "VERIFY_MAX_RESOLUTION", 24)
+    out = tmp_path / "large"
+    assert main(["render", str(cornell_blend), "--out", str(out), "--method", "auto", "--error-budget", "0.3",
+                 "--verify", "--res", "40", "--repeat", "1", "--quiet"]) == 0
+    stats = json.loads((out / "stats.json").read_text())
+    assert stats["choice"]["verified"]["resolution"] == 24 and stats["estimate_resolution"] == 24
+    assert stats["image_size"] == [40, 40] and stats["config"]["gi"]["resolution"] == 40
+    assert images.read_exr(out / "indirect.exr").shape[:2] == (40, 40)
+
+
 def test_render_verify_with_none_within_runs_the_least_estimate(cornell_blend, tmp_path, monkeypatch):
     # When no candidate's estimate is within the budget, the one whose estimate is least runs, reported
     # as not meeting the budget and with that estimate. On the Cornell box real candidates verify, so
