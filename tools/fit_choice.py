@@ -357,8 +357,8 @@ def report(results_path: str, arguments: str, judged: dict, summ: dict, model: c
              f"than {choice.VERIFY_FASTER_SHARE:g} of its time, the first within replacing it; at most "
              f"{choice.VERIFY_MAX_TRIES} rendered; else the one "
              "rendered whose estimate is least; else the model's choice), met and within 2x as above, the mean "
-             "number of rows it rendered, the median time of those renders over the time of the row that runs "
-             "(cost), and its estimate (the path-traced one of the row that runs, else the model's) within a "
+             "number of rows it rendered, the median over scenes of their summed time over the time of the row "
+             "that runs (cost), and its estimate (the path-traced one of the row that runs, else the model's) within a "
              "factor 1.5 of the measured error.", "",
              "| budget | scenes | met | possible | within 2x | estimate within 1.5x | path-traced within 1.5x | "
              "verified: met | within 2x | rows tried | cost | estimate within 1.5x |",
