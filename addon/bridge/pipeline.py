@@ -94,12 +94,12 @@ def camera_check_render(bounces: int, res: int):
 SELF_CHECK_RESOLVE = 0.1
 
 
-def run_self_check(captured_settings: dict, decided: dict, written: dict, progress) -> dict:
+def run_self_check(settings: dict, decided: dict, written: dict, progress) -> dict:
     """The run-time estimate of the rendered indirect image: choice's path-traced check, as precise as the
     model's estimate of these settings asks (SELF_CHECK_RESOLVE where it has none)."""
     if "indirect" not in written:
         return {"note": "no self-check: the method makes no indirect light"}
-    gi = captured_settings["gi"]
+    gi = settings["gi"]
     check = choice.path_traced_check(decided.get("estimated_rel_rmse_8") or SELF_CHECK_RESOLVE,
                                      camera_check_render(gi.bounces, gi.resolution), progress)
     estimate = choice.path_traced_estimate(written["indirect"], check) if check is not None else None
