@@ -456,7 +456,8 @@ def main(argv=None) -> int:
     arguments = results_path + ("" if args.cache == default_cache else f" --cache {args.cache}") + (
         f" --estimates {args.estimates}" if args.estimates else "")
     (args.out / "REPORT.md").write_text(report(results_path, arguments, judged, summ, model, results))
-    (args.out / "judged.json").write_text(judged_json({"summary": summ, **judged}))
+    command = f".venv/bin/python tools/fit_choice.py {arguments}"
+    (args.out / "judged.json").write_text(judged_json({"summary": summ, "command": command, **judged}))
     print(json.dumps(summ))
     return 0 if all(math.isfinite(r["predicted"]) for r in judged["estimates"]) else 1
 

@@ -34,6 +34,8 @@ GPU_JSON = tuple(ROOT / "benchmarks" / "gpu" / f"h200-{run}.json" for run in ("t
 GPU_SCENES = ("cornell", "window-sky", "sponza")
 DIFFUSION_JSON = (ROOT / "benchmarks" / "diffusion" / "b1" / "results.json",
                   ROOT / "benchmarks" / "diffusion" / "b2" / "results.json")
+# tools/fit_choice.py's held-out judgement of the choice for an error budget (benchmarks/choice/REPORT.md)
+CHOICE_JSON = ROOT / "benchmarks" / "choice" / "judged.json"
 LPV_CAMERA_TARGET_PCT = 15  # the issue's target: lpv's camera update <= 15 % of its full update
 _BLOCK = re.compile(r"(<!-- figures:(?P<name>[a-z0-9-]+):begin -->\n)(?P<body>.*?)(<!-- figures:(?P=name):end -->)",
                     re.S)
@@ -420,6 +422,35 @@ def gpu_block(*runs: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def choice_block(judged: dict) -> str:
+    """Table: per error budget, what `render --method auto --error-budget E` (the model alone) and with
+    `--verify` (candidates judged by the path-traced check) met on held-out scenes, from fit_choice's
+    judged.json (its summary)."""
+    s = judged["summary"]
+    budgets = [b for b in s if b.replace(".", "", 1).isdigit()]
+    lines = ["**Choosing for an error budget, and saying how far from a path tracer**: each of the "
+             f"{s[budgets[0]]['scenes']} benchmark scenes judged by a model fitted without it "
+             "(`benchmarks/choice/REPORT.md`, from `" + judged["command"] + "`). `render --method auto "
+             "--error-budget E --verify` renders candidate settings fastest first and judges each against two "
+             "few-sample Cycles renders of the scene, their own noise subtracted (`--self-check` reports the "
+             "same estimate for any render, `bake --self-check` for each lightmap).", "",
+             "| E | scenes where some setting meets E | met, the model alone | met, verified | verified within 2x "
+             "of the fastest setting meeting E | its estimate within 1.5x of the error | settings tried | "
+             "the Cycles check (128 px) |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for b in budgets:
+        v = s[b]
+        t = v.get("check_time_s")
+        lines.append(f"| {b} | {v['possible']} | {v['met']} | {v['verified_met']} | {v['verified_within_2x']} | "
+                     f"{v['verified_estimate_within_1.5x']} | {v['verified_mean_tries']:.1f} | "
+                     + (f"{t[0]:.1f}-{t[1]:.0f} s" if t else "–") + " |")
+    shares = ", ".join(f"{s[b]['all_rows_path_traced_within_1.5x']:.0%}" for b in budgets
+                       if "all_rows_path_traced_within_1.5x" in s[b])
+    lines += ["", f"Every benchmark row's estimate within a factor 1.5 of its measured error: {shares} with the "
+              f"check of each budget; the model's own prediction {s['all_rows_estimate_within_1.5x']:.0%}."]
+    return "\n".join(lines) + "\n"
+
+
 # block name -> (the file it is in, its results.json file(s), the function that formats them)
 BLOCKS: dict[str, tuple[Path, tuple[Path, ...], Callable[..., str]]] = {
     "headline": (README, (DEFAULTS_JSON,), headline_block),
@@ -427,6 +458,7 @@ BLOCKS: dict[str, tuple[Path, tuple[Path, ...], Callable[..., str]]] = {
     "gpu": (README, GPU_JSON, gpu_block),
     "accuracy": (README, (DEFAULTS_JSON,), accuracy_block),
     "methods": (README, (DEFAULTS_JSON,), methods_block),
+    "choice": (README, (CHOICE_JSON,), choice_block),
     "lpv-octree": (LPV_DOC, (OCTREE_JSON,), octree_block),
     "diffusion-grids": (DIFFUSION_DOC, DIFFUSION_JSON, diffusion_block),
     "probes-encodings": (PROBES_DOC, (PROBES_JSON,), encodings_block),

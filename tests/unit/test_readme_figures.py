@@ -175,3 +175,20 @@ def test_produced_by_says_when_errors_were_measured_again():
     assert readme_figures._produced_by(results).endswith(
         " Errors measured again from its cached images by `tools/bench_rescore.py --cache C --ref-noise 0.03 --out O`"
         " on 2026-12-04 (commit fedcba987654 with uncommitted changes).")
+
+
+def test_choice_block():
+    # fit_choice's judged.json summary: one row per budget, the check's time range rounded, and the share
+    # of rows whose path-traced estimate is within 1.5x beside the model's.
+    budget = {"scenes": 15, "possible": 12, "met": 9, "verified_met": 12, "verified_within_2x": 11,
+              "verified_estimate_within_1.5x": 15, "verified_mean_tries": 9.44, "check_time_s": [1.04, 83.6],
+              "all_rows_path_traced_within_1.5x": 1.0}
+    judged = {"command": ".venv/bin/python tools/fit_choice.py R --cache C",
+              "summary": {"0.1": budget, "0.2": {**budget, "check_time_s": None,
+                                                 "all_rows_path_traced_within_1.5x": 0.955},
+                          "all_rows_estimate_within_1.5x": 0.594}}
+    text = readme_figures.choice_block(judged)
+    assert "each of the 15 benchmark scenes" in text and "`.venv/bin/python tools/fit_choice.py R --cache C`" in text
+    assert "| 0.1 | 12 | 9 | 12 | 11 | 15 | 9.4 | 1.0-84 s |" in text
+    assert "| 0.2 | 12 | 9 | 12 | 11 | 15 | 9.4 | – |" in text
+    assert "100%, 96% with the check of each budget; the model's own prediction 59%." in text
