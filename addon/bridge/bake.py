@@ -178,10 +178,6 @@ def pass_values(products: dict, pass_name: str) -> np.ndarray:
 
 # Cycles' DIFFUSE bake filter for each pass (light alone, without the Color contribution)
 CYCLES_PASS_FILTER = {"indirect": {"INDIRECT"}, "direct": {"DIRECT"}, "combined": {"DIRECT", "INDIRECT"}}
-# --self-check without a model estimate to resolve (settings no benchmark row has)
-SELF_CHECK_RESOLVE = 0.1
-
-
 def bake_check_render(obj_name: str, pass_name: str, size: int, bounces: int):
     """choice.path_traced_check's `render` for one object's lightmap: Cycles' own bake of the same pass
     (reference.cycles_bake, the object's active UV map as ours), covering the texels its triangles touch."""
@@ -193,13 +189,13 @@ def bake_check_render(obj_name: str, pass_name: str, size: int, bounces: int):
     return render
 
 
-def self_check(obj, values: np.ndarray, pass_name: str, size: int, bounces: int, resolve: float) -> dict:
+def self_check(obj, values: np.ndarray, pass_name: str, size: int, bounces: int) -> dict:
     """bake --self-check of one lightmap (`values`, RGBA, alpha = coverage): its rel_rmse_8 against Cycles'
-    converged bake, estimated by choice's path-traced check of the object (`resolve`: the error the check
-    must resolve); a note where it cannot be made."""
+    converged bake, estimated by choice's path-traced check of the object, as precise as the error its
+    pilot finds asks; a note where it cannot be made."""
     if not obj.material_slots or not all(slot.material and slot.material.use_nodes for slot in obj.material_slots):
         return {"note": "no self-check: Cycles bakes only objects whose every material slot has a node material"}
-    check = choice.path_traced_check(resolve, bake_check_render(obj.name, pass_name, size, bounces))
+    check = choice.path_traced_check(None, bake_check_render(obj.name, pass_name, size, bounces), ours=values)
     estimate = choice.path_traced_estimate(values, check) if check is not None else None
     if estimate is None:
         return {"note": "no self-check: no texel lit in both bakes"}
@@ -398,9 +394,8 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
     say(f"bake: capturing the scene, method {gi.method} setup")
     baker = Baker(be, bpy.context.evaluated_depsgraph_get(), settings, size, budget)
     settings, gi = baker.settings, baker.settings["gi"]
-    resolve = (baker.decided.get("estimated_rel_rmse_8") or SELF_CHECK_RESOLVE) if self_check else None
     results = _bake_objects(baker, names, out_dir, size, pass_name, target, overwrite, margin, progress,
-                            supersample, resolve)
+                            supersample, self_check)
     saved = None
     if save_blend is not None and target == "vertex-colors":
         bpy.ops.wm.save_as_mainfile(filepath=str(save_blend), copy=True, compress=False)
@@ -431,7 +426,7 @@ def _stderr_lines(enabled: bool):
 
 def _bake_objects(baker: Baker, names: list[str], out_dir: Path, size: int, pass_name: str, target: str,
                   overwrite: bool, margin: int, progress: bool, supersample: int = 1,
-                  resolve: float | None = None) -> list[ObjectResult]:
+                  checked: bool = False) -> list[ObjectResult]:
     from tqdm import tqdm
 
     results, taken = [], set()
@@ -439,7 +434,7 @@ def _bake_objects(baker: Baker, names: list[str], out_dir: Path, size: int, pass
     for name in bar:
         bar.set_postfix_str(name[:30])
         res = _bake_one(baker, name, out_dir, size, pass_name, target, overwrite, margin, taken, supersample,
-                        resolve)
+                        checked)
         results.append(res)
         tqdm.write(res.line(), file=sys.stdout)
     return results
@@ -458,8 +453,8 @@ def _file_warnings(scene, results: list[ObjectResult]) -> list[str]:
 
 
 def _bake_one(baker: Baker, name: str, out_dir: Path, size: int, pass_name: str, target: str, overwrite: bool,
-              margin: int, taken: set[str], supersample: int = 1, resolve: float | None = None) -> ObjectResult:
-    """Bake one object; with `resolve` (bake --self-check) also its path-traced estimate (self_check)."""
+              margin: int, taken: set[str], supersample: int = 1, checked: bool = False) -> ObjectResult:
+    """Bake one object; `checked` (bake --self-check): also its path-traced estimate (self_check)."""
     res = ObjectResult(name)
     t0 = time.perf_counter()
     try:
@@ -475,8 +470,8 @@ def _bake_one(baker: Baker, name: str, out_dir: Path, size: int, pass_name: str,
             values, notes = baker.bake_image(obj, size, pass_name, margin, supersample)
             images.write_exr(path, values)
             res.size = [size, size]
-            if resolve is not None:
-                res.self_check = self_check(obj, values, pass_name, size, baker.settings["gi"].bounces, resolve)
+            if checked:
+                res.self_check = self_check(obj, values, pass_name, size, baker.settings["gi"].bounces)
         else:
             values, notes = baker.bake_vertex_colors(obj, pass_name)
             store_vertex_colors(obj.data, attribute_name(pass_name), values)

@@ -89,19 +89,14 @@ def camera_check_render(bounces: int, res: int):
     return render
 
 
-# --self-check without a model estimate to resolve (settings no benchmark row has): the check resolves
-# errors of this size.
-SELF_CHECK_RESOLVE = 0.1
-
-
-def run_self_check(settings: dict, decided: dict, written: dict, progress) -> dict:
+def run_self_check(settings: dict, written: dict, progress) -> dict:
     """The run-time estimate of the rendered indirect image: choice's path-traced check, as precise as the
-    model's estimate of these settings asks (SELF_CHECK_RESOLVE where it has none)."""
+    error its pilot finds asks."""
     if "indirect" not in written:
         return {"note": "no self-check: the method makes no indirect light"}
     gi = settings["gi"]
-    check = choice.path_traced_check(decided.get("estimated_rel_rmse_8") or SELF_CHECK_RESOLVE,
-                                     camera_check_render(gi.bounces, gi.resolution), progress)
+    check = choice.path_traced_check(None, camera_check_render(gi.bounces, gi.resolution), progress,
+                                     ours=written["indirect"])
     estimate = choice.path_traced_estimate(written["indirect"], check) if check is not None else None
     if estimate is None:
         return {"note": "no self-check: the image holds no diffuse surface"}
@@ -219,7 +214,7 @@ def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,
     checked = None
     if self_check:
         progress("self-check: the path-traced check")
-        checked = run_self_check(settings, decided, written, progress)
+        checked = run_self_check(settings, written, progress)
         if checked.get("estimated_rel_rmse_8") is not None:
             # The run-time estimate replaces the model's, as with --verify: held out, it was within a factor
             # 1.5 of the measured error on every benchmark row, the model on 58 % (benchmarks/choice).

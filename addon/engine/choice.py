@@ -480,6 +480,9 @@ def decide(scene: Scene, settings: dict, pixels: int, error_budget: float | None
 CHECK_PILOT_SPP = 4
 CHECK_NOISE = 0.25
 CHECK_MAX_SPP = 4096
+# A self-check resolves the error its pilot pair finds, but no finer than this (a nearly exact image would
+# otherwise ask for CHECK_MAX_SPP): the direct light's errors against Cycles are ~0.01 (docs/DIRECT.md).
+CHECK_MIN_RESOLVE = 0.01
 # Seeds of the pilot pair and the check pair: far from 0 and 1, a benchmark reference's (Cycles draws the
 # first n samples of a seed alike at any spp, so a check with the reference's seed would share them).
 CHECK_SEEDS = ((7001, 7002), (7003, 7004))
@@ -495,15 +498,18 @@ def check_spp(pilot_noise: float, target_noise: float) -> int:
     return int(min(CHECK_MAX_SPP, max(CHECK_PILOT_SPP, math.ceil(n))))
 
 
-def path_traced_check(resolve: float, render, progress=lambda step: None) -> dict | None:
+def path_traced_check(resolve: float | None, render, progress=lambda step: None,
+                      ours: np.ndarray | None = None) -> dict | None:
     """The check pair of the path-traced check, precise enough to resolve an error of `resolve`
     (rel_rmse_8): a pilot pair at CHECK_PILOT_SPP measures the scene's noise, then a pair at check_spp for
-    a mean as noisy as CHECK_NOISE x `resolve`. `render(spp, seed)` -> (the path tracer's light, (h, w, 3);
+    a mean as noisy as CHECK_NOISE x `resolve`. `resolve` None: the error of `ours` (RGBA, the image the
+    check will judge) as the pilot pair estimates it, at least CHECK_MIN_RESOLVE (a self-check resolves
+    the error it finds). `render(spp, seed)` -> (the path tracer's light, (h, w, 3);
     the texels or pixels it covers, (h, w) bool; its time in s): a camera image or a lightmap
     (bridge/pipeline.camera_check_render, bridge/bake.bake_check_render). Returns {"images": the pair,
     "mask": what the pair's first render covers, "spp", "pilot_noise", "noise": the pair's mean's
     rel_noise_8, "time_s": all four renders}; None where nothing is covered."""
-    from .metrics import rel_noise_8
+    from .metrics import rel_noise_8, rel_rmse_8_against_noisy
 
     def pair(spp: int, seeds) -> tuple[list, np.ndarray, float]:
         progress(f"path-traced check: {spp} spp, seeds {seeds[0]} and {seeds[1]}")
@@ -514,6 +520,9 @@ def path_traced_check(resolve: float, render, progress=lambda step: None) -> dic
     pilot_noise = rel_noise_8(pilot, mask)
     if pilot_noise is None:
         return None
+    if resolve is None:
+        found = rel_rmse_8_against_noisy(ours[..., :3], pilot, mask & (ours[..., 3] > 0.5))
+        resolve = max(found or 0.0, CHECK_MIN_RESOLVE)
     spp = check_spp(pilot_noise, CHECK_NOISE * resolve)
     checks, mask, check_s = pair(spp, CHECK_SEEDS[1])
     return {"images": checks, "mask": mask, "spp": spp, "pilot_noise": pilot_noise,

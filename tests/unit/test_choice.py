@@ -307,5 +307,10 @@ def test_path_traced_check_sizes_its_pair_from_the_pilot():
     assert choice.path_traced_estimate(ours, check) == pytest.approx(0.1, rel=0.15)
     ours[..., 3] = 0.0
     assert choice.path_traced_estimate(ours, check) is None
+    # A self-check (resolve None) resolves the error the pilot pair finds in `ours`: 0.1 here, so about the
+    # spp above (the pilot's estimate of 0.1, from a pair whose mean is 0.177 noisy, is within +-30 %: the
+    # spp, which goes as 1 / resolve^2, within a factor 2).
+    ours[..., 3] = 1.0
+    assert 0.5 <= choice.path_traced_check(None, render, ours=ours)["spp"] / check["spp"] <= 2.0
     # A path tracer that covers nothing gives no check.
     assert choice.path_traced_check(0.1, lambda spp, seed: (np.ones((8, 8, 3)), np.zeros((8, 8), bool), 0.1)) is None
