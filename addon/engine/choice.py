@@ -34,6 +34,7 @@ from . import world
 from .area_light import split_area_light
 from .config import RsmConfig
 from .errors import ConfigError
+from .metrics import rel_noise_8, rel_rmse_8_against_noisy
 from .passes.light_views import emissive_lights, views_for
 from .scene import Scene
 
@@ -509,8 +510,6 @@ def path_traced_check(resolve: float | None, render, progress=lambda step: None,
     (bridge/pipeline.camera_check_render, bridge/bake.bake_check_render). Returns {"images": the pair,
     "mask": what the pair's first render covers, "spp", "pilot_noise", "noise": the pair's mean's
     rel_noise_8, "time_s": all four renders}; None where nothing is covered."""
-    from .metrics import rel_noise_8, rel_rmse_8_against_noisy
-
     def pair(spp: int, seeds) -> tuple[list, np.ndarray, float]:
         progress(f"path-traced check: {spp} spp, seeds {seeds[0]} and {seeds[1]}")
         rendered = [render(spp, seed) for seed in seeds]
@@ -532,8 +531,6 @@ def path_traced_check(resolve: float | None, render, progress=lambda step: None,
 def path_traced_estimate(ours: np.ndarray, check: dict) -> float | None:
     """`ours` (RGBA: light, alpha = what it covers) judged by a path_traced_check: its estimated rel_rmse_8
     against the converged path tracer, over what both cover; None where nothing is."""
-    from .metrics import rel_rmse_8_against_noisy
-
     return rel_rmse_8_against_noisy(ours[..., :3], check["images"], check["mask"] & (ours[..., 3] > 0.5))
 
 
