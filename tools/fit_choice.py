@@ -65,6 +65,17 @@ def records_of(results: dict) -> list[dict]:
             if r.get("rel_rmse_8") and r.get("product") == "indirect"]
 
 
+def pooled(runs: list[dict]) -> list[dict]:
+    """Every run's records_of, a later run's row replacing an earlier's of the same scene, method and
+    setting: a run of new methods pools beside an earlier one of the others, a re-run of the scenes a
+    change touched replaces their rows."""
+    rows = {}
+    for results in runs:
+        for record in records_of(results):
+            rows[record["scene"], choice.row_key(record["method"], record["setting"])] = record
+    return list(rows.values())
+
+
 def margin_of(records: list[dict], features: dict, ridge: float) -> float:
     """MARGIN_QUANTILE of measured / predicted over a leave-one-scene-out of `records`."""
     ratios = []
@@ -413,7 +424,8 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("results", type=Path, nargs="+",
                    help="bench results.json files of one resolution, reference spp and bounce count (their "
-                        "records are pooled: e.g. a run of new methods beside an earlier one of the others)")
+                        "records are pooled, a later file's row replacing an earlier's: e.g. a run of new "
+                        "methods beside an earlier one of the others, or a re-run of some scenes)")
     default_cache = ROOT / "out" / "bench"
     p.add_argument("--cache", type=Path, default=default_cache)
     p.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "choice")
@@ -434,7 +446,7 @@ def main(argv=None) -> int:
 
     if any(judged_by(r) != judged_by(results) for r in runs):
         raise SystemExit("the results differ in resolution, references or bounces: errors would not compare")
-    records = [rec for r in runs for rec in records_of(r)]
+    records = pooled(runs)
     features = scene_features(args.cache, sorted({r["scene"] for r in records}), results["bounces"], results["res"])
     models = held_out(records, features, args.ridge)
     judged = judge(models, features)

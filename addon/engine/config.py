@@ -65,7 +65,11 @@ class _Validated:
 class RsmConfig(_Validated):
     """Reflective shadow maps: one per light (six faces for a point light)."""
 
-    resolution: int = _num(256, 16, 4096, "RSM side in texels (per face for point lights)")
+    # A perspective view gets fewer where its footprint is narrower than the scene's diagonal, at the
+    # same texel width (light_views.view_texels): a lamp's face that sees the ceiling a few centimetres
+    # away is drawn at 64.
+    resolution: int = _num(256, 16, 4096, "most texels a side of an RSM view (per face for point lights; a "
+                                          "face that sees only nearby geometry gets fewer, as wide)")
     vpl_samples: int = _num(256, 1, 4096, "VPLs gathered per pixel by the `rsm` method")
     shadow_bias_texels: float = _num(0.0, 0.0, 8.0, "shadow bias in RSM texels beyond the 1.5-texel normal offset")
     visibility: str = _choice("none", ("none", "voxel"), "VPL visibility in the `rsm` gather: none or voxel-traced")

@@ -4,7 +4,15 @@ views_for spends a light's views on the bounds."""
 import numpy as np
 import pytest
 
-from addon.engine.passes.light_views import bounds_cone, face_meets, reaches, views_for
+from addon.engine.passes.light_views import (
+    MIN_VIEW_TEXELS,
+    bounds_cone,
+    face_meets,
+    reaches,
+    texel_width_m,
+    view_texels,
+    views_for,
+)
 from addon.engine.scene import Light
 from addon.engine.transforms import box_corners
 
@@ -90,9 +98,8 @@ def test_a_far_lamp_gets_one_view_fitted_to_the_bounds(position):
     assert view.face_index == -1
     lo, hi = BOUNDS
     assert in_view(view, points_in((lo - 0.05, hi + 0.05))).all()
-    fov_deg = np.degrees(2 * np.arctan(np.sqrt(view.texel_scale) * 256 / 2))
     distance = np.linalg.norm(np.array(position, float) - (lo + hi) / 2)
-    assert fov_deg < np.degrees(2 * np.arcsin(np.sqrt(3) * 1.2 / distance))  # the bounds' sphere, 20 % wider
+    assert fov_deg(view) < np.degrees(2 * np.arcsin(np.sqrt(3) * 1.2 / distance))  # the bounds' sphere, 20 % wider
 
 
 def test_a_lamp_just_outside_a_wall_skips_the_faces_that_see_nothing():
@@ -110,11 +117,15 @@ def test_a_lamp_just_outside_a_wall_skips_the_faces_that_see_nothing():
     assert set(face.tolist()) <= kept
 
 
+def fov_deg(view):
+    return np.degrees(2 * np.arctan(np.sqrt(view.texel_scale) * view.resolution / 2))
+
+
 def test_a_spot_keeps_its_own_cone_where_it_is_the_narrower():
     spot_view = views_for(spot((0, 0, 30), (0, 0, -1), size_deg=3.0), 0, BOUNDS, 256)[0]
-    assert np.degrees(2 * np.arctan(np.sqrt(spot_view.texel_scale) * 256 / 2)) == pytest.approx(3.06)
+    assert fov_deg(spot_view) == pytest.approx(3.06)
     wide_view = views_for(spot((0, 0, 30), (0, 0, -1), size_deg=100.0), 0, BOUNDS, 256)[0]
-    assert np.degrees(2 * np.arctan(np.sqrt(wide_view.texel_scale) * 256 / 2)) < 10.0
+    assert fov_deg(wide_view) < 10.0
 
 
 def test_the_bounds_cone_and_the_face_test_are_exact_on_simple_boxes():
@@ -126,3 +137,50 @@ def test_the_bounds_cone_and_the_face_test_are_exact_on_simple_boxes():
     assert face_meets(np.array([0.0, 0.0, 1.0]), corners)
     assert not face_meets(np.array([0.0, 0.0, -1.0]), corners)
     assert not face_meets(np.array([1.0, 0.0, 0.0]), corners)  # x <= 1 < z everywhere in the box
+
+
+# -- a view's texels from its footprint (light_views.view_texels) -------------------------------------
+
+def test_view_texels_halve_while_they_still_cover_the_footprint():
+    # At 1 cm texels and at most 256 a side: a 2.56 m footprint needs all 256; 1.28 m exactly 128; 1.27 m
+    # still 128 (64 would cover 0.64 m); 0.5 m stops at the floor of 64. An odd most (75 = 300 / 4) is
+    # never halved into a fraction of a texel, and a most below the floor stays.
+    assert view_texels(2.56, 0.01, 256) == 256
+    assert view_texels(1.28, 0.01, 256) == 128
+    assert view_texels(1.27, 0.01, 256) == 128
+    assert view_texels(0.5, 0.01, 256) == MIN_VIEW_TEXELS == 64
+    assert view_texels(1.0, 0.01, 300) == 150
+    assert view_texels(0.1, 0.01, 300) == 75
+    assert view_texels(0.01, 0.01, 32) == 32
+
+
+def test_a_lamp_under_the_ceiling_draws_its_upward_face_coarse_at_the_same_texel_width():
+    # 5 cm under the 2 m ceiling of the 2 x 2 x 2 m bounds (diagonal 2 sqrt(3) = 3.46 m: texels of 13.5 mm
+    # at 256): the upward face's footprint at the ceiling is 2 x 0.05 m = 0.1 m, 64 texels (the floor);
+    # the downward face's, 2 x 1.95 m = 3.9 m, needs all 256; the side faces' (1 m to the walls: 2 m)
+    # 256 too (128 texels would cover only 1.73 m).
+    views = views_for(lamp((0.0, 0.0, 1.95)), 0, BOUNDS, 256)
+    texels = {v.face_index: v.resolution for v in views}
+    assert texels == {0: 256, 1: 256, 2: 256, 3: 256, 4: 64, 5: 256}
+    # The coarse face's texels at its geometry (0.05 m x 2 / 64 = 1.6 mm) are no wider than a 256-texel
+    # view's across the diagonal: fewer texels, no coarser than the scene's widest view.
+    width_m = texel_width_m(BOUNDS, 256)
+    assert width_m == pytest.approx(2 * np.sqrt(3) / 256)
+    (up,) = (v for v in views if v.face_index == 4)
+    assert np.sqrt(up.texel_scale) * 0.05 == pytest.approx(0.1 / 64)
+
+
+def test_a_narrow_spot_gets_the_texels_its_cone_needs():
+    # A 30-degree spot 2 m above the floor it lights, inside the bounds: its cone is 2 tan(15 deg) x 2 m
+    # = 1.07 m wide at the floor, 80 texels of 13.5 mm: 128 (a halving of 256 that still covers it;
+    # 64 would not). Its texels there are 8.4 mm wide, at most the diagonal view's 13.5 mm.
+    (view,) = views_for(spot((0, 0, 2.0), (0, 0, -1), size_deg=30.0), 0, BOUNDS, 256)
+    assert view.resolution == 128
+    assert np.sqrt(view.texel_scale) * 2.0 <= texel_width_m(BOUNDS, 256)
+
+
+def test_a_sun_keeps_the_resolution():
+    # a sun's view is fitted to the bounds: its footprint is the scene's (and the sky's tiles rely on it)
+    sun = Light("SUN", np.zeros(3), np.array([0.3, 0.2, -1.0]) / np.linalg.norm([0.3, 0.2, -1.0]), np.ones(3),
+                sun_strength=3.0)
+    assert [v.resolution for v in views_for(sun, 0, BOUNDS, 256)] == [256]

@@ -21,7 +21,6 @@ from .. import registry
 from ..config import DiffusionConfig
 from ..grid import Grid
 from ..passes import (
-    atlas,
     declare,
     diffusion_cells,
     diffusion_inject,
@@ -75,7 +74,6 @@ class DiffusionMethod(OneBounceMethod):
             self.bounce_flux = ([diffusion_propagate.sides(be, grid) for _ in range(min(2, self.gi.bounces))]
                                 if self.diffusion_config.emitter_class_passes else [self.absorbed])
             self.accumulated = diffusion_propagate.sides(be, grid) if self.gi.bounces > 1 else self.bounce_flux[0]
-            self._points = atlas.texel_points(be, self.rsm_config.resolution, diffusion_inject.SPEC)
         self.voxels = self.voxelizer.run()
         diffusion_cells.run(be, self.voxels, self.cells, self.grid)
 
@@ -84,7 +82,8 @@ class DiffusionMethod(OneBounceMethod):
 
     def solve_view(self, view: LightView, timings: dict[str, float]) -> None:
         with self.step(timings, diffusion_inject.DECL):
-            diffusion_inject.run(self.backend, self._inject_target, self._points, self.rsm, self.grid, self.atlas,
+            points = self.rsm_points(view.resolution, diffusion_inject.SPEC)
+            diffusion_inject.run(self.backend, self._inject_target, points, self.rsm, self.grid, self.atlas,
                                  self.cells["cell_normal"])
 
     def finish_solve(self, timings: dict[str, float]) -> None:

@@ -30,6 +30,7 @@ from ..errors import ConfigError
 from ..passes import (
     accumulate,
     albedo_atlas,
+    atlas,
     declare,
     denoise,
     direct_light,
@@ -221,9 +222,12 @@ class DirectMethod:
         self._not_emitting = not_emitting
         self._bvh = None  # the same triangles' hierarchy (RsmConfig.sky_rays), made on first use
         n = self.rsm_config.resolution
-        self._rsm_slots: list[tuple[dict, object]] = []  # (textures, target) per kept face, made on use
+        # (textures, target) per kept face and RSM size (LightView.resolution), made on use. Counted at
+        # the largest size: a face's sizes, halved from it, add at most a third more.
+        self._rsm_slots: dict[tuple[int, int], tuple[dict, object]] = {}
         self._kept_faces = max(1, RSM_KEEP_BYTES // (RSM_BYTES_PER_TEXEL * n * n))
-        self.rsm, self.rsm_target = self._rsm_slot(0)  # the face being drawn or read (hooks use it)
+        self.rsm, self.rsm_target = self._rsm_slot(0, n)  # the face being drawn or read (hooks use it)
+        self._rsm_points: dict[tuple, object] = {}  # rsm_points' meshes
         self._slot = 0  # that face's slot: its sun shadow map's too
         self._sun_shadows: dict[int, tuple[dict, object]] = {}  # slot -> a sun's own shadow map (made on use)
         self._emitter_rows = None  # the emitter table on the GPU (light_views)
@@ -244,14 +248,22 @@ class DirectMethod:
         self.samples = 0
         self._allocate_images()
 
-    def _rsm_slot(self, index: int) -> tuple[dict, object]:
-        """The RSM textures and target of kept face `index`, allocated on first use."""
-        be, n = self.backend, self.rsm_config.resolution
-        while len(self._rsm_slots) <= index:
-            textures = {k: be.texture((n, n)) for k in ("position", "normal", "flux")}
-            target = be.target([textures["position"], textures["normal"], textures["flux"]], be.depth_texture((n, n)))
-            self._rsm_slots.append((textures, target))
-        return self._rsm_slots[index]
+    def _rsm_slot(self, index: int, texels: int) -> tuple[dict, object]:
+        """The RSM textures and target of kept face `index` at `texels` a side, allocated on first use."""
+        if (index, texels) not in self._rsm_slots:
+            be, size = self.backend, (texels, texels)
+            textures = {k: be.texture(size) for k in ("position", "normal", "flux")}
+            target = be.target([textures["position"], textures["normal"], textures["flux"]], be.depth_texture(size))
+            self._rsm_slots[index, texels] = (textures, target)
+        return self._rsm_slots[index, texels]
+
+    def rsm_points(self, texels: int | tuple[int, int], spec: ShaderSpec, copies: int = 1):
+        """atlas.texel_points of an RSM `texels` a side (or (width, height)) for the splatting program
+        `spec`, made once per size: the views' RSMs differ in size (LightView.resolution)."""
+        key = (texels, spec.name, copies)
+        if key not in self._rsm_points:
+            self._rsm_points[key] = atlas.texel_points(self.backend, texels, spec, copies)
+        return self._rsm_points[key]
 
     def _own_sun_shadow(self, view: LightView) -> bool:
         """Whether `view` (a sun lamp's face; world suns' direct light is the sky pass's) gets a shadow
@@ -495,7 +507,7 @@ class DirectMethod:
         return timings
 
     def _draw_rsm(self, view: LightView, slot: int, timings: dict[str, float]) -> None:
-        self.rsm, self.rsm_target = self._rsm_slot(slot)
+        self.rsm, self.rsm_target = self._rsm_slot(slot, view.resolution)
         self._slot = slot
         with self.step(timings, rsm.DECL):
             rsm.run(self.backend, self.rsm_target, self._meshes[rsm.SPEC.name], view, self.albedo_atlas)
@@ -560,7 +572,7 @@ class DirectMethod:
         self.begin_gather(timings)
         self._sky_direct(timings)
         for view, slot in zip(views, slots, strict=True):
-            self.rsm, self.rsm_target = self._rsm_slot(slot)
+            self.rsm, self.rsm_target = self._rsm_slot(slot, view.resolution)
             self._slot = slot
             self._gather_view(view, timings)
         self.gather_pixels(timings)

@@ -43,7 +43,6 @@ from ..config import LpvConfig
 from ..errors import ConfigError
 from ..grid import Grid
 from ..passes import (
-    atlas,
     declare,
     lpv_cascade,
     lpv_far_field,
@@ -216,10 +215,7 @@ class LpvMethod(OneBounceMethod):
                 below = LpvVolume(self, lpv_cascade.Cascade(grid), far_field_of=below,
                                   blocks=i < self.lpv_config.octree_blocked_levels)
                 top.octree.append(below)
-        res = self.rsm_config.resolution
-        self._reduce = rsm_reduce.factor_for(res, self.lpv_config.grid_cells)
-        self._vpls = rsm_reduce.textures(self.backend, res, self._reduce) if self._reduce > 1 else None
-        self._points = atlas.texel_points(self.backend, res // self._reduce, lpv_inject.spec(self.classes))
+        self._reduced: dict[int, tuple[int, dict | None]] = {}  # reduced_vpls' (factor, textures) per RSM size
 
     def allocate_products(self, size: tuple[int, int]) -> None:
         super().allocate_products(size)
@@ -261,13 +257,23 @@ class LpvMethod(OneBounceMethod):
 
     def solve_view(self, view: LightView, timings: dict[str, float]) -> None:
         with self.step(timings, lpv_inject.DECL):
-            vpls = self.rsm
-            if self._vpls is not None:
-                rsm_reduce.run(self.backend, self.rsm, self._vpls, self._reduce)
-                vpls = self._vpls
+            vpls, factor = self.reduced_vpls(view.resolution)
+            points = self.rsm_points(view.resolution // factor, lpv_inject.spec(self.classes))
             for level in self.grids():
-                lpv_inject.run(self.backend, level.inject_target, self._points, vpls, level.grid, level.atlas,
+                lpv_inject.run(self.backend, level.inject_target, points, vpls, level.grid, level.atlas,
                                self.classes)
+
+    def reduced_vpls(self, texels: int) -> tuple[dict, int]:
+        """The face's VPLs (`self.rsm`, `texels` a side) as injected, and the factor its side was reduced by
+        (rsm_reduce: about two VPLs per cell of the finest grid); the reduced textures are made once per size."""
+        if texels not in self._reduced:
+            factor = rsm_reduce.factor_for(texels, self.lpv_config.grid_cells)
+            self._reduced[texels] = factor, rsm_reduce.textures(self.backend, texels, factor) if factor > 1 else None
+        factor, textures = self._reduced[texels]
+        if textures is None:
+            return self.rsm, 1
+        rsm_reduce.run(self.backend, self.rsm, textures, factor)
+        return textures, factor
 
     def propagate(self, iterations: int | None = None, accumulated: dict | None = None,
                   level: LpvVolume | None = None) -> None:

@@ -23,7 +23,6 @@ from ..config import VctConfig
 from ..grid import Grid
 from ..passes import (
     accumulate,
-    atlas,
     declare,
     denoise,
     rsm,
@@ -83,10 +82,6 @@ class VctMethod(OneBounceMethod):
         self.light_flux = vct_pyramid.direction_textures(be, self.atlas.size)
         self._light_target = be.target([self.light_flux[d] for d in DIRECTIONS])
         self._pending_light: int | None = None
-        self._sky_points = None  # (size, point mesh) of the sky's RSM tiles (inject_sky)
-        filtered = cfg.filtered_injection
-        self._points = atlas.texel_points(be, self.rsm_config.resolution, vct_inject.spec(filtered),
-                                          vct_inject.points_per_texel(filtered))
         self.pyramid = vct_pyramid.pyramid_textures(be, self.grid)
         if self.gi.bounces > 1:
             self.next_bounce = vct_pyramid.direction_textures(be, self.grid.dims)
@@ -110,8 +105,10 @@ class VctMethod(OneBounceMethod):
         with self.step(timings, vct_inject.DECL):
             if self._pending_light is not None and view.light_index != self._pending_light:
                 self._flush_light()
-            vct_inject.run(self.backend, self._light_target, self._points, self.rsm, self.grid, self.atlas,
-                           self.voxels["vox_projected"] if self.vct_config.filtered_injection else None)
+            filtered = self.vct_config.filtered_injection
+            points = self.rsm_points(view.resolution, vct_inject.spec(filtered), vct_inject.points_per_texel(filtered))
+            vct_inject.run(self.backend, self._light_target, points, self.rsm, self.grid, self.atlas,
+                           self.voxels["vox_projected"] if filtered else None)
             self._pending_light = view.light_index
 
     def _flush_light(self) -> None:
@@ -173,11 +170,8 @@ class VctMethod(OneBounceMethod):
                                 sky.views)
         with self.step(timings, vct_inject.SKY_DECL):
             filtered = self.vct_config.filtered_injection
-            size = sky.layout.size
-            if self._sky_points is None or self._sky_points[0] != size:
-                self._sky_points = (size, atlas.texel_points(self.backend, size, vct_inject.spec(filtered),
-                                                             vct_inject.points_per_texel(filtered)))
-            vct_inject.run(self.backend, self._light_target, self._sky_points[1], textures, self.grid, self.atlas,
+            points = self.rsm_points(sky.layout.size, vct_inject.spec(filtered), vct_inject.points_per_texel(filtered))
+            vct_inject.run(self.backend, self._light_target, points, textures, self.grid, self.atlas,
                            self.voxels["vox_projected"] if filtered else None)
             self._flush_light()
 

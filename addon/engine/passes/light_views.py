@@ -9,6 +9,14 @@ face, or a spot's face), the light gets that one view instead (a lamp 30 m from 
 the far distance first: the direct pass lifts a receiver off its surface by a few texels before it
 looks the receiver up, and the lifted point must still lie in a view.
 
+Texels only where they are needed: `resolution` (RsmConfig.resolution) is the most texels a side of a
+perspective view has. Its texels are as wide as those of a view of that side spanning the bounds'
+diagonal (texel_width_m); a view whose footprint (its width at the farthest depth of the bounds in it)
+is narrower gets that many fewer texels, halved while they still cover it (view_texels): a lamp under
+the ceiling draws its upward face at 64 texels rather than 256, at the same texel width as its other
+faces. A sun keeps `resolution`: its view is fitted to the bounds (and the sky's tiles, sky_light.py,
+rely on their size).
+
 An area light's RSM looks from its centre as a Lambertian point, I(w) = P / pi * cos: its VPLs. A
 light with a shape (area_light.split_area_light's patches, emissive triangles: Light.emitter) is lit
 exactly in the direct pass from its polygons and shadowed from its position.
@@ -35,6 +43,9 @@ FIT_MARGIN_TEXELS = 12.0
 # those of the view the light has otherwise (its spot's face, or a cube face): a lamp just outside a
 # wall keeps its cube faces, which waste few texels on it, and only the faces that see nothing go.
 FIT_MIN_GAIN = 2.0
+# The fewest texels a side a perspective view is given from its footprint (view_texels): the rsm
+# gather's strata (at most 64 a side at RsmConfig.vpl_samples' 4096) each keep a texel or more.
+MIN_VIEW_TEXELS = 64
 
 
 @dataclass(frozen=True)
@@ -48,6 +59,7 @@ class LightView:
     face_index: int  # 0..5 for cube faces (major-axis partition), -1 otherwise
     texel_scale: float  # perspective: texel solid angle at the face axis (sr); sun: texel area (m^2)
     uniforms: dict
+    resolution: int  # its RSM's side in texels (view_texels)
 
 
 def emissive_lights(positions_m: np.ndarray, emission: np.ndarray, scene_extent_m: float, bins: int = 8
@@ -171,20 +183,46 @@ def reaches(light: Light, bounds: tuple[np.ndarray, np.ndarray]) -> bool:
     return True
 
 
+def texel_width_m(bounds: tuple[np.ndarray, np.ndarray], resolution: int) -> float:
+    """The width (m) of a perspective view's texels, whatever its footprint: that of `resolution` texels
+    across the bounds' diagonal, the widest footprint a view of the scene has."""
+    lo, hi = bounds
+    return max(float(np.linalg.norm(np.asarray(hi) - np.asarray(lo))), 1e-9) / resolution
+
+
+def view_texels(footprint_m: float, texel_m: float, most: int) -> int:
+    """Texels a side for a view `footprint_m` wide at its farthest geometry: `most`, halved while half
+    as many still cover the footprint at texel_m each, stays even (RSM reductions halve it again) and
+    keeps MIN_VIEW_TEXELS."""
+    texels = most
+    while texels % 2 == 0 and texels // 2 >= MIN_VIEW_TEXELS and (texels // 2) * texel_m >= footprint_m:
+        texels //= 2
+    return texels
+
+
 def views_for(light: Light, index: int, bounds: tuple[np.ndarray, np.ndarray], resolution: int) -> list[LightView]:
+    """`light`'s RSM views (module docstring): a sun's at `resolution`, a perspective view's at
+    view_texels of its footprint, `resolution` at most."""
     lo, hi = bounds
     corners = box_corners(lo, hi)
     if light.kind == "SUN":
         return [_sun_view(light, index, corners, resolution)]
+    texel_m = texel_width_m(bounds, resolution)
     far = float(np.max(np.linalg.norm(corners - light.position_m, axis=1))) * 1.01 + 1e-3
     # Depth precision goes with far / near: keep near as large as the scene allows. Outside the
     # bounds, half the distance to them clips nothing; inside, far / 1000 (32-bit depth, ~1e-4 relative).
     outside_m = float(np.linalg.norm(np.maximum(np.maximum(lo - light.position_m, light.position_m - hi), 0.0)))
     near = max(far * 1e-3, 0.5 * outside_m)
 
-    def widened(tan_half: float) -> np.ndarray:  # the bounds' corners from the light, FIT_MARGIN_TEXELS wider
-        margin_m = FIT_MARGIN_TEXELS * (2.0 * tan_half / resolution) * far + 1e-6 * float(np.linalg.norm(hi - lo))
+    def widened(tan_half: float, texels: int = resolution) -> np.ndarray:
+        """The bounds' corners from the light, FIT_MARGIN_TEXELS of a view's `texels` wider."""
+        margin_m = FIT_MARGIN_TEXELS * (2.0 * tan_half / texels) * far + 1e-6 * float(np.linalg.norm(hi - lo))
         return box_corners(lo - margin_m, hi + margin_m) - light.position_m
+
+    def texels_for(axis: np.ndarray, fov: float) -> int:
+        """view_texels of the view's footprint at the bounds' farthest depth along its axis."""
+        depth_m = float(np.clip(np.max((corners - light.position_m) @ axis), near, far))
+        return view_texels(2.0 * np.tan(fov / 2.0) * depth_m, texel_m, resolution)
 
     spot_face = light.kind == "SPOT" and light.spot_size_rad <= SINGLE_FACE_MAX_SPOT_RAD
     # the field of view the light has otherwise: its spot's face, or a cube face's
@@ -193,17 +231,25 @@ def views_for(light: Light, index: int, bounds: tuple[np.ndarray, np.ndarray], r
     if cone is not None:
         cone = bounds_cone(widened(np.tan(cone[1])))  # in the fitted view's own texels
     if cone is not None and np.tan(cone[1]) * FIT_MIN_GAIN <= np.tan(own_fov / 2.0):
-        return [_perspective_view(light, index, cone[0], -1, 2.0 * cone[1], near, far, resolution)]
+        texels = texels_for(cone[0], 2.0 * cone[1])
+        if texels < resolution:  # its margin in its own, wider texels: the wider view may need more
+            cone = bounds_cone(widened(np.tan(cone[1]), texels))
+            texels = texels_for(cone[0], 2.0 * cone[1])
+        return [_perspective_view(light, index, cone[0], -1, 2.0 * cone[1], near, far, texels)]
     if spot_face:
-        return [_perspective_view(light, index, light.direction, -1, own_fov, near, far, resolution)]
-    wide = widened(1.0)  # in a cube face's texels
+        return [_perspective_view(light, index, light.direction, -1, own_fov, near, far,
+                                  texels_for(light.direction, own_fov))]
+    # The faces' margin at `resolution` texels holds their fewer texels' lifts too: a face's texels are
+    # at most texel_m wide at its geometry (view_texels), so a lift of up to 8 of them moves a receiver at
+    # most 8 diagonal / resolution, less than the margin's 12 x 2 far / resolution (far >= diagonal / 2).
+    wide = widened(1.0)
     views = []
     for face, axis in enumerate(CUBE_AXES):
         if light.kind == "AREA" and np.dot(axis, light.direction) < -0.5:
             continue  # the face behind a one-sided emitter receives nothing
         if not face_meets(axis, wide):
             continue  # nothing of the scene lies in this face's pyramid
-        views.append(_perspective_view(light, index, axis, face, np.pi / 2.0, near, far, resolution))
+        views.append(_perspective_view(light, index, axis, face, np.pi / 2.0, near, far, texels_for(axis, np.pi / 2.0)))
     return views
 
 
@@ -266,7 +312,8 @@ def _perspective_view(light, index, axis, face, fov, near, far, resolution) -> L
     texel_scale = (2.0 * np.tan(fov / 2.0) / resolution) ** 2
     uniforms = {"light_view_projection": vp, "light_view_projection_inverse": np.linalg.inv(vp),
                 "face_axis": axis, "face_index": face, **_common_uniforms(light, light.direction, texel_scale)}
-    return LightView(index, vp, light.position_m, np.asarray(axis, np.float64), face, texel_scale, uniforms)
+    return LightView(index, vp, light.position_m, np.asarray(axis, np.float64), face, texel_scale, uniforms,
+                     resolution)
 
 
 def _sun_view(light, index, corners, resolution) -> LightView:
@@ -280,4 +327,4 @@ def _sun_view(light, index, corners, resolution) -> LightView:
     texel_scale = (x1 - x0 + 2 * pad) * (y1 - y0 + 2 * pad) / resolution**2
     uniforms = {"light_view_projection": vp, "face_axis": light.direction, "face_index": -1,
                 **_common_uniforms(light, light.direction, texel_scale)}
-    return LightView(index, vp, center, light.direction, -1, texel_scale, uniforms)
+    return LightView(index, vp, center, light.direction, -1, texel_scale, uniforms, resolution)
