@@ -65,7 +65,7 @@ def measure(blend: Path, res: int, iterations: list[int], repeat: int, reference
     method = methods.create(be, settings(gi=GIConfig(method="vct", resolution=res)))
     method.set_scene(scene)
     before = method.run().images["indirect"]  # also the warm-up
-    update_ms = update_costs(method, repeat)["lights"]  # the solve and the gathers: an update with no upload
+    update_ms = update_costs(method, repeat, kinds=("lights",))["lights"]  # the solve and gathers, no upload
     out, scratch = be.texture((width, height)), be.texture((width, height))
     reference = images.read_exr(references / str(res) / "indirect.exr") if references is not None else None
     row = {"res": res, "vct_update_ms": update_ms}

@@ -79,7 +79,7 @@ def filter_share(method, repeat: int) -> dict:
     from addon.engine.updates import update_costs
 
     be = method.backend
-    update_ms = update_costs(method, repeat)["lights"]
+    update_ms = update_costs(method, repeat, kinds=("lights",))["lights"]
     size = method.gbuf["position"].size
     noisy, out, scratch = be.texture(size), be.texture(size), be.texture(size)
     params = denoise.Params(iterations=denoise.iterations_for(max(size)))

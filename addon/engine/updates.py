@@ -12,7 +12,7 @@ import numpy as np
 UPDATE_STEP_M = 0.01  # how far update_costs moves the lights or the camera per update
 
 
-def update_costs(method, repeat: int) -> dict[str, float]:
+def update_costs(method, repeat: int, kinds: tuple[str, ...] = ("full", "lights", "camera")) -> dict[str, float]:
     """Median wall time in ms (GPU work finished, no read-back) of the three kinds of update a user
     makes, each right after its change, alternately moving by UPDATE_STEP_M and back:
     - full: a geometry change, everything: the upload and the setup passes (set_scene: voxelization,
@@ -21,7 +21,8 @@ def update_costs(method, repeat: int) -> dict[str, float]:
       (the G-buffer is still valid);
     - camera: the camera moved UPDATE_STEP_M along its right axis: the G-buffer and the gathers
       (the solve too where the method cannot keep its light field: `keeps_light_field`).
-    Per-pass waits are off, as in the viewport; the method is left as it was found."""
+    Only `kinds` of them are timed (a full update of a big scene takes seconds). Per-pass waits are off,
+    as in the viewport; the method is left as it was found."""
     be, source, profile = method.backend, method.source, method.profile
     lights, camera = list(source.lights), source.camera
     moved_lights = [replace(light, position_m=light.position_m + np.array([0.0, 0.0, UPDATE_STEP_M]))
@@ -38,15 +39,18 @@ def update_costs(method, repeat: int) -> dict[str, float]:
         return (time.perf_counter() - t0) * 1e3
 
     method.profile = False
-    samples = {"full": [], "lights": [], "camera": []}
+    samples = {kind: [] for kind in kinds}
     try:
         for i in range(repeat):
             away = i % 2 == 0
-            samples["full"].append(timed(lambda: (method.set_scene(method.source), method.compute())))
-            method.set_lights(moved_lights if away else lights)
-            samples["lights"].append(timed(lambda: method.compute(run_gbuffer=False)))
-            method.set_camera(moved_camera if away else camera)
-            samples["camera"].append(timed(method.compute))
+            if "full" in kinds:
+                samples["full"].append(timed(lambda: (method.set_scene(method.source), method.compute())))
+            if "lights" in kinds:
+                method.set_lights(moved_lights if away else lights)
+                samples["lights"].append(timed(lambda: method.compute(run_gbuffer=False)))
+            if "camera" in kinds:
+                method.set_camera(moved_camera if away else camera)
+                samples["camera"].append(timed(method.compute))
         method.set_lights(lights)
         method.set_camera(camera)
         method.compute()  # the products of the state the caller set

@@ -35,6 +35,20 @@ def test_denoise_cost_prints_the_filters_share_of_an_update(cornell):
     assert "32" in text and "ms" in text
 
 
+def test_footprint_cost_prints_the_texels_time_and_change_of_each_method(tmp_path):
+    # cornell-point's lamp hangs under the ceiling: its upward face is drawn at 64 of 256 texels, 5 of
+    # 6 faces at 256 (texel share (5 x 256^2 + 64^2) / (6 x 256^2) = 0.84375 exactly)
+    blend = tmp_path / "cornell-point.blend"
+    tool("-m", "addon", "scene", "cornell-point", "--out", str(blend))
+    out = tool("tools/footprint_cost.py", str(blend), "--res", "32", "--methods", "lpv", "--rounds", "1")
+    (row,) = [json.loads(line) for line in out.splitlines() if line.startswith("{")]
+    assert (row["scene"], row["method"], row["texels"], row["texels_every"]) == ("cornell-point", "lpv",
+                                                                              5 * 256**2 + 64**2, 6 * 256**2)
+    assert row["texel_share"] == pytest.approx(0.84375)
+    assert row["lights_update_ms"] > 0 and row["lights_update_ms_every"] > 0
+    assert 0 <= row["indirect_change"] < 0.01
+
+
 def test_bake_speedup_prints_a_row_per_object():
     out = tool("tools/bake_speedup.py", "--size", "16", "--ref-spp", "16", "--method", "lpv")
     rows = [line for line in out.splitlines() if line.startswith("| ") and not line.startswith("| ---")]
