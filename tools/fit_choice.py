@@ -3,6 +3,7 @@ scene on scenes it was not fitted on, and write the model and the report.
 
     .venv/bin/python tools/fit_choice.py RESULTS.json [MORE.json ...] [--cache out/bench] [--out benchmarks/choice]
         [--model addon/engine/data/choice_model.json] [--estimates benchmarks/choice/judged.json] [--sweep-verify]
+        [--pixel-scaling benchmarks/choice/pixel_scaling.json]
 
 Each scene's features come from its .blend in the bench cache (`<cache>/scenes/<scene>.blend`, what
 bench rendered), captured as `render` captures it. The judgement is leave-one-scene-out: for every
@@ -91,14 +92,15 @@ def margin_of(records: list[dict], features: dict, ridge: float) -> float:
     return float(np.quantile(ratios, MARGIN_QUANTILE)) if ratios else 1.0
 
 
-def held_out(records: list[dict], features: dict, ridge: float) -> dict[str, tuple[choice.Model, dict]]:
+def held_out(records: list[dict], features: dict, ridge: float,
+             per_pixel_share: dict[str, float]) -> dict[str, tuple[choice.Model, dict]]:
     """Per scene: the model fitted without it (its margin from the others alone) and the scene's measured
     rows by key. Shared by `judge` and `verified`: the margin is itself a leave-one-out, the costly part."""
     out = {}
     for held in sorted(features):
         train_feats = {s: f for s, f in features.items() if s != held}
         train = [r for r in records if r["scene"] != held]
-        model = choice.fit(train, train_feats, ridge)
+        model = choice.fit(train, train_feats, ridge, per_pixel_share)
         model.margin = margin_of(train, train_feats, ridge)
         out[held] = model, {choice.row_key(r["method"], r["setting"]): r for r in records if r["scene"] == held}
     return out
@@ -123,8 +125,9 @@ def judge(models: dict, features: dict) -> dict:
                 "fastest_ms": fastest["total_ms"] if fastest else None})
         for key, r in measured.items():
             if key in model.rows:
-                out["estimates"].append({"scene": held, "row": key, "measured": r["rel_rmse_8"],
-                                         "predicted": model.predict(key, features[held])[0]})
+                err, ms = model.predict(key, features[held])
+                out["estimates"].append({"scene": held, "row": key, "measured": r["rel_rmse_8"], "predicted": err,
+                                         "measured_ms": r["total_ms"], "predicted_ms": ms})
     return out
 
 
@@ -328,6 +331,8 @@ def summary(judged: dict) -> dict:
             s[budget].update({f"verified_{k}": v for k, v in verified_figures(checked, float(budget)).items()})
     ratios = [e["predicted"] / e["measured"] for e in judged["estimates"]]
     s["all_rows_estimate_within_1.5x"] = float(np.mean([1 / ESTIMATE_FACTOR <= x <= ESTIMATE_FACTOR for x in ratios]))
+    times = [e["predicted_ms"] / e["measured_ms"] for e in judged["estimates"]]
+    s["all_rows_time_within_2x"] = float(np.mean([0.5 <= x <= 2.0 for x in times]))
     for budget in map(str, BUDGETS):
         got = [1 / ESTIMATE_FACTOR <= e["estimate"] / e["measured"] <= ESTIMATE_FACTOR
                for e in judged.get("checked", []) if e["budget"] == budget]
@@ -380,8 +385,12 @@ def report(results_path: str, arguments: str, judged: dict, summ: dict, model: c
                      f"{s.get('verified_within_2x', '-')} | {s.get('verified_mean_tries', float('nan')):.1f} | "
                      f"{s.get('verified_median_cost', float('nan')):.1f} | "
                      f"{s.get('verified_estimate_within_1.5x', '-')} |")
+    shares = ", ".join(f"{m} {s:.2f}" for m, s in sorted(model.per_pixel_share.items()))
     lines += ["", f"Every measured row's predicted error within a factor 1.5: "
-              f"{summ['all_rows_estimate_within_1.5x']:.0%}.", ""]
+              f"{summ['all_rows_estimate_within_1.5x']:.0%}; its predicted time within a factor 2: "
+              f"{summ['all_rows_time_within_2x']:.0%}. Times are taken to other pixel counts by each method's "
+              f"share of its update that grows with the pixels at {choice.TIME_REFERENCE_PIXELS} pixels "
+              f"(tools/pixel_scaling.py): {shares}.", ""]
     if judged.get("checked"):
         def cell(b: str) -> str:
             t = summ[b]["check_time_s"]
@@ -431,6 +440,10 @@ def main(argv=None) -> int:
     p.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "choice")
     p.add_argument("--model", type=Path, default=choice.MODEL_PATH)
     p.add_argument("--ridge", type=float, default=1.0)
+    default_scaling = ROOT / "benchmarks" / "choice" / "pixel_scaling.json"
+    p.add_argument("--pixel-scaling", type=Path, default=default_scaling,
+                   help="tools/pixel_scaling.py's output: each method's per-pixel share of its update, which "
+                        "takes the rows' times to choice.TIME_REFERENCE_PIXELS")
     p.add_argument("--estimates", type=Path,
                    help="take the path-traced estimates from this judged.json, an earlier fit's on the same "
                         "results and --ridge, instead of the rows' images in the cache (a later bench into the "
@@ -448,7 +461,8 @@ def main(argv=None) -> int:
         raise SystemExit("the results differ in resolution, references or bounces: errors would not compare")
     records = pooled(runs)
     features = scene_features(args.cache, sorted({r["scene"] for r in records}), results["bounces"], results["res"])
-    models = held_out(records, features, args.ridge)
+    shares = json.loads(args.pixel_scaling.read_text())["per_pixel_share"]
+    models = held_out(records, features, args.ridge, shares)
     judged = judge(models, features)
     judged["checked"], judged["checks"] = (stored_estimates(args.estimates, records) if args.estimates else
                                            checked_estimates(models, args.cache, results["res"], results["bounces"]))
@@ -458,14 +472,15 @@ def main(argv=None) -> int:
     judged["verified"] = verified(models, features, judged["checked"])
     judged["estimate_bound"] = estimate_bound(models, judged["checked"])
     summ = summary(judged)
-    model = choice.fit(records, features, args.ridge)
+    model = choice.fit(records, features, args.ridge, shares)
     model.margin = margin_of(records, features, args.ridge)
     args.model.parent.mkdir(parents=True, exist_ok=True)
     args.model.write_text(json.dumps(model.to_json(), indent=1, sort_keys=True) + "\n")
     args.out.mkdir(parents=True, exist_ok=True)
     results_path = " ".join(map(str, args.results))
     arguments = results_path + ("" if args.cache == default_cache else f" --cache {args.cache}") + (
-        f" --estimates {args.estimates}" if args.estimates else "")
+        f" --estimates {args.estimates}" if args.estimates else "") + (
+        "" if args.pixel_scaling == default_scaling else f" --pixel-scaling {args.pixel_scaling}")
     (args.out / "REPORT.md").write_text(report(results_path, arguments, judged, summ, model, results))
     command = f".venv/bin/python tools/fit_choice.py {arguments}"
     (args.out / "judged.json").write_text(judged_json({"summary": summ, "command": command, **judged}))

@@ -8,11 +8,13 @@ The choice bench times every row at one resolution (128 px on the long side), so
 how a method's time grows with the image: a slope fitted on the few pixel counts the scenes' aspects
 give (16 384 down to 8 192) extrapolated to a viewport's million pixels by factors of 10^4. Here each
 method at its defaults runs the update the bench times (Method.run: G-buffer, light views, solve,
-gathers, read-back; the setup passes of set_scene are outside it) at the two resolutions of --res, the runs of every method and resolution timed in
-turn over --rounds rounds (so the machine's drift falls alike on all), and the update is split as
-t(P) = t_fixed + t_pixel * P: from the medians at P_low and P_high pixels, the per-pixel share at P_low
-is s = (t_high / t_low - 1) / (P_high / P_low - 1), clamped to [0, 1]. Per method the output keeps the
-mean of s over the scenes (`per_pixel_share`), which choice.fit reads.
+gathers, read-back; the setup passes of set_scene are outside it) at the two resolutions of --res, the
+runs of every method and resolution timed in turn over --rounds rounds (so the machine's drift falls
+alike on all), and the update is split as t(P) = t_fixed + t_pixel P through the medians at P_low and
+P_high pixels (each part at least 0: timing noise can make the line's slope or intercept negative). The
+per-pixel share is stated at choice.TIME_REFERENCE_PIXELS, P_ref: s = t_pixel P_ref / (t_fixed + t_pixel
+P_ref). Per method the output keeps the mean of s over the scenes (`per_pixel_share`), which
+tools/fit_choice.py gives choice.fit.
 """
 
 from __future__ import annotations
@@ -27,14 +29,19 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from addon.engine.choice import TIME_REFERENCE_PIXELS  # noqa: E402
+
 METHODS = "rsm,lpv,vct,probes,diffusion,gather"
 
 
-def per_pixel_share(ms_low: float, ms_high: float, pixels_low: int, pixels_high: int) -> float:
-    """The share of the update at pixels_low that grows with the pixels, from t(P) = t_fixed + t_pixel P
-    through the two medians; clamped to [0, 1] (timing noise can put the ratio outside 1..P_high/P_low)."""
-    share = (ms_high / ms_low - 1.0) / (pixels_high / pixels_low - 1.0)
-    return min(max(share, 0.0), 1.0)
+def per_pixel_share(ms_low: float, ms_high: float, pixels_low: int, pixels_high: int,
+                    reference_pixels: int = TIME_REFERENCE_PIXELS) -> float:
+    """The share of the update at `reference_pixels` that grows with the pixels, from t(P) = t_fixed +
+    t_pixel P through the two medians, each part clamped at 0."""
+    ms_per_pixel = max((ms_high - ms_low) / (pixels_high - pixels_low), 0.0)
+    fixed_ms = max(ms_low - ms_per_pixel * pixels_low, 0.0)
+    grows = ms_per_pixel * reference_pixels
+    return grows / (fixed_ms + grows) if grows > 0 else 0.0
 
 
 def measure(blend: Path, resolutions: tuple[int, int], names: list[str], rounds: int) -> list[dict]:

@@ -8,15 +8,18 @@ under a sun than under a spot, a gather of point VPLs is worse near glowing pane
 with a few numbers per scene (`FEATURES`, all computed from the engine's Scene, no Blender):
 
     log rel_rmse_8(row, scene) = a_row + b_method . x(scene)
-    log ms(row, scene)         = c_row + d_method . (log10 triangles, log10 pixels)
+    log ms(row, scene)         = c_row + d_method . (log10 triangles, log10 light faces)
+                                 + log((1 - s_method) + s_method P / TIME_REFERENCE_PIXELS)
 
 a_row, c_row: one intercept per row (how good and how fast the row is on the mean scene); b_method,
-d_method: slopes shared by a method's rows (how the method's error and time move with the scene),
-fitted by ridge least squares on standardised features, so a dozen scenes cannot make a slope
-explode. The model's own uncertainty is measured, not assumed: `margin` is a quantile of its
-leave-one-scene-out error ratios, and a row counts as meeting a budget E when its predicted error
-times the margin is at most E (tools/fit_choice.py fits, evaluates and writes the model;
-benchmarks/choice/REPORT.md its figures).
+d_method: slopes shared by a method's rows (how the method's error and time move with the scene), fitted
+by ridge least squares on standardised features, so a dozen scenes cannot make a slope explode. The last
+term scales a time to the image's P pixels: s_method, the share of the method's update that grows with
+the pixels at TIME_REFERENCE_PIXELS, is measured apart (tools/pixel_scaling.py), because the benchmark
+times every row at one resolution and so cannot tell it. The model's own uncertainty is measured, not
+assumed: `margin` is a quantile of its leave-one-scene-out error ratios, and a row counts as meeting a
+budget E when its predicted error times the margin is at most E (tools/fit_choice.py fits, evaluates and
+writes the model; benchmarks/choice/REPORT.md its figures).
 
 Blender-free (numpy only); the bridge captures the scene and calls `scene_features` and `choose`.
 """
@@ -44,9 +47,13 @@ MODEL_PATH = Path(__file__).resolve().parent / "data" / "choice_model.json"
 # light_shares); enclosure is the share of directions from points inside the bounds that meet geometry.
 FEATURES = ("enclosure", "sun_share", "world_share", "shaped_share", "glossy_share", "log_triangles",
             "aspect", "bounces")
-# Time goes with what every update rasterizes and gathers: triangles, pixels, and light faces (each an
-# RSM and, for most methods, a gather pass of its own).
-TIME_FEATURES = ("log_triangles", "log_pixels", "log_light_faces")
+# Time goes with what every update rasterizes and gathers: triangles and light faces (each an RSM and,
+# for most methods, a gather pass of its own); the pixels enter through the measured per-pixel shares
+# (pixel_factor). Fitted as a slope, log10 pixels spanned only the aspects of the bench's 128 px images
+# (3.91-4.21), and it extrapolated a lone 2:1 scene's times by 1000x and a 1920 x 1080 image's by 10^5.
+TIME_FEATURES = ("log_triangles", "log_light_faces")
+# The pixels at which the benchmark times its rows (a 128 px square) and the per-pixel shares are stated.
+TIME_REFERENCE_PIXELS = 128 * 128
 
 ENCLOSURE_DIRECTIONS = 64  # per point, a Fibonacci sphere
 # The largest triangles alone decide whether a direction is closed (walls, floors, roofs), and a ray
@@ -194,28 +201,41 @@ class Model:
     margin: float = 1.0                          # predicted error x margin <= budget counts as meeting it
     ridge: float = 1.0
     scenes: dict[str, dict] = field(default_factory=dict)  # the features of the scenes fitted on
+    per_pixel_share: dict[str, float] = field(default_factory=dict)  # method -> s (absent: 0)
 
     def _x(self, features: dict, names) -> np.ndarray:
         return np.array([(features[k] - self.mean[k]) / self.scale[k] for k in names])
+
+    def pixel_factor(self, method: str, features: dict) -> float:
+        """How much longer than at TIME_REFERENCE_PIXELS the method's update takes at the scene's pixels."""
+        return pixel_factor(self.per_pixel_share.get(method, 0.0), features["log_pixels"])
 
     def predict(self, key: str, features: dict) -> tuple[float, float]:
         """(rel_rmse_8, ms) the model expects of row `key` on a scene with these features."""
         row = self.rows[key]
         err = row["a"] + float(np.dot(self.slopes[row["method"]], self._x(features, FEATURES)))
         ms = row["c"] + float(np.dot(self.time_slopes[row["method"]], self._x(features, TIME_FEATURES)))
-        return math.exp(err), math.exp(ms)
+        return math.exp(err), math.exp(ms) * self.pixel_factor(row["method"], features)
 
     def to_json(self) -> dict:
         return {"rows": self.rows, "slopes": self.slopes, "time_slopes": self.time_slopes, "mean": self.mean,
                 "scale": self.scale, "margin": self.margin, "ridge": self.ridge, "scenes": self.scenes,
-                "features": list(FEATURES), "time_features": list(TIME_FEATURES)}
+                "per_pixel_share": self.per_pixel_share, "features": list(FEATURES),
+                "time_features": list(TIME_FEATURES)}
 
     @classmethod
     def from_json(cls, data: dict) -> Model:
         if data.get("features") != list(FEATURES) or data.get("time_features") != list(TIME_FEATURES):
             raise ConfigError("the choice model was fitted on other features: re-run tools/fit_choice.py")
         return cls(rows=data["rows"], slopes=data["slopes"], time_slopes=data["time_slopes"], mean=data["mean"],
-                   scale=data["scale"], margin=data["margin"], ridge=data["ridge"], scenes=data["scenes"])
+                   scale=data["scale"], margin=data["margin"], ridge=data["ridge"], scenes=data["scenes"],
+                   per_pixel_share=data["per_pixel_share"])
+
+
+def pixel_factor(per_pixel_share: float, log_pixels: float) -> float:
+    """t(P) / t(TIME_REFERENCE_PIXELS) for an update whose share `per_pixel_share` at the reference grows
+    with the pixels and the rest does not: (1 - s) + s P / P_ref, P = 10^log_pixels."""
+    return (1.0 - per_pixel_share) + per_pixel_share * 10.0 ** log_pixels / TIME_REFERENCE_PIXELS
 
 
 def load(path: Path = MODEL_PATH) -> Model:
@@ -224,9 +244,12 @@ def load(path: Path = MODEL_PATH) -> Model:
     return Model.from_json(json.loads(path.read_text()))
 
 
-def fit(records: list[dict], features: dict[str, dict], ridge: float = 1.0) -> Model:
+def fit(records: list[dict], features: dict[str, dict], ridge: float = 1.0,
+        per_pixel_share: dict[str, float] | None = None) -> Model:
     """Fit on benchmark records ({"scene", "method", "setting", "rel_rmse_8", "total_ms"}; rows without
-    an error are skipped) and the features of their scenes. Margin 1 (set by the evaluation)."""
+    an error are skipped) and the features of their scenes; each record's time is taken back to
+    TIME_REFERENCE_PIXELS by its method's `per_pixel_share` (absent: 0, a time that ignores the pixels).
+    Margin 1 (set by the evaluation)."""
     recs = [r for r in records if r.get("rel_rmse_8") and r["scene"] in features and r.get("total_ms")]
     if not recs:
         raise ConfigError("no benchmark records with errors to fit on")
@@ -237,7 +260,8 @@ def fit(records: list[dict], features: dict[str, dict], ridge: float = 1.0) -> M
     keys = sorted({row_key(r["method"], r["setting"]) for r in recs})
     methods = sorted({r["method"] for r in recs})
     model = Model(rows={}, slopes={}, time_slopes={}, mean=mean, scale=scale, ridge=ridge,
-                  scenes={s: features[s] for s in sorted({r["scene"] for r in recs})})
+                  scenes={s: features[s] for s in sorted({r["scene"] for r in recs})},
+                  per_pixel_share=dict(per_pixel_share or {}))
 
     def solve(names_used, target):
         nk, nf = len(keys), len(names_used)
@@ -252,7 +276,8 @@ def fit(records: list[dict], features: dict[str, dict], ridge: float = 1.0) -> M
         return w[:nk], {m: w[nk + i * nf: nk + (i + 1) * nf].tolist() for i, m in enumerate(methods)}
 
     a, model.slopes = solve(FEATURES, lambda r: r["rel_rmse_8"])
-    c, model.time_slopes = solve(TIME_FEATURES, lambda r: r["total_ms"])
+    c, model.time_slopes = solve(TIME_FEATURES, lambda r: r["total_ms"] / model.pixel_factor(r["method"],
+                                                                                        features[r["scene"]]))
     for i, key in enumerate(keys):
         r = next(r for r in recs if row_key(r["method"], r["setting"]) == key)
         model.rows[key] = {"method": r["method"], "setting": r["setting"], "a": float(a[i]), "c": float(c[i])}

@@ -101,6 +101,7 @@ def synthetic(rows, scenes, a, b, c):
 def features(rng):
     f = {k: float(rng.uniform(0, 1)) for k in choice.FEATURES}
     f.update({k: float(rng.uniform(1, 3)) for k in choice.TIME_FEATURES})
+    f["log_pixels"] = math.log10(choice.TIME_REFERENCE_PIXELS)
     return f
 
 
@@ -119,6 +120,40 @@ def test_fit_recovers_a_noiseless_model():
         err, ms = model.predict(choice.row_key(r["method"], r["setting"]), scenes[r["scene"]])
         assert err == pytest.approx(r["rel_rmse_8"], rel=1e-6)
         assert ms == pytest.approx(r["total_ms"], rel=1e-6)
+
+
+def test_pixel_factor_splits_an_update_into_a_fixed_and_a_per_pixel_part():
+    # A quarter of the update at the reference pixels grows with them: at 4x the pixels it takes
+    # 0.75 + 0.25 x 4 = 1.75x as long, at a quarter 0.75 + 0.0625 = 0.8125x; shares 0 and 1 bound it.
+    ref = math.log10(choice.TIME_REFERENCE_PIXELS)
+    assert choice.pixel_factor(0.25, ref) == pytest.approx(1.0)
+    assert choice.pixel_factor(0.25, ref + math.log10(4)) == pytest.approx(1.75)
+    assert choice.pixel_factor(0.25, ref - math.log10(4)) == pytest.approx(0.8125)
+    assert choice.pixel_factor(0.0, ref + 2) == pytest.approx(1.0)
+    assert choice.pixel_factor(1.0, ref + 2) == pytest.approx(100.0)
+
+
+def test_fit_takes_times_to_the_reference_pixels_and_predicts_at_the_scenes():
+    # Records timed at each scene's own pixels (1/2 to 2x the reference) by t = exp(c_row) x
+    # pixel_factor(s_method): fitted with those shares, every time is reproduced to 1e-6 and the model
+    # carries the time of a 1920 x 1080 image as the split says (no slope on the pixels is fitted).
+    rng = np.random.default_rng(4)
+    scenes = {f"s{i}": features(rng) for i in range(8)}
+    for i, f in enumerate(scenes.values()):
+        f["log_pixels"] = math.log10(choice.TIME_REFERENCE_PIXELS) + math.log10(2) * (i / 3.5 - 1)
+    shares = {"m": 0.2, "n": 0.9}
+    rows = {"m x=1": ("m", {"g.x": 1}), "n y=2": ("n", {"h.y": 2})}
+    c = {"m x=1": math.log(50.0), "n y=2": math.log(400.0)}
+    recs = synthetic(rows, scenes, {k: -1.0 for k in rows}, np.zeros(len(choice.FEATURES)), c)
+    for r in recs:
+        r["total_ms"] *= choice.pixel_factor(shares[r["method"]], scenes[r["scene"]]["log_pixels"])
+    model = choice.fit(recs, scenes, ridge=1e-9, per_pixel_share=shares)
+    for r in recs:
+        assert model.predict(choice.row_key(r["method"], r["setting"]), scenes[r["scene"]])[1] == \
+            pytest.approx(r["total_ms"], rel=1e-6)
+    hd = {**scenes["s0"], "log_pixels": math.log10(1920 * 1080)}
+    ratio = 1920 * 1080 / choice.TIME_REFERENCE_PIXELS
+    assert model.predict("n y=2", hd)[1] == pytest.approx(400.0 * (0.1 + 0.9 * ratio), rel=1e-6)
 
 
 def three_rows(seed: int):
@@ -265,8 +300,9 @@ def test_model_round_trips_through_json():
     rows = {"m x=1": ("m", {"g.x": 1}), "n y=2": ("n", {"h.y": 2})}
     recs = synthetic(rows, scenes, {"m x=1": -1.0, "n y=2": -2.0}, np.ones(len(choice.FEATURES)) * 0.1,
                      {"m x=1": 1.0, "n y=2": 2.0})
-    model = choice.fit(recs, scenes)
+    model = choice.fit(recs, scenes, per_pixel_share={"m": 0.3})
     again = choice.Model.from_json(model.to_json())
+    assert again.per_pixel_share == {"m": 0.3}
     for k in model.rows:
         assert again.predict(k, scenes["s1"]) == model.predict(k, scenes["s1"])
 
