@@ -49,6 +49,18 @@ def test_footprint_cost_prints_the_texels_time_and_change_of_each_method(tmp_pat
     assert 0 <= row["indirect_change"] < 0.01
 
 
+def test_pixel_scaling_splits_each_update_into_its_fixed_and_per_pixel_parts(cornell, tmp_path):
+    out = tmp_path / "scaling.json"
+    tool("tools/pixel_scaling.py", str(cornell), "--res", "16,32", "--methods", "rsm,lpv", "--rounds", "1",
+         "--out", str(out))
+    written = json.loads(out.read_text())
+    assert [(r["scene"], r["method"], r["pixels"]) for r in written["rows"]] == [
+        ("cornell", "rsm", [16 * 16, 32 * 32]), ("cornell", "lpv", [16 * 16, 32 * 32])]
+    assert all(ms > 0 for r in written["rows"] for ms in r["update_ms"])
+    assert set(written["per_pixel_share"]) == {"rsm", "lpv"}
+    assert all(0 <= s <= 1 for s in written["per_pixel_share"].values())
+
+
 def test_bake_speedup_prints_a_row_per_object():
     out = tool("tools/bake_speedup.py", "--size", "16", "--ref-spp", "16", "--method", "lpv")
     rows = [line for line in out.splitlines() if line.startswith("| ") and not line.startswith("| ---")]

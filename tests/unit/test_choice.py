@@ -156,6 +156,27 @@ def test_fit_takes_times_to_the_reference_pixels_and_predicts_at_the_scenes():
     assert model.predict("n y=2", hd)[1] == pytest.approx(400.0 * (0.1 + 0.9 * ratio), rel=1e-6)
 
 
+def test_each_row_time_may_grow_with_the_scene_its_own_way():
+    # One method, two rows: one's time grows as triangles^1 (an RSM draw), the other's not at all (a
+    # march over a fixed grid). Each row's own slopes, held by a negligible row ridge, reproduce every
+    # time to 1e-6; held to the method's shared slope by a huge one, the fit must split the difference
+    # and misses the times by far more than 10 % on the scenes at the ends of the triangle range.
+    rng = np.random.default_rng(6)
+    scenes = {f"s{i}": features(rng) for i in range(10)}
+    rows = {"m x=1": ("m", {"g.x": 1}), "m x=2": ("m", {"g.x": 2})}
+    recs = synthetic(rows, scenes, {k: -1.0 for k in rows}, np.zeros(len(choice.FEATURES)), {k: 5.0 for k in rows})
+    for r in recs:
+        if r["setting"]["g.x"] == 1:
+            r["total_ms"] *= 10.0 ** scenes[r["scene"]]["log_triangles"]
+
+    def worst(model):
+        return max(abs(model.predict(choice.row_key(r["method"], r["setting"]), scenes[r["scene"]])[1]
+                       / r["total_ms"] - 1) for r in recs)
+
+    assert worst(choice.fit(recs, scenes, ridge=1e-9, time_row_ridge=1e-9)) < 1e-6
+    assert worst(choice.fit(recs, scenes, ridge=1e-9, time_row_ridge=1e9)) > 0.1
+
+
 def three_rows(seed: int):
     """(model, one scene's features): rows "m x=1..3" with errors 0.3, 0.15, 0.05 and times 10, 100,
     1000 ms on every one of 6 random scenes, fitted with a negligible ridge (margin 1)."""
