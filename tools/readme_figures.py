@@ -423,17 +423,19 @@ def gpu_block(*runs: dict) -> str:
 
 
 def choice_block(judged: dict) -> str:
-    """Table: per error budget, what `render --method auto --error-budget E` (the model alone) and with
-    `--verify` (candidates judged by the path-traced check) met on held-out scenes, from fit_choice's
-    judged.json (its summary)."""
+    """Table: per error budget, what `render --method auto --error-budget E` (verified: candidates judged
+    by the path-traced check, the default) and with `--no-verify` (the model alone) met on held-out
+    scenes, from fit_choice's judged.json (its summary)."""
     s = judged["summary"]
     budgets = [b for b in s if b.replace(".", "", 1).isdigit()]
     lines = ["**Choosing for an error budget, and saying how far from a path tracer**: each of the "
              f"{s[budgets[0]]['scenes']} benchmark scenes judged by a model fitted without it "
              "(`benchmarks/choice/REPORT.md`, from `" + judged["command"] + "`). `render --method auto "
-             "--error-budget E --verify` renders candidate settings fastest first and judges each against two "
-             "few-sample Cycles renders of the scene, their own noise subtracted (`--self-check` reports the "
-             "same estimate for any render, `bake --self-check` for each lightmap).", "",
+             "--error-budget E` renders candidate settings fastest first and judges each against two "
+             "few-sample Cycles renders of the scene, their own noise subtracted (`bake` judges lightmaps "
+             "likewise on the largest objects; `--no-verify` takes the model's choice unchecked; "
+             "`--self-check` reports the same estimate for any render, `bake --self-check` for each "
+             "lightmap).", "",
              "| E | scenes where some setting meets E | met, the model alone | met, verified | verified within 2x "
              "of the fastest setting meeting E | its estimate within 1.5x of the error | settings tried | "
              "the Cycles check (128 px) |",

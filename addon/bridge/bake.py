@@ -24,7 +24,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-from ..engine import choice, methods
+from ..engine import choice, methods, registry
 from ..engine.config import settings as complete_settings
 from ..engine.errors import ConfigError, SceneError
 from ..engine.lightmap import (
@@ -189,11 +189,16 @@ def bake_check_render(obj_name: str, pass_name: str, size: int, bounces: int):
     return render
 
 
+def cycles_bakes(obj) -> bool:
+    """Whether Cycles bakes the object: every material slot holds a node material."""
+    return bool(obj.material_slots) and all(slot.material and slot.material.use_nodes for slot in obj.material_slots)
+
+
 def self_check(obj, values: np.ndarray, pass_name: str, size: int, bounces: int) -> dict:
     """bake --self-check of one lightmap (`values`, RGBA, alpha = coverage): its rel_rmse_8 against Cycles'
     converged bake, estimated by choice's path-traced check of the object, as precise as the error its
     pilot finds asks; a note where it cannot be made."""
-    if not obj.material_slots or not all(slot.material and slot.material.use_nodes for slot in obj.material_slots):
+    if not cycles_bakes(obj):
         return {"note": "no self-check: Cycles bakes only objects whose every material slot has a node material"}
     check = choice.path_traced_check(None, bake_check_render(obj.name, pass_name, size, bounces), ours=values)
     estimate = choice.path_traced_estimate(values, check) if check is not None else None
@@ -215,17 +220,22 @@ class Baker:
         (engine/choice.py); `settings` and `decided` say what was run and why."""
         t0 = time.perf_counter()
         define_light_switch()
+        self.backend = backend
         self.depsgraph = depsgraph
         scene = SceneCache().update(depsgraph, size, size)
         if scene.camera is None:
             scene.camera = _default_camera(size)  # only the G-buffer size is taken from it
         self.scene = scene
-        self.settings, self.decided = choice.decide(scene, complete_settings(**settings), size * size,
-                                                    **(budget or {}))
-        self.method = methods.create(backend, self.settings)
-        self.method.set_scene(scene)
-        self.texels = TexelBaker(self.method)
+        settings, self.decided = choice.decide(scene, complete_settings(**settings), size * size, **(budget or {}))
+        self.use(settings)
         self.setup_ms = (time.perf_counter() - t0) * 1e3
+
+    def use(self, settings: dict) -> None:
+        """Bake with `settings` from now on: their method made on the captured scene."""
+        self.settings = settings
+        self.method = methods.create(self.backend, settings)
+        self.method.set_scene(self.scene)
+        self.texels = TexelBaker(self.method)
 
     def bake_image(self, obj, size: int, pass_name: str, margin: int = 16,
                    supersample: int = 1) -> tuple[np.ndarray, list[str]]:
@@ -258,6 +268,68 @@ class Baker:
         out = values[c["corner_sample"]].astype(np.float32)
         out[:, 3] = 1.0
         return out, notes
+
+
+# bake --verify judges its candidates on the VERIFY_OBJECTS largest objects baked (by surface: where most
+# of the lightmaps' texels lie), each lightmap at most VERIFY_MAX_TEXELS a side: every object judged costs
+# a Cycles check pair of its own, and the check's samples per texel do not fall as the texels grow (the
+# model was fitted on 128 px images, 16 384 pixels; a 128 x 128 lightmap holds as many texels).
+VERIFY_OBJECTS = 3
+VERIFY_MAX_TEXELS = 128
+
+
+def judged_objects(names: list[str], depsgraph) -> list:
+    """The objects bake --verify judges: of `names`, the meshes with a bake UV map that Cycles bakes
+    (cycles_bakes), the VERIFY_OBJECTS largest by world surface area."""
+    found = []
+    for name in names:
+        obj = bpy.data.objects.get(name)
+        if obj is None or obj.type != "MESH" or bake_uv_layer(obj.data) is None or not cycles_bakes(obj):
+            continue
+        pos = object_triangles(obj, depsgraph)["positions"]
+        area_m2 = 0.5 * float(np.linalg.norm(np.cross(pos[:, 1] - pos[:, 0], pos[:, 2] - pos[:, 0]), axis=1).sum())
+        found.append((area_m2, name, obj))
+    return [obj for _, _, obj in sorted(found, key=lambda f: (-f[0], f[1]))[:VERIFY_OBJECTS]]
+
+
+def verify_bake(baker: Baker, requested: dict, names: list[str], error_budget: float, size: int, say) -> None:
+    """bake --verify: choice.verify's candidates baked on the judged objects (judged_objects) at
+    min(size, VERIFY_MAX_TEXELS) texels, each lightmap judged by its object's path-traced check of the
+    indirect light (resolving `error_budget`). A row's estimate is the largest of its lightmaps': the
+    budget holds for every lightmap judged. The baker is left on the row taken (choice.take_verified:
+    the first within the budget, else the least estimated), its `decided` listing the rows tried and the
+    checks."""
+    model = choice.load()
+    feats = baker.decided["features"]
+    texels = min(size, VERIFY_MAX_TEXELS)
+    bounces = requested["gi"].bounces
+    checks = {}
+    for obj in judged_objects(names, baker.depsgraph):
+        say(f"bake verify: the path-traced check of {obj.name}")
+        check = choice.path_traced_check(error_budget, bake_check_render(obj.name, "indirect", texels, bounces), say)
+        if check is not None:
+            checks[obj.name] = (obj, check)
+    if not checks:
+        baker.decided["choice"]["verified"] = {
+            "tried": [], "accepted": None,
+            "note": "not verified: no object baked has a UV map, node materials and light in Cycles' bake"}
+        return
+
+    def estimate(key: str) -> float | None:
+        say(f"bake verify: baking {key}")
+        row = model.rows[key]
+        baker.use(choice.apply_row(requested, row["method"], row["setting"]))
+        found = [choice.path_traced_estimate(baker.bake_image(obj, texels, "indirect")[0], check)
+                 for obj, check in checks.values()]
+        found = [f for f in found if f is not None]
+        return max(found) if found else None
+
+    chosen = baker.settings
+    accepted, tried = choice.verify(model, feats, error_budget, estimate, registry.computing(bounces))
+    settings, baker.decided = choice.take_verified(
+        model, feats, requested, chosen, baker.decided, error_budget, accepted, tried,
+        {"texels": texels, "objects": {name: choice.check_stats(check) for name, (_, check) in checks.items()}})
+    baker.use(settings)
 
 
 # ------------------------------------------------------------------------------------- Blender outputs
@@ -357,14 +429,17 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
               settings: dict | None = None, pass_name: str = "indirect",
               target: str = "image", overwrite: bool = False, shard_index: int = 0, shard_count: int = 1,
               save_blend: Path | None = None, margin: int = 16, progress: bool = True, backend=None,
-              budget: dict | None = None, supersample: int = 1, self_check: bool = False) -> dict:
+              budget: dict | None = None, supersample: int = 1, self_check: bool = False,
+              verify: bool | None = None) -> dict:
     """Bake the objects of `blend` (see module docstring) into out_dir; returns the summary written to
     out_dir/bake.json. Per-object problems are recorded, never raised; bad arguments raise BounceError.
     size: the lightmap side (IMAGE_SIZE_TEXELS when None). settings: {group: config} (config.settings'
     form; defaults for missing groups). budget: the method chosen for the scene (Baker). supersample:
     sub-texels per texel side of --target image (Baker.bake_image). self_check (--target image): each
     lightmap's error against Cycles' converged bake estimated by the path-traced check (`self_check`),
-    in its object's entry. A bake that yields no light is recorded under "warnings" and told on stderr."""
+    in its object's entry. verify (an error budget, --target image; None: on exactly there): the choice
+    checked on the objects before they are baked (verify_bake; bake.json choice.verified). A bake that
+    yields no light is recorded under "warnings" and told on stderr."""
     from .pipeline import backend as default_backend
     from .pipeline import open_blend
 
@@ -374,6 +449,11 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
         raise ConfigError(f"--target {target} is one per scene, not per object: use bake_volume / bake_probes")
     if self_check and target != "image":
         raise ConfigError("--self-check judges lightmap images (--target image): Cycles bakes no vertex colours")
+    error_budget = (budget or {}).get("error_budget")
+    if verify and (error_budget is None or target != "image"):
+        raise ConfigError("--verify checks the choice for an error budget on lightmap images: give --method auto "
+                          "--error-budget E with --target image")
+    verify = error_budget is not None and target == "image" if verify is None else verify
     size = IMAGE_SIZE_TEXELS if size is None else size
     if not 8 <= size <= 8192:
         raise ConfigError(f"--size must be in 8..8192, got {size}")
@@ -393,6 +473,11 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
     be = backend or default_backend()
     say(f"bake: capturing the scene, method {gi.method} setup")
     baker = Baker(be, bpy.context.evaluated_depsgraph_get(), settings, size, budget)
+    verify_ms = 0.0
+    if verify:
+        t_verify = time.perf_counter()
+        verify_bake(baker, settings, names, error_budget, size, say)
+        verify_ms = (time.perf_counter() - t_verify) * 1e3
     settings, gi = baker.settings, baker.settings["gi"]
     results = _bake_objects(baker, names, out_dir, size, pass_name, target, overwrite, margin, progress,
                             supersample, self_check)
@@ -407,7 +492,8 @@ def bake_file(blend: Path, out_dir: Path, objects: list[str] | None = None, size
         "blend": str(blend), "method": gi.method, "pass": pass_name, "target": target, "size": size,
         "supersample": supersample,
         "config": {group: config.to_dict() for group, config in settings.items()}, "renderer": be.renderer,
-        "setup_ms": round(baker.setup_ms, 2), "total_ms": round((time.perf_counter() - t0) * 1e3, 2),
+        "setup_ms": round(baker.setup_ms, 2), "verify_ms": round(verify_ms, 2),
+        "total_ms": round((time.perf_counter() - t0) * 1e3, 2),
         "shard": [shard_index, shard_count], "saved_blend": saved, "solves": baker.method.solves,
         **{k: v for k, v in baker.decided.items() if k != "features"},
         "scene_warnings": list(baker.scene.warnings), "warnings": warnings,

@@ -140,27 +140,11 @@ def verify_choice(be, captured, requested: dict, settings: dict, decided: dict, 
         return choice.path_traced_estimate(render_row(be, captured, requested, model, key), check)
 
     accepted, tried = choice.verify(model, feats, error_budget, estimate, able)
-    # None within the budget: the row tried with the least estimate runs (choice.least_estimated).
-    key = accepted if accepted is not None else choice.least_estimated(tried)
-    decided["choice"]["verified"] = {"tried": tried, "accepted": accepted, "resolution": res,
-                                     **choice.check_stats(check)}
-    if key is None:
-        return settings, decided
-    found = next(t["estimated_rel_rmse_8"] for t in tried if t["row"] == key)
-    # The run-time estimate, not the model's: it is the better judge on held-out scenes (REPORT.md).
-    decided.update(estimated_rel_rmse_8=found, estimate_row=key, estimate_source="path-traced check",
-                   **({"estimate_resolution": res} if res < gi.resolution else {}))
-    if accepted is not None and key == decided["choice"]["row"]:
-        return settings, decided
-    row = model.rows[key]
-    predicted, predicted_ms = model.predict(key, feats)
-    why = (f"fastest of the settings tried whose path-traced check is within rel_rmse_8 {error_budget:g}: "
-           f"{found:.3f}" if accepted is not None else
-           f"no setting tried came within rel_rmse_8 {error_budget:g} by the path-traced check; this one came "
-           f"nearest: {found:.3f}")
-    decided["choice"].update(method=row["method"], setting=row["setting"], row=key, predicted_rel_rmse_8=predicted,
-                             predicted_ms=predicted_ms, meets_budget=accepted is not None, why=why)
-    return choice.apply_row({**requested, "gi": gi}, row["method"], row["setting"]), decided
+    settings, decided = choice.take_verified(model, feats, {**requested, "gi": gi}, settings, decided, error_budget,
+                                             accepted, tried, {"resolution": res, **choice.check_stats(check)})
+    if res < gi.resolution and decided.get("estimate_source") == "path-traced check":
+        decided["estimate_resolution"] = res
+    return settings, decided
 
 
 def render_file(blend: Path, out_dir: Path, settings: dict, repeat: int = 3,

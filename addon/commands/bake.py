@@ -7,6 +7,7 @@ is checked before a file is opened or written."""
 
 from __future__ import annotations
 
+import argparse
 import json
 import sys
 from pathlib import Path
@@ -53,6 +54,11 @@ def add_arguments(p) -> None:
                    help="also estimate each lightmap's rel_rmse_8 against Cycles' bake of the object: two Cycles "
                         "bakes of a few samples, their own noise subtracted (bake.json objects.*.self_check; "
                         "--target image)")
+    p.add_argument("--verify", action=argparse.BooleanOptionalAction, default=None,
+                   help="with --method auto --error-budget E and --target image (on by default there): bake the "
+                        "candidate settings (fastest first) on the largest objects, judge each lightmap by the "
+                        "--self-check's path-traced check, and take the first whose every lightmap is within E "
+                        "(bake.json choice.verified); --no-verify: the model's choice, unchecked")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     add_config_flags(p)
     add_budget_flags(p)
@@ -77,6 +83,8 @@ def _check_target(args) -> None:
                               f"(got --method {args.method})")
         if args.size is not None:
             raise ConfigError(f"--size has no meaning with --target {args.target} (one {what} per scene)")
+        if args.verify:
+            raise ConfigError(f"--verify judges lightmap images (--target image), not {what}")
     elif args.target == "vertex-colors" and not args.save_blend:
         raise ConfigError("--target vertex-colors writes colour attributes into a copy of the .blend: "
                           "give --save-blend OUT.blend (the input file is never modified)")
@@ -133,7 +141,7 @@ def run(args) -> int:
         summary = bake_file(blend, file_out, objects, args.size, settings, args.pass_name, args.target,
                             args.overwrite, index, count, Path(args.save_blend) if args.save_blend else None,
                             args.margin, progress=not args.quiet, budget=chosen_for, supersample=args.supersample,
-                            self_check=args.self_check)
+                            self_check=args.self_check, verify=args.verify)
         files[str(blend)] = str(file_out / "bake.json")
         failed += [f"{blend.name}:{n}" for n, r in summary["objects"].items() if r["status"] == "error"]
     if len(blends) > 1:

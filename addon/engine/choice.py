@@ -441,6 +441,34 @@ def verify(model: Model, features: dict, error_budget: float, estimate,
     return None, tried
 
 
+def take_verified(model: Model, features: dict, requested: dict, settings: dict, decided: dict,
+                  error_budget: float, accepted: str | None, tried: list[dict],
+                  extra: dict | None = None) -> tuple[dict, dict]:
+    """What runs after `verify` (camera or bake): the row accepted, else the one tried whose estimate is
+    least (least_estimated), else the model's choice (`settings`, nothing could be tried). Returns the
+    settings to run (`requested`, the user's, with that row's setting) and `decided` (decide's) with
+    choice["verified"] = the rows tried, the one accepted and `extra` (the check's figures), and the
+    estimate the row's path-traced one."""
+    decided["choice"]["verified"] = {"tried": tried, "accepted": accepted, **(extra or {})}
+    key = accepted if accepted is not None else least_estimated(tried)
+    if key is None:
+        return settings, decided
+    found = next(t["estimated_rel_rmse_8"] for t in tried if t["row"] == key)
+    # The run-time estimate, not the model's: it is the better judge on held-out scenes (REPORT.md).
+    decided.update(estimated_rel_rmse_8=found, estimate_row=key, estimate_source="path-traced check")
+    if accepted is not None and key == decided["choice"]["row"]:
+        return settings, decided
+    row = model.rows[key]
+    predicted, predicted_ms = model.predict(key, features)
+    why = (f"fastest of the settings tried whose path-traced check is within rel_rmse_8 {error_budget:g}: "
+           f"{found:.3f}" if accepted is not None else
+           f"no setting tried came within rel_rmse_8 {error_budget:g} by the path-traced check; this one came "
+           f"nearest: {found:.3f}")
+    decided["choice"].update(method=row["method"], setting=row["setting"], row=key, predicted_rel_rmse_8=predicted,
+                             predicted_ms=predicted_ms, meets_budget=accepted is not None, why=why)
+    return apply_row(requested, row["method"], row["setting"]), decided
+
+
 def least_estimated(tried: list[dict]) -> str | None:
     """Of the rows `verify` tried (none within the budget), the one whose run-time estimate is least:
     what runs then, rather than the model's unchecked choice: the estimate is the better judge of the two

@@ -20,13 +20,14 @@ def cornell_blend(tmp_path_factory):
 
 
 def test_render_auto_runs_the_chosen_setting_and_says_why(cornell_blend, tmp_path):
-    # The choice is the model's for this scene: the stats name it, its method ran, and the estimate
-    # is the model's prediction for that row (the fastest row expected within the budget).
+    # --no-verify: the choice is the model's for this scene: the stats name it, its method ran, and the
+    # estimate is the model's prediction for that row (the fastest row expected within the budget).
     out = tmp_path / "auto"
     assert main(["render", str(cornell_blend), "--out", str(out), "--method", "auto", "--error-budget", "0.3",
-                 "--res", "32", "--repeat", "1", "--quiet"]) == 0
+                 "--no-verify", "--res", "32", "--repeat", "1", "--quiet"]) == 0
     stats = json.loads((out / "stats.json").read_text())
     c = stats["choice"]
+    assert "verified" not in c
     assert stats["method"] == c["method"] and c["meets_budget"]
     assert c["predicted_rel_rmse_8"] * choice.load().margin <= 0.3
     assert stats["estimated_rel_rmse_8"] == pytest.approx(c["predicted_rel_rmse_8"])
@@ -63,12 +64,13 @@ def test_budget_flags_refused_alone_or_out_of_range(cornell_blend, tmp_path, cap
 
 
 def test_render_verify_runs_a_row_whose_estimate_is_within_the_budget(cornell_blend, tmp_path):
-    # --verify: the rows tried are listed with their path-traced estimates; the one accepted is the first
-    # within the budget and is what ran, with that estimate. On the Cornell box most rows are within
-    # 0.3 (benchmarks/choice/REPORT.md), so one is accepted. The check's samples and noise are recorded.
+    # An error budget is verified by default: the rows tried are listed with their path-traced estimates;
+    # the one accepted is the first within the budget and is what ran, with that estimate. On the Cornell
+    # box most rows are within 0.3 (benchmarks/choice/REPORT.md), so one is accepted. The check's samples
+    # and noise are recorded.
     out = tmp_path / "verify"
     assert main(["render", str(cornell_blend), "--out", str(out), "--method", "auto", "--error-budget", "0.3",
-                 "--verify", "--res", "32", "--repeat", "1", "--quiet"]) == 0
+                 "--res", "32", "--repeat", "1", "--quiet"]) == 0
     stats = json.loads((out / "stats.json").read_text())
     c = stats["choice"]
     tried, accepted = c["verified"]["tried"], c["verified"]["accepted"]
@@ -130,6 +132,43 @@ def test_bake_auto_records_the_choice(cornell_blend, tmp_path):
     summary = json.loads((out / "bake.json").read_text())
     assert summary["method"] == summary["choice"]["method"] and summary["choice"]["meets_budget"]
     assert summary["objects"]["Floor"]["status"] == "ok"
+
+
+def test_bake_auto_verifies_an_error_budget_on_the_largest_objects(cornell_blend, tmp_path, monkeypatch):
+    # An error budget is verified by default on lightmaps too: each candidate is baked on the judged
+    # objects, the largest of those asked (here 2 of 3: the 2 x 2 m floor and back wall before the short
+    # box), and judged by their path-traced checks; the row taken is the first whose every lightmap is
+    # within the budget, and it is what baked every object.
+    from addon.bridge import bake
+
+    monkeypatch.setattr(bake, "VERIFY_OBJECTS", 2)
+    out = tmp_path / "verify"
+    assert main(["bake", str(cornell_blend), "--out", str(out), "--objects", "ShortBox,Floor,BackWall",
+                 "--size", "16", "--method", "auto", "--error-budget", "0.3", "--quiet"]) == 0
+    summary = json.loads((out / "bake.json").read_text())
+    c = summary["choice"]
+    verified = c["verified"]
+    assert sorted(verified["objects"]) == ["BackWall", "Floor"] and verified["texels"] == 16
+    assert verified["accepted"] == c["row"] == verified["tried"][-1]["row"]
+    assert verified["tried"][-1]["estimated_rel_rmse_8"] <= 0.3
+    assert all(t["estimated_rel_rmse_8"] > 0.3 for t in verified["tried"][:-1])
+    assert summary["method"] == c["method"] and summary["estimate_source"] == "path-traced check"
+    for key, value in c["setting"].items():
+        group, name = key.split(".")
+        assert summary["config"][group][name] == value
+    assert all(r["status"] == "ok" for r in summary["objects"].values()) and summary["verify_ms"] > 0
+
+
+def test_bake_no_verify_keeps_the_models_choice_and_verify_needs_an_error_budget(cornell_blend, tmp_path, capsys):
+    out = tmp_path / "unchecked"
+    assert main(["bake", str(cornell_blend), "--out", str(out), "--objects", "Floor", "--size", "16",
+                 "--method", "auto", "--error-budget", "0.3", "--no-verify", "--quiet"]) == 0
+    summary = json.loads((out / "bake.json").read_text())
+    assert "verified" not in summary["choice"] and summary["estimate_source"] == "model"
+    bad = tmp_path / "bad"
+    assert main(["bake", str(cornell_blend), "--out", str(bad), "--objects", "Floor", "--size", "16",
+                 "--method", "auto", "--time-budget", "100", "--verify", "--quiet"]) == 2
+    assert "--verify" in capsys.readouterr().err and not (bad / "bake.json").exists()
 
 
 def test_choose_operator_sets_the_scene_and_notes_the_estimate(bounce, fresh_blend):

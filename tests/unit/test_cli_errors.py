@@ -61,6 +61,7 @@ def test_bad_setting_names_the_flag(capsys, tmp_path, blend, command, flags, lin
     (["--target", "volume", "--size", "64"], ["--size", "--target volume"]),
     (["--target", "probes", "--method", "vct"], ["--target probes", "--method probes", "vct"]),
     (["--target", "probes", "--size", "64"], ["--size", "--target probes"]),
+    (["--target", "volume", "--verify"], ["--verify", "--target image"]),
     (["--method", "direct"], ["--pass indirect", "--method direct"]),
     (["--method", "direct", "--pass", "combined"], ["--pass combined", "--method direct"]),
     (["--size", "4"], ["--size 4: out of range"]),
