@@ -296,9 +296,19 @@ vec3 face_light(vec3 p, vec3 n) {
     // lies behind it. Its whole length projects to one point of the map, in the face its start lies in.
     p_test = p + n * ((EXACT_LIFT_TEXELS + shadow_bias_texels) * texel_m);
 #endif
-    if (face_index >= 0 && cube_face(p_test - light_pos_ws) != face_index) {
-        return vec3(0.0);  // another face of this point light shades this pixel: the one p_test projects into
+    // Another face of this point light shades this pixel: the one its lifted point projects into. The
+    // faces of one light may differ in texels (light_views.view_texels), and so in lift: each face
+    // asking where its own lift lands would leave a pixel on the edge between a fine and a coarse face to
+    // neither or to both (a band 2-5 % dark across cornell-large-area's walls). So every face asks where
+    // the lift of a full-resolution face lands (face_lift_share: its texels / the light's most); its
+    // shadow test below keeps its own lift, clamped into its map. (A sun has one view, no faces.)
+#ifndef SOFT_SUN
+    // (at share 1, p_test itself: p + (p_test - p) need not round back to it)
+    vec3 p_face = face_lift_share == 1.0 ? p_test : p + (p_test - p) * face_lift_share;
+    if (face_index >= 0 && cube_face(p_face - light_pos_ws) != face_index) {
+        return vec3(0.0);
     }
+#endif
 #ifdef POLYGONS
     // A light with its shape (an area light's patch, an emissive mesh's triangles; never a sun): the
     // exact unshadowed irradiance of its polygons, after the face test, so that only the face that
@@ -310,6 +320,9 @@ vec3 face_light(vec3 p, vec3 n) {
 #endif
     vec4 clip = light_view_projection * vec4(p_test, 1.0);
     vec3 ndc = clip.xyz / clip.w;
+    if (face_index >= 0) {
+        ndc.xy = clamp(ndc.xy, -1.0, 1.0);  // a coarse face's larger lift may carry p_test past its edge
+    }
     float lit = 1.0;
     if (clip.w > 0.0 && all(lessThanEqual(abs(ndc.xy), vec2(1.0)))) {
         ivec2 size = textureSize(rsm_position, 0);

@@ -63,3 +63,36 @@ def test_a_face_drawn_at_its_footprints_texels_leaves_the_image(gl, monkeypatch,
         ours, full = images[0][key][..., :3], images[1][key][..., :3]
         assert np.isfinite(ours).all()
         assert np.abs(ours - full).mean() <= 0.01 * full.mean(), key
+
+
+def test_faces_of_other_texels_share_the_pixels_between_them(gl, monkeypatch):
+    """cornell-large-area's 2 x 2 patches draw their side faces at half the texels of their downward
+    faces. Each pixel must still be shaded by exactly one face: when each face judged by its own lift
+    (1.5 of its texels) which face a pixel lies in, pixels along the edge between a fine and a coarse face
+    went to neither, a band 2-5 % dark across both side walls in 8 x 8 blocks. Every face now asks where
+    a full-resolution face's lift lands, so the direct light equals that of every face at full
+    resolution: measured equal to the last digit of rel_rmse_8 against Cycles; held here to 0.5 % per
+    8 x 8 block (shadows are read from coarser maps and may move a little)."""
+    from addon.bridge import scenes
+    from addon.bridge.capture import SceneCache
+    from addon.engine import methods, metrics
+    from addon.engine.config import GIConfig, RsmConfig
+    from addon.engine.passes import light_views
+
+    scenes.build("cornell-large-area")
+    scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 64, 64)
+    footprint_texels = light_views.view_texels
+    images, texels = [], []
+    for rule in (footprint_texels, lambda footprint_m, texel_m, most: most):
+        monkeypatch.setattr(light_views, "view_texels", rule)
+        method = methods.create(gl, {"gi": GIConfig(method="direct", resolution=64), "rsm": RsmConfig(resolution=256)})
+        method.set_scene(scene)
+        method.compute()
+        images.append(method.read()["direct"])
+        texels.append(sorted(v.resolution for v in method.light_views()))
+    assert texels[0] != texels[1] and 128 in texels[0]  # some faces are coarser
+    mask = images[1][..., 3] > 0.5
+    ours, _ = metrics.box_average(images[0][..., :3], mask, 8)
+    full, _ = metrics.box_average(images[1][..., :3], mask, 8)
+    lit = full.mean(axis=2) > 0.01 * full.mean()
+    assert np.abs(ours.mean(axis=2)[lit] / full.mean(axis=2)[lit] - 1.0).max() <= 0.005

@@ -79,6 +79,7 @@ def _spec(polygons: bool, soft_sun: bool, area_samples: int = 0) -> ShaderSpec:
             Var("spot_cos_half", "float"), Var("spot_blend", "float"), Var("shadow_bias_texels", "float"),
             Var("accumulate", "int"),
         ) + (() if polygons else (Var("exact_near_texels", "float"),))  # the exact tests': not a polygon's
+        + (() if soft_sun else (Var("face_lift_share", "float"),))  # a lamp's faces' partition: no sun's
         + ((Var("poly_first", "int"), Var("poly_count", "int"), Var("emitter_radius_m", "float"),
                Var("light_view_projection_inverse", "mat4")) if polygons else ())
         + ((Var("sun_tan_half", "float"),) if soft_sun else ()),

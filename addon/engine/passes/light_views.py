@@ -249,7 +249,8 @@ def views_for(light: Light, index: int, bounds: tuple[np.ndarray, np.ndarray], r
             continue  # the face behind a one-sided emitter receives nothing
         if not face_meets(axis, wide):
             continue  # nothing of the scene lies in this face's pyramid
-        views.append(_perspective_view(light, index, axis, face, np.pi / 2.0, near, far, texels_for(axis, np.pi / 2.0)))
+        views.append(_perspective_view(light, index, axis, face, np.pi / 2.0, near, far, texels_for(axis, np.pi / 2.0),
+                                       resolution))
     return views
 
 
@@ -306,12 +307,15 @@ def _common_uniforms(light: Light, emit_axis: np.ndarray, texel_scale: float) ->
     }
 
 
-def _perspective_view(light, index, axis, face, fov, near, far, resolution) -> LightView:
+def _perspective_view(light, index, axis, face, fov, near, far, resolution, most=None) -> LightView:
+    """A perspective view of `resolution` texels; a cube face (`face` >= 0) also carries the share of its
+    texels' lift that a face of `most` texels has (direct_light's face partition: the same for all faces)."""
     view = look_along(light.position_m, axis)
     vp = perspective(fov, near, far) @ view
     texel_scale = (2.0 * np.tan(fov / 2.0) / resolution) ** 2
     uniforms = {"light_view_projection": vp, "light_view_projection_inverse": np.linalg.inv(vp),
-                "face_axis": axis, "face_index": face, **_common_uniforms(light, light.direction, texel_scale)}
+                "face_axis": axis, "face_index": face, "face_lift_share": resolution / (most or resolution),
+                **_common_uniforms(light, light.direction, texel_scale)}
     return LightView(index, vp, light.position_m, np.asarray(axis, np.float64), face, texel_scale, uniforms,
                      resolution)
 
