@@ -34,6 +34,31 @@ def test_a_spot_aimed_away_costs_nothing_and_changes_nothing(gl):
         np.testing.assert_array_equal(images[0][key], images[1][key], err_msg=key)
 
 
+def at_footprint_and_full_texels(gl, monkeypatch, scene_name: str, method_name: str, size: int,
+                                 rsm_texels: int) -> tuple[list[dict], list[list[int]]]:
+    """The images of `method_name` on the procedural scene, and its views' texels, sorted: first with
+    each view's texels from its footprint (light_views.view_texels), then with every view at
+    `rsm_texels`."""
+    from addon.bridge import scenes
+    from addon.bridge.capture import SceneCache
+    from addon.engine import methods
+    from addon.engine.config import GIConfig, RsmConfig
+    from addon.engine.passes import light_views
+
+    scenes.build(scene_name)
+    scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), size, size)
+    images, texels = [], []
+    for rule in (light_views.view_texels, lambda footprint_m, texel_m, most: most):
+        monkeypatch.setattr(light_views, "view_texels", rule)
+        method = methods.create(gl, {"gi": GIConfig(method=method_name, resolution=size),
+                                     "rsm": RsmConfig(resolution=rsm_texels)})
+        method.set_scene(scene)
+        method.compute()
+        images.append(method.read())
+        texels.append(sorted(v.resolution for v in method.light_views()))
+    return images, texels
+
+
 @pytest.mark.parametrize("name", ["rsm", "lpv", "vct", "diffusion", "probes"])
 def test_a_face_drawn_at_its_footprints_texels_leaves_the_image(gl, monkeypatch, name):
     """The Cornell box's lamp hangs under its ceiling: its upward face sees the ceiling a few centimetres
@@ -41,23 +66,7 @@ def test_a_face_drawn_at_its_footprints_texels_leaves_the_image(gl, monkeypatch,
     its own area's flux (texel_scale), so the light injected, gathered and shadowed is the same, only
     sampled at other points of the ceiling: the images move by less than 1 % of their mean (measured
     0 for the direct light, 0.002-0.09 % for the indirect light)."""
-    from addon.bridge import scenes
-    from addon.bridge.capture import SceneCache
-    from addon.engine import methods
-    from addon.engine.config import GIConfig, RsmConfig
-    from addon.engine.passes import light_views
-
-    scenes.build("cornell-point")
-    scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 48, 48)
-    footprint_texels = light_views.view_texels
-    images, texels = [], []
-    for rule in (footprint_texels, lambda footprint_m, texel_m, most: most):
-        monkeypatch.setattr(light_views, "view_texels", rule)
-        method = methods.create(gl, {"gi": GIConfig(method=name, resolution=48), "rsm": RsmConfig(resolution=128)})
-        method.set_scene(scene)
-        method.compute()
-        images.append(method.read())
-        texels.append(sorted(v.resolution for v in method.light_views()))
+    images, texels = at_footprint_and_full_texels(gl, monkeypatch, "cornell-point", name, 48, 128)
     assert texels == [[64, 128, 128, 128, 128, 128], [128] * 6]
     for key in ("direct", "indirect"):
         ours, full = images[0][key][..., :3], images[1][key][..., :3]
@@ -73,23 +82,10 @@ def test_faces_of_other_texels_share_the_pixels_between_them(gl, monkeypatch):
     a full-resolution face's lift lands, so the direct light equals that of every face at full
     resolution: measured equal to the last digit of rel_rmse_8 against Cycles; held here to 0.5 % per
     8 x 8 block (shadows are read from coarser maps and may move a little)."""
-    from addon.bridge import scenes
-    from addon.bridge.capture import SceneCache
-    from addon.engine import methods, metrics
-    from addon.engine.config import GIConfig, RsmConfig
-    from addon.engine.passes import light_views
+    from addon.engine import metrics
 
-    scenes.build("cornell-large-area")
-    scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 64, 64)
-    footprint_texels = light_views.view_texels
-    images, texels = [], []
-    for rule in (footprint_texels, lambda footprint_m, texel_m, most: most):
-        monkeypatch.setattr(light_views, "view_texels", rule)
-        method = methods.create(gl, {"gi": GIConfig(method="direct", resolution=64), "rsm": RsmConfig(resolution=256)})
-        method.set_scene(scene)
-        method.compute()
-        images.append(method.read()["direct"])
-        texels.append(sorted(v.resolution for v in method.light_views()))
+    found, texels = at_footprint_and_full_texels(gl, monkeypatch, "cornell-large-area", "direct", 64, 256)
+    images = [f["direct"] for f in found]
     assert texels[0] != texels[1] and 128 in texels[0]  # some faces are coarser
     mask = images[1][..., 3] > 0.5
     ours, _ = metrics.box_average(images[0][..., :3], mask, 8)
