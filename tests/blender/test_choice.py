@@ -179,11 +179,66 @@ def test_choose_operator_sets_the_scene_and_notes_the_estimate(bounce, fresh_ble
         scenes.build("cornell")
         s = bpy.context.scene.bounce
         s.gi.resolution, s.error_budget = 32, 0.3
-        assert bpy.ops.bounce.choose() == {"FINISHED"}
-        assert s.choice_row and "% from a path tracer" in s.choice_note
+        assert bpy.ops.bounce.choose(verify=False) == {"FINISHED"}
+        assert s.choice_row and s.choice_note.endswith("from a path tracer, the model's estimate")
         from addon.properties import to_config
 
         assert choice.row_for(choice.load(), to_config(s)) == s.choice_row
+    finally:
+        bounce.unregister()
+
+
+def test_choose_operator_checks_the_choice_in_a_second_process(bounce, fresh_blend):
+    # The panel's default: the check of `render --method auto` run on a saved copy in a second process
+    # (the bpy module's Python here, Blender's binary in tests/real_blender), whose verdict is applied.
+    # The user's session keeps its render settings: the check's Cycles render changed only the copy's.
+    from addon.bridge import scenes
+    from addon.properties import to_config
+
+    bounce.register()
+    try:
+        scenes.build("cornell")
+        scene = bpy.context.scene
+        engine, samples = scene.render.engine, scene.cycles.samples
+        s = scene.bounce
+        s.gi.resolution, s.error_budget = 32, 0.3
+        assert bpy.ops.bounce.choose() == {"FINISHED"}
+        assert s.choice_note.split(": ~")[1].endswith("from a path tracer, checked by Cycles"), s.choice_note
+        assert choice.row_for(choice.load(), to_config(s)) == s.choice_row
+        assert (scene.render.engine, scene.cycles.samples) == (engine, samples)
+        assert "Render Result" not in bpy.data.images
+    finally:
+        bounce.unregister()
+
+
+def test_choose_job_reports_a_failed_check_in_one_line_and_stops_on_cancel(bounce, fresh_blend):
+    # The second process's failure comes back as the one-line error the operator reports (here: a copy
+    # without a camera, which the operator itself never sends), and a cancelled check leaves no process
+    # and no folder behind.
+    import importlib
+
+    from addon.bridge import scenes
+    from addon.properties import to_config
+
+    job_module = importlib.import_module("bounce.addon.bridge.choose_job")
+    errors = importlib.import_module("bounce.addon.engine.errors")
+    bounce.register()
+    try:
+        scenes.build("cornell")
+        bpy.context.scene.camera = None
+        configs = to_config(bpy.context.scene.bounce)
+        job = job_module.ChooseJob("bounce", configs, 0.3)
+        try:
+            job.wait()
+            with pytest.raises(errors.BounceError, match="^the check failed: .*the scene has no camera$"):
+                job.result()
+        finally:
+            job.close()
+        assert not job.folder.exists()
+        job = job_module.ChooseJob("bounce", configs, 0.3)
+        job.cancel()
+        job.close()
+        assert job.process.returncode is not None and not job.folder.exists()
     finally:
         bounce.unregister()
 

@@ -157,6 +157,21 @@ def steps():
                          "error": live.STATE.error, "gpu_runs": viewport.gpu_runs - runs,
                          "map": live.STATE.scene.world_map is not None,
                          "sun_discs": [light.name for light in live.STATE.scene.lights if light.kind == "SUN"]}
+    # Choose for Budget as the panel's button runs it (invoked: modal, its check in a second Blender on a
+    # copy of the file), on the Cornell box's lamps again, at 32 px so that the check takes seconds here.
+    settings.enabled = False
+    bpy.context.scene.world = None
+    spot.hide_viewport = spot.hide_render = False
+    settings.gi.resolution, settings.error_budget, settings.choice_note = 32, 0.3, ""
+    engine = bpy.context.scene.render.engine
+    t0 = time.perf_counter()
+    with bpy.context.temp_override(window=window, area=view3d()):
+        entry = result["choose"] = {"invoked": sorted(bpy.ops.bounce.choose("INVOKE_DEFAULT"))}
+    while not settings.choice_note and time.perf_counter() - t0 < WAIT_S:
+        yield 0.5
+    entry.update(note=settings.choice_note, row=settings.choice_row, method=settings.gi.method,
+                 seconds=round(time.perf_counter() - t0, 1), engine_kept=bpy.context.scene.render.engine == engine,
+                 render_result="Render Result" in bpy.data.images)
 
 
 _steps = steps()
