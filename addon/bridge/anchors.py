@@ -124,7 +124,7 @@ def render_eevee(blend, res: int, out_dir) -> dict:
     and its shadows cancel). The second render only measures; its time is not EEVEE's."""
     from pathlib import Path
 
-    from . import images
+    from . import compat, images
     from .capture import image_size
     from .reference import _open_blend, _render
 
@@ -138,10 +138,8 @@ def render_eevee(blend, res: int, out_dir) -> dict:
     r.filter_size = 0.01  # point-sampled pixel centres, as the references' filter_width
     vl = bpy.context.view_layer
     vl.use_pass_combined = vl.use_pass_diffuse_direct = vl.use_pass_diffuse_color = True
-    im = r.image_settings
-    im.media_type = "MULTI_LAYER_IMAGE"  # 5.0: before the file format (FACTS.md)
-    im.file_format = "OPEN_EXR_MULTILAYER"
-    im.color_depth = "32"
+    compat.multilayer_exr(r.image_settings)
+    r.image_settings.exr_codec = "NONE"  # read back without OpenImageIO (exr.py), as reference.render_open
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     light, seconds = {}, {}

@@ -42,7 +42,7 @@ from ..engine.lightmap import (
     uv_problems,
 )
 from ..engine.scene import Camera
-from . import images
+from . import compat, images
 from .bake_raster import TexelBaker
 from .capture import SceneCache, define_light_switch, material_values
 
@@ -191,7 +191,8 @@ def bake_check_render(obj_name: str, pass_name: str, size: int, bounces: int):
 
 def cycles_bakes(obj) -> bool:
     """Whether Cycles bakes the object: every material slot holds a node material."""
-    return bool(obj.material_slots) and all(slot.material and slot.material.use_nodes for slot in obj.material_slots)
+    return bool(obj.material_slots) and all(slot.material and compat.uses_nodes(slot.material)
+                                            for slot in obj.material_slots)
 
 
 def self_check(obj, values: np.ndarray, pass_name: str, size: int, bounces: int) -> dict:

@@ -64,6 +64,15 @@ def area_power_normalized(light_data) -> bool:
 _layer_keys: tuple[str, str] | None = None
 
 
+def multilayer_exr(image_settings) -> None:
+    """Render output as 32-bit multi-layer OpenEXR. Blender 5.0 files the formats under a media type that
+    must be set before the file format (FACTS.md); 4.x has no media type."""
+    if hasattr(image_settings, "media_type"):
+        image_settings.media_type = "MULTI_LAYER_IMAGE"
+    image_settings.file_format = "OPEN_EXR_MULTILAYER"
+    image_settings.color_depth = "32"
+
+
 def layer_attachment(texture: gpu.types.GPUTexture, layer: int) -> dict:
     """A color slot for GPUFrameBuffer(color_slots=...) that attaches one layer of a 3D texture."""
     keys = _layer_keys or ("texture", "layer")

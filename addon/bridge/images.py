@@ -2,7 +2,9 @@
 
 OpenImageIO is imported on first use, not with this module: Blender builds need not have it (Debian's
 has none) and the extension does not ship it, so the paths a user runs inside Blender (the overlay, the
-bake operator's packed images) never import it; the CLI's venv installs it from requirements.txt.
+bake operator's packed images) never import it; the CLI's venv installs it from requirements.txt. The
+Cycles renders Bounce makes inside Blender are written uncompressed and read without it (read_multilayer,
+exr.py).
 
 Arrays are float32 (h, w, c) with row 0 = the TOP of the image (EXR order; GL read-backs must be
 flipped before writing). Channels are R, G, B[, A]. Pixels are written as 32-bit FLOAT: half floats
@@ -85,38 +87,56 @@ def read_exr(path) -> np.ndarray:
 
 
 def read_multilayer(path) -> dict[str, np.ndarray]:
-    """Blender's multi-layer EXR as {pass name: float32 (h, w, c)}.
+    """An uncompressed multi-layer EXR from Blender as {pass name: float32 (h, w, c)}, read without
+    OpenImageIO (exr.py), so it works inside any Blender: Bounce writes its own renders so
+    (compat.multilayer_exr, codec NONE).
 
-    Blender 5.0 writes each pass as its own subimage (part) with channels "<view layer>.<pass>.<chan>",
-    e.g. "ViewLayer.Diffuse Indirect.R"; Combined is "ViewLayer.Combined.R/G/B/A". Channels are put
-    in R, G, B, A (or X, Y, Z, ...) order as Blender wrote them; a subimage holding several passes
-    (older writers put all passes in one part) is split by pass name. Only the first view layer found
-    is kept under the bare pass name; others (rare in our scenes) are keyed "<layer>.<pass>".
+    Blender 5.0 writes each pass as its own part with channels "<view layer>.<pass>.<chan>", e.g.
+    "ViewLayer.Diffuse Indirect.R"; Combined is "ViewLayer.Combined.R/G/B/A". 4.x puts all passes in
+    one part. See passes_by_name for the keys and the channels' order.
     """
-    inp = _open(path)
+    from . import exr
+
+    if not Path(path).is_file():
+        raise SceneError(f"no such image: {path}")
+    return passes_by_name(exr.read_parts(path), path)
+
+
+# Blender before 5.0 names the passes in a multi-layer EXR by their short names; 5.0 by the long ones
+# used everywhere else (docs/ARCHITECTURE.md, Blender versions).
+_LONG_PASS_NAMES = {"DiffDir": "Diffuse Direct", "DiffInd": "Diffuse Indirect", "DiffCol": "Diffuse Color",
+                    "GlossDir": "Glossy Direct", "GlossInd": "Glossy Indirect", "GlossCol": "Glossy Color"}
+
+# A pass's channels in the order its consumers index them (colour R, G, B, A; vectors X, Y, Z, W), as
+# OpenImageIO returns them; the file itself lists them alphabetically.
+_CHANNEL_RANK = {"R": 0, "G": 1, "B": 2, "A": 3, "X": 0, "Y": 1, "Z": 2, "W": 3}
+
+
+def passes_by_name(parts: list[tuple[list[str], np.ndarray]], path) -> dict[str, np.ndarray]:
+    """{pass name: float32 (h, w, c)} from an EXR's parts ((channel names, pixels) each). Channels are
+    "<layer>.<pass>.<chan>" (pass names contain no dots in Blender), "<pass>.<chan>", or bare (Combined);
+    passes are named as Blender 5.0 names them (_LONG_PASS_NAMES) and their channels go in _CHANNEL_RANK's
+    order. Only the first view layer found is kept under the
+    bare pass name; others (rare in our scenes) are keyed "<layer>.<pass>"."""
     passes: dict[str, np.ndarray] = {}
     first_layer = None
-    try:
-        sub = 0
-        while inp.seek_subimage(sub, 0):
-            px, names = _read_subimage(inp, sub, path)
-            groups: dict[str, list[int]] = {}
-            for i, name in enumerate(names):
-                parts = name.split(".")
-                if len(parts) >= 3:  # layer.pass.channel (pass names may not contain dots in Blender)
-                    layer, pname = parts[0], ".".join(parts[1:-1])
-                elif len(parts) == 2:  # pass.channel without a layer
-                    layer, pname = "", parts[0]
-                else:
-                    layer, pname = "", "Combined"
-                first_layer = layer if first_layer is None else first_layer
-                key = pname if layer == first_layer else f"{layer}.{pname}"
-                groups.setdefault(key, []).append(i)
-            for key, idx in groups.items():
-                passes[key] = np.ascontiguousarray(px[:, :, idx])
-            sub += 1
-    finally:
-        inp.close()
+    for names, px in parts:
+        groups: dict[str, list[tuple[int, str]]] = {}
+        for i, name in enumerate(names):
+            fields = name.split(".")
+            if len(fields) >= 3:
+                layer, pname = fields[0], ".".join(fields[1:-1])
+            elif len(fields) == 2:
+                layer, pname = "", fields[0]
+            else:
+                layer, pname = "", "Combined"
+            pname = _LONG_PASS_NAMES.get(pname, pname)
+            first_layer = layer if first_layer is None else first_layer
+            key = pname if layer == first_layer else f"{layer}.{pname}"
+            groups.setdefault(key, []).append((i, fields[-1]))
+        for key, channels in groups.items():
+            ordered = sorted(channels, key=lambda c: (_CHANNEL_RANK.get(c[1], 4), c[1]))
+            passes[key] = np.ascontiguousarray(px[:, :, [i for i, _ in ordered]])
     if not passes:
         raise SceneError(f"no passes in {path}")
     return passes

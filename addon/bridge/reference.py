@@ -27,7 +27,7 @@ import numpy as np
 
 from ..engine.errors import ConfigError, SceneError
 from ..engine.metrics import compare
-from . import images
+from . import compat, images
 from .capture import image_size, image_unreadable
 
 PASSES = {"indirect": "Diffuse Indirect", "direct": "Diffuse Direct", "albedo": "Diffuse Color", "normal": "Normal"}
@@ -125,11 +125,8 @@ def _configure(bpy, scene, spp, bounces, width, height, seed, exr_path, glossy: 
     vl.use_pass_diffuse_direct = vl.use_pass_diffuse_indirect = vl.use_pass_diffuse_color = True
     vl.use_pass_normal = True
     vl.use_pass_glossy_indirect = vl.use_pass_glossy_color = glossy
-    im = r.image_settings
-    im.media_type = "MULTI_LAYER_IMAGE"  # 5.0: must come before the file format (FACTS.md)
-    im.file_format = "OPEN_EXR_MULTILAYER"
-    im.color_depth = "32"
-    im.exr_codec = "ZIP"
+    compat.multilayer_exr(r.image_settings)
+    r.image_settings.exr_codec = "NONE"  # read back without OpenImageIO, which a Blender may lack (exr.py)
     r.filepath = str(exr_path)
     r.use_file_extension = False
     settings = {

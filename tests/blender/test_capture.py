@@ -51,6 +51,7 @@ def _plane_head_on(tmp_path, inputs: dict, spp: int, pass_name: str, base_image=
     """A 100 m Principled plane (`inputs`; `base_image`, if given, an Image Texture into its Base Color;
     or `material`) filling a 16 x 16 Cycles render from 10 m above: returns the capture and the render's
     layers, with `pass_name` ("Diffuse Color" or "Glossy Color") enabled."""
+    from addon.bridge import compat
     from addon.bridge.images import read_multilayer
 
     plane = _obj("Plane", [(-50, -50, 0), (50, -50, 0), (50, 50, 0), (-50, 50, 0)], [(0, 1, 2, 3)])
@@ -72,9 +73,8 @@ def _plane_head_on(tmp_path, inputs: dict, spp: int, pass_name: str, base_image=
     sc.cycles.filter_width = 0.01
     setattr(bpy.context.view_layer, {"Diffuse Color": "use_pass_diffuse_color",
                                      "Glossy Color": "use_pass_glossy_color"}[pass_name], True)
-    r.image_settings.media_type = "MULTI_LAYER_IMAGE"  # 5.0: before the file format
-    r.image_settings.file_format = "OPEN_EXR_MULTILAYER"
-    r.image_settings.color_depth = "32"
+    compat.multilayer_exr(r.image_settings)
+    r.image_settings.exr_codec = "NONE"  # what read_multilayer reads
     r.filepath, r.use_file_extension = str(tmp_path / "r.exr"), False
     s = cap.capture(_dg())
     bpy.ops.render.render(write_still=True)

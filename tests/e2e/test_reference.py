@@ -121,7 +121,7 @@ def test_exr_roundtrip_is_float_and_top_row_first(tmp_path):
     with pytest.raises(SceneError, match="no such image"):
         images.read_exr(tmp_path / "missing.exr")
     (tmp_path / "junk.exr").write_bytes(b"not an exr")
-    with pytest.raises(SceneError, match="cannot read"):
+    with pytest.raises(SceneError, match="not an OpenEXR file"):
         images.read_multilayer(tmp_path / "junk.exr")
 
 
