@@ -141,9 +141,9 @@ def test_a_sky_lights_by_direction_once_captured(shots):
 def test_choose_for_budget_checks_in_a_second_blender(shots):
     # The panel's Choose for Budget, invoked in the window: modal, its check (the model's candidates
     # against a few-sample Cycles render) run by a second, background Blender on a saved copy; the
-    # verdict is applied, and this session's render engine and Render Result stay as they were.
+    # verdict is applied, and this session's render settings stay as they were.
     entry = shots[0]["choose"]
     assert entry["invoked"] == ["RUNNING_MODAL"], entry
     assert entry["note"].endswith("from a path tracer, checked by Cycles"), entry
     assert entry["row"].split()[0] == entry["method"], entry
-    assert entry["engine_kept"] and not entry["render_result"], entry
+    assert entry["render_settings_kept"], entry

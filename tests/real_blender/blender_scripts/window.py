@@ -163,15 +163,19 @@ def steps():
     bpy.context.scene.world = None
     spot.hide_viewport = spot.hide_render = False
     settings.gi.resolution, settings.error_budget, settings.choice_note = 32, 0.3, ""
-    engine = bpy.context.scene.render.engine
+    render = bpy.context.scene.render
+
+    def render_settings():  # what the check's Cycles render sets on the scene it renders
+        return [render.engine, render.resolution_x, render.resolution_y, render.film_transparent,
+                bpy.context.scene.cycles.samples]
+    before = render_settings()
     t0 = time.perf_counter()
     with bpy.context.temp_override(window=window, area=view3d()):
         entry = result["choose"] = {"invoked": sorted(bpy.ops.bounce.choose("INVOKE_DEFAULT"))}
     while not settings.choice_note and time.perf_counter() - t0 < WAIT_S:
         yield 0.5
     entry.update(note=settings.choice_note, row=settings.choice_row, method=settings.gi.method,
-                 seconds=round(time.perf_counter() - t0, 1), engine_kept=bpy.context.scene.render.engine == engine,
-                 render_result="Render Result" in bpy.data.images)
+                 seconds=round(time.perf_counter() - t0, 1), render_settings_kept=render_settings() == before)
 
 
 _steps = steps()
