@@ -27,7 +27,7 @@ def note(decided: dict) -> str:
     """The panel's line: the chosen setting, its expected error in per cent of a path tracer's light, and
     whether a Cycles check on this scene or the model alone gave that figure."""
     c = decided["choice"]
-    setting = ", ".join(f"{k.split('.')[-1]} {v}" for k, v in c["setting"].items())
+    setting = ", ".join(f"{k.split('.')[-1]} {v}" for k, v in c["setting"].items()) or "its defaults"
     checked = decided.get("estimate_source") == "path-traced check"
     return (f"{c['method']} ({setting}): ~{100 * decided['estimated_rel_rmse_8']:.0f} % from a path tracer"
             + (", checked by Cycles" if checked else ", the model's estimate")
