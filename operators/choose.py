@@ -84,6 +84,11 @@ class BOUNCE_OT_choose(bpy.types.Operator):
         finally:
             self._stop(context)
 
+    def cancel(self, context):
+        """Blender ends the modal run (a file loaded, the window closed): the check's process and folder
+        must not outlive it."""
+        self._stop(context)
+
     def _start(self, context):
         """The model's choice, applied at once where it is not to be checked (Verify off, or no camera to
         check it with); else the started check (a ChooseJob). None when nothing is left to run."""
@@ -127,6 +132,7 @@ class BOUNCE_OT_choose(bpy.types.Operator):
 
     def _stop(self, context) -> None:
         context.window_manager.event_timer_remove(self._timer)
-        context.workspace.status_text_set(None)
+        if context.workspace is not None:  # none while a file loads
+            context.workspace.status_text_set(None)
         self._job.cancel()
         self._job.close()
