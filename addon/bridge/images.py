@@ -116,8 +116,8 @@ def passes_by_name(parts: list[tuple[list[str], np.ndarray]], path) -> dict[str,
     """{pass name: float32 (h, w, c)} from an EXR's parts ((channel names, pixels) each). Channels are
     "<layer>.<pass>.<chan>" (pass names contain no dots in Blender), "<pass>.<chan>", or bare (Combined);
     passes are named as Blender 5.0 names them (_LONG_PASS_NAMES) and their channels go in _CHANNEL_RANK's
-    order. Only the first view layer found is kept under the
-    bare pass name; others (rare in our scenes) are keyed "<layer>.<pass>"."""
+    order. Only the first view layer found is kept under the bare pass name; others (rare in our scenes)
+    are keyed "<layer>.<pass>"."""
     passes: dict[str, np.ndarray] = {}
     first_layer = None
     for names, px in parts:
