@@ -137,9 +137,9 @@ def child_command(package: str, job_dir: str) -> list[str]:
     (the package is imported by its top-level name there, as the tests import it)."""
     import bpy
 
-    root = sys.modules[package.split(".")[0]] if "." not in package else None
-    path_setup = (f"import sys; sys.path.insert(0, {str(Path(root.__file__).parent.parent)!r}); "
-                  if root is not None else "")
+    top_level = "." not in package  # its folder's parent must be on the path; bl_ext's Blender sets up
+    path_setup = (f"import sys; sys.path.insert(0, {str(Path(sys.modules[package].__file__).parent.parent)!r}); "
+                  if top_level else "")
     code = (f"{path_setup}import importlib; "
             f"importlib.import_module({package + '.addon.bridge.choose_job'!r}).child_main({job_dir!r})")
     if bpy.app.binary_path:
