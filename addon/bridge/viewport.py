@@ -53,7 +53,9 @@ FULL_SCREEN_TRIANGLE = np.array([[-1.0, -1.0], [3.0, -1.0], [-1.0, 3.0]], np.flo
 # view_mode -> (weight of direct, weight of indirect); VOXELS shows the rsm method's voxel grid instead.
 MODE_WEIGHTS = {"COMBINED": (1.0, 1.0), "INDIRECT": (0.0, 1.0), "DIRECT": (1.0, 0.0), "VOXELS": (0.0, 1.0)}
 PREVIEW_SCALE = 0.5        # preview quality: half the resolution ...
-PREVIEW_VPL_DIVISOR = 4    # ... and a quarter of the VPLs: ~8x less gather work while a light is dragged
+PREVIEW_VPL_DIVISOR = 4    # ... and a quarter of the VPLs: ~8x less gather work while a light is dragged,
+# each pixel sampled once however small the image (GIConfig.sample_budget_px 0): the still view's first
+# update takes the samples, refinement the rest
 MAX_OVERLAYS = 8           # (region, quality) pairs kept; regions come and go with the UI layout
 MAX_SAMPLES = 64           # gathers averaged while nothing changes (progressive refinement, rsm and vct)
 
@@ -245,6 +247,7 @@ def _draw(context, settings) -> None:
     if quality == "preview":
         vpls = max(1, rsm_config.vpl_samples // PREVIEW_VPL_DIVISOR)
         configs["rsm"] = dataclasses.replace(rsm_config, vpl_samples=vpls)
+        configs["gi"] = dataclasses.replace(gi, sample_budget_px=0)
     width, height = view_size(region.width, region.height, gi.resolution, quality)
     camera = region_camera(*matrices, width, height, context.scene.unit_settings.scale_length)
     overlay = overlay_for(region_key, quality)

@@ -328,6 +328,13 @@ class GIConfig(_Validated):
     # each with other VPLs / cone rotations (DirectMethod.refine; noise / sqrt(samples)); the viewport
     # keeps adding gathers while nothing changes.
     samples: int = _num(1, 1, 1024, "gathers averaged per render or bake (rsm, vct: noise falls as 1 / sqrt)")
+    # The denoise filter's reach is a fixed share of the image (denoise.iterations_for), so a small image
+    # leaves it few samples to average: the viewport's 256 px (128 while moving) and the benchmarks' 128 px
+    # are small. There the stochastic gathers sample every pixel budget / pixels times (at most 4;
+    # surface_support.image_samples), which a GPU does in a fraction of a millisecond at those sizes
+    # (docs/ARCHITECTURE.md, "A clean preview").
+    sample_budget_px: int = _num(518400, 0, 1 << 24, "pixel samples an update of rsm or vct spends: an image with "
+                                 "fewer pixels samples each pixel several times (up to 4; 0: once)")
     denoise: bool = field(default=True, metadata={
         "doc": "filter the stochastic gathers' noise along each surface (never across edges)"})
     seed: int = _num(0, 0, 2**31 - 1, "seed of every stochastic choice")

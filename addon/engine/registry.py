@@ -66,7 +66,7 @@ METHODS: tuple[MethodSpec, ...] = (
     MethodSpec(
         name="rsm", summary="one bounce gathered from the shadow maps' VPLs, optionally with voxel visibility",
         module="rsm", class_name="RsmMethod", products=("direct", "indirect", "albedo"), max_bounces=1,
-        reads=(*_IMAGE, "gi.seed", "gi.samples", "gi.denoise", "rsm.*"),
+        reads=(*_IMAGE, "gi.seed", "gi.samples", "gi.sample_budget_px", "gi.denoise", "rsm.*"),
         # Voxel visibility marches every VPL (x6 faces for point lights): on llvmpipe 256 VPLs at 64 cells
         # is what fits a benchmark run; 1024 VPLs at 128 cells (rel_rmse_8 0.055 on cornell) takes minutes.
         bench=({"rsm.vpl_samples": 64}, {"rsm.vpl_samples": 256}, {"rsm.vpl_samples": 1024},
@@ -95,7 +95,8 @@ METHODS: tuple[MethodSpec, ...] = (
     MethodSpec(
         name="vct", summary="voxel cone tracing through a six-direction radiance pyramid, glossy cones",
         module="vct", class_name="VctMethod", products=("direct", "indirect", "ao", "albedo", "glossy"),
-        max_bounces=8, reads=(*_IMAGE, "gi.bounces", "gi.seed", "gi.samples", "gi.denoise", *_LIGHT_VIEWS, "vct.*"),
+        max_bounces=8, reads=(*_IMAGE, "gi.bounces", "gi.seed", "gi.samples", "gi.sample_budget_px", "gi.denoise",
+                                   *_LIGHT_VIEWS, "vct.*"),
         # Two grid sizes at the defaults (16 cones, docs/VCT.md), the half-resolution gather, and the
         # filtered injection (four points per VPL: no flicker as lights move, slower).
         bench=({"vct.voxel_cells": 64}, {"vct.voxel_cells": 64, "vct.gather_scale": 2}, {"vct.voxel_cells": 128},

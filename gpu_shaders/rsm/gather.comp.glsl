@@ -97,16 +97,20 @@ void main() {
     if (pos.w == 0.0) {
         return;
     }
-    // Pixels whose denoise filter finds little of their surface around them (passes/surface_support.py)
-    // make draw_sets sets of draws, one per dispatch set (draw_set), each weighing 1 / draw_sets and
-    // shifted a further 1 / draw_sets of the way within each draw's cell (the sets stay stratified);
-    // the other pixels make set 0 alone.
-    bool more = draw_sets > 1 && texelFetch(support, px, 0).x < support_threshold;
-    if (draw_set > 0 && !more) {
+    // Every pixel makes image_sets sets of draws (GIConfig.sample_budget_px: a small image, whose filter has
+    // few pixels to average, spends the draws a larger one would), and pixels whose denoise filter finds
+    // little of their surface around them (passes/surface_support.py) draw_sets times that. One set per
+    // dispatch set (draw_set), each weighing 1 / sets and shifted a further 1 / sets of the way within
+    // each draw's cell (the sets stay stratified); a pixel leaves the dispatches beyond its sets at once.
+    int sets = image_sets;
+    if (draw_sets > 1 && texelFetch(support, px, 0).x < support_threshold) {
+        sets *= draw_sets;
+    }
+    if (draw_set >= sets) {
         return;
     }
-    float set_weight = more ? 1.0 / float(draw_sets) : 1.0;
-    float set_shift = float(draw_set) / float(draw_sets);
+    float set_weight = 1.0 / float(sets);
+    float set_shift = float(draw_set) / float(sets);
     vec3 x = pos.xyz;
     vec3 n = texelFetch(gbuf_normal, px, 0).xyz;
     ivec2 rsm_size = textureSize(rsm_flux, 0);

@@ -38,17 +38,20 @@ void main() {
     vec3 u = fract(image_random + pixel_pattern(px, sample_index));
     float jitter = u.x, rotation = 6.28318531 * u.y, dither = u.z;
     vec4 e = gather_diffuse(pos.xyz, n, rotation, jitter, dither);
-    // Where the denoise filter will find little of the pixel's own surface around it (`support`, from
-    // passes/surface_support.py, at the pixel the texel stands for), it cannot average this gather's
-    // noise: such pixels gather `support_gathers` times, each turned and jittered a further
-    // 1 / support_gathers of the way, so the set stays stratified.
+    // Every pixel gathers `image_gathers` times (VctConfig.gather_budget_px: a small image, whose filter
+    // has few pixels to average, spends the gathers a larger one would), and where the denoise filter will
+    // find little of the pixel's own surface around it (`support`, from passes/surface_support.py, at the
+    // pixel the texel stands for), which it cannot average, `support_gathers` times that. Gather g of n
+    // is turned and jittered a further g / n of the way, so the set stays stratified.
+    int gathers = image_gathers;
     if (support_gathers > 1 && texelFetch(support, src, 0).x < support_threshold) {
-        for (int g = 1; g < support_gathers; g++) {
-            float t = float(g) / float(support_gathers);
-            e += gather_diffuse(pos.xyz, n, rotation + 6.28318531 * t, fract(jitter + t), fract(dither + t));
-        }
-        e /= float(support_gathers);
+        gathers *= support_gathers;
     }
+    for (int g = 1; g < gathers; g++) {
+        float t = float(g) / float(gathers);
+        e += gather_diffuse(pos.xyz, n, rotation + 6.28318531 * t, fract(jitter + t), fract(dither + t));
+    }
+    e /= float(gathers);
     imageStore(indirect, px, vec4(e.rgb, 1.0));
     imageStore(ao, px, vec4(vec3(1.0 - e.a), 1.0));
 }

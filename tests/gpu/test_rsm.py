@@ -477,10 +477,11 @@ def test_rsm_reduce_keeps_every_watt(gl):
         np.testing.assert_allclose(got["normal"][by, bx, :3], mean_n / np.linalg.norm(mean_n), rtol=1e-4, atol=1e-6)
 
 
-def pole_rsm(gl, support_draws: int, seed: int):
-    """hard_scenes.pole_room's indirect with rsm (64-texel RSMs), and its pole's pixels."""
+def pole_rsm(gl, support_draws: int, seed: int, sample_budget_px: int = 0):
+    """hard_scenes.pole_room's indirect with rsm (64-texel RSMs), and its pole's pixels; each pixel one
+    set of draws unless the budget says more (GIConfig.sample_budget_px; the image is 64 x 64 = 4096 px)."""
     rsm = RsmConfig(resolution=64, support_draws=support_draws)
-    return pole_indirect(gl, {"gi": GIConfig(method="rsm"), "rsm": rsm}, seed)
+    return pole_indirect(gl, {"gi": GIConfig(method="rsm", sample_budget_px=sample_budget_px), "rsm": rsm}, seed)
 
 
 def test_pixels_the_filter_cannot_average_draw_more_vpls(gl):

@@ -75,4 +75,5 @@ class RsmMethod(OneBounceMethod):
                            self.block_pdfs[face], self.support,
                            occupancy=self.voxels["vox_albedo"] if self.voxels else None,
                            grid=self.voxels and self.grid, offset_cells=self.rsm_config.voxel_offset_cells,
-                           sample=self.sample_index, draw_sets=self.rsm_config.support_draws)
+                           sample=self.sample_index, draw_sets=self.rsm_config.support_draws,
+                           image_sets=surface_support.image_samples(self.indirect.size, self.gi.sample_budget_px))

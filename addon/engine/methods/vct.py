@@ -185,9 +185,10 @@ class VctMethod(OneBounceMethod):
 
     def gather_pixels(self, timings: dict[str, float]) -> None:
         with self.step(timings, vct_gather.PIXELS_DECL):
+            gathered = (self._low or (self.indirect,))[0].size
             vct_gather.pixels(self.backend, self.pyramid, self.radiance_scale, self.gbuf, self.support,
                               self.indirect, self.ao, self.grid, self.vct_config, self.gi.seed, self._low,
-                              self.sample_index)
+                              self.sample_index, surface_support.image_samples(gathered, self.gi.sample_budget_px))
         with self.step(timings, vct_gather.GLOSSY_DECL):
             vct_gather.glossy(self.backend, self.pyramid, self.radiance_scale, self.gbuf, self._lobe_albedo,
                               self.glossy, self.grid, self.vct_config, self.camera().position_m,

@@ -30,7 +30,8 @@ _SAMPLERS = (Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampl
 _GATHER_SAMPLERS = (*_SAMPLERS, Sampler("block_pdf", "2D"), Sampler("support", "2D"))
 _UNIFORMS = (Var("strata_per_side", "int"), Var("seed", "int"), Var("sample_index", "int"), Var("row_begin", "int"),
              Var("row_end", "int"), Var("rsm_view_projection", "mat4"), Var("near_strata", "int"),
-             Var("draw_set", "int"), Var("draw_sets", "int"), Var("support_threshold", "float"))
+             Var("draw_set", "int"), Var("draw_sets", "int"), Var("image_sets", "int"),
+             Var("support_threshold", "float"))
 # Receivers per side of the grid the blocks' view importance is estimated on (256 receivers).
 RECEIVERS_PER_SIDE = 16
 # llvmpipe ends a shader invocation's loops after 65,535 iterations in total (FACTS.md); keep each
@@ -143,19 +144,21 @@ def block_pdf(backend: Backend, gbuf: dict, rsm: dict, importance: dict, vpl_sam
 
 def run(backend: Backend, gbuf: dict, rsm: dict, indirect, vpl_samples: int, seed: int, view_projection,
         pdf, support, occupancy=None, grid: Grid | None = None, offset_cells: float = 1.5, sample: int = 0,
-        draw_sets: int = 1) -> None:
+        draw_sets: int = 1, image_sets: int = 1) -> None:
     """Gather one RSM face (drawn through `view_projection`, the face's local-space 4 x 4) into
     `indirect`, drawing its blocks by `pdf` (block_pdf's, for this face and G-buffer); pass the
     voxelizer's `vox_albedo` and grid for visibility. `seed` is the update's; `sample` the
     gather's index among those averaged since (DirectMethod.sample_index): the draws step along a
     low-discrepancy sequence with it. `support` (surface_support's image): pixels below its THRESHOLD
-    make `draw_sets` sets of draws (RsmConfig.support_draws), each set in dispatches of its own (the
-    loop cap below holds per set) that the other pixels leave at once."""
+    make `draw_sets` times as many sets of draws (RsmConfig.support_draws) as the `image_sets` every pixel
+    makes (surface_support.image_samples), each set in dispatches of its own (the loop cap below holds
+    per set) that the pixels with fewer sets leave at once."""
     spec = SPEC if occupancy is None else SPEC_VOXEL_VISIBILITY
     k = strata_per_side(vpl_samples)
     near = near_strata(vpl_samples)
     uniforms = {"strata_per_side": k, "seed": seed, "sample_index": sample,
                 "rsm_view_projection": view_projection, "near_strata": near, "draw_sets": draw_sets,
+                "image_sets": image_sets,
                 "support_threshold": surface_support.THRESHOLD}
     samplers = {**_samplers(gbuf, rsm), "block_pdf": pdf, "support": support}
     if occupancy is not None:
@@ -166,7 +169,7 @@ def run(backend: Backend, gbuf: dict, rsm: dict, indirect, vpl_samples: int, see
     per_vpl = 1 if grid is None else int(np.ceil(2.0 * np.linalg.norm(grid.dims))) + 1
     # The first dispatch also makes the three squares' near draws; each walks the blocks' running sum.
     rows = max(1, (MAX_LOOP_ITERATIONS - 3 * near * near * per_vpl - k * k) // (k * per_vpl))
-    for draw_set in range(draw_sets):
+    for draw_set in range(draw_sets * image_sets):
         for begin in range(0, k, rows):
             backend.dispatch(backend.program(spec), group_count(indirect.size, spec.local_size),
                              uniforms={**uniforms, "row_begin": begin, "row_end": min(begin + rows, k),

@@ -54,7 +54,8 @@ PIXELS = ShaderSpec(
     local_size=GATHER_GROUP,
     samplers=(*_PYRAMID, Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"), Sampler("support", "2D")),
     images=(Image("indirect", "2D"), Image("ao", "2D")),
-    uniforms=(*_DIFFUSE_UNIFORMS, Var("scale", "int"), Var("sample_index", "int"), Var("support_gathers", "int"),
+    uniforms=(*_DIFFUSE_UNIFORMS, Var("scale", "int"), Var("sample_index", "int"), Var("image_gathers", "int"),
+              Var("support_gathers", "int"),
               Var("support_threshold", "float")),
 )
 
@@ -115,10 +116,11 @@ def low_size(size: tuple[int, int], scale: int) -> tuple[int, int]:
 
 
 def pixels(backend: Backend, pyramid: dict, radiance_scale: float, gbuf: dict, support, indirect, ao, grid: Grid,
-           config: VctConfig, seed: int = 0, low: tuple | None = None, sample: int = 0) -> None:
+           config: VctConfig, seed: int = 0, low: tuple | None = None, sample: int = 0, image_samples: int = 1) -> None:
     """Gather into `indirect` and `ao`; with config.gather_scale > 1, into `low` (two textures of
     low_size) first, then upsample. `support` (surface_support's image of `gbuf`): pixels below its
-    THRESHOLD gather config.support_gathers times. `seed` is the update's; `sample` the gather's index among those
+    THRESHOLD gather config.support_gathers times as often; every pixel gathers `image_samples` times
+    (surface_support.image_samples). `seed` is the update's; `sample` the gather's index among those
     averaged since (DirectMethod.sample_index): each pixel's cone pattern continues one low-discrepancy
     sequence over the samples (gather.comp.glsl)."""
     scale = config.gather_scale
@@ -126,6 +128,7 @@ def pixels(backend: Backend, pyramid: dict, radiance_scale: float, gbuf: dict, s
     backend.dispatch(backend.program(PIXELS), group_count(out[0].size, PIXELS.local_size),
                      uniforms={**cone_uniforms(grid, config, seed, radiance_scale),
                                "diffuse_cones": config.diffuse_cones, "scale": scale, "sample_index": sample,
+                               "image_gathers": image_samples,
                                "support_gathers": config.support_gathers,
                                "support_threshold": surface_support.THRESHOLD},
                      samplers={**named(pyramid, "pyr"), "gbuf_position": gbuf["position"],
