@@ -190,10 +190,12 @@ def test_default_vpls_near_field_disk(gl):
 
 def raw_indirect_over_seeds(gl, scene, rows: slice, cols: slice, seeds: int = 16,
                             config: RsmConfig | None = None) -> np.ndarray:
-    """The unfiltered gather's indirect (red) in a window of the image, one image per seed 0..seeds-1."""
+    """The unfiltered gather's indirect (red) in a window of the image, one image per seed 0..seeds-1,
+    each pixel one set of draws (GIConfig.sample_budget_px 0): the draws themselves are under test."""
     images = []
     for seed in range(seeds):
-        method = RsmMethod(gl, GIConfig(method="rsm", denoise=False, seed=seed), config or RsmConfig())
+        method = RsmMethod(gl, GIConfig(method="rsm", denoise=False, seed=seed, sample_budget_px=0),
+                           config or RsmConfig())
         method.set_scene(scene)
         images.append(method.run().images["indirect"][rows, cols, 0])
     return np.array(images)
