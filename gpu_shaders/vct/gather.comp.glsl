@@ -38,7 +38,7 @@ void main() {
     vec3 u = fract(image_random + pixel_pattern(px, sample_index));
     float jitter = u.x, rotation = 6.28318531 * u.y, dither = u.z;
     vec4 e = gather_diffuse(pos.xyz, n, rotation, jitter, dither);
-    // Every pixel gathers `image_gathers` times (VctConfig.gather_budget_px: a small image, whose filter
+    // Every pixel gathers `image_gathers` times (GIConfig.sample_budget_px: a small image, whose filter
     // has few pixels to average, spends the gathers a larger one would), and where the denoise filter will
     // find little of the pixel's own surface around it (`support`, from passes/surface_support.py, at the
     // pixel the texel stands for), which it cannot average, `support_gathers` times that. Gather g of n
