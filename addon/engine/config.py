@@ -309,6 +309,12 @@ class DiffusionConfig(_Validated):
     # cornell-area 0.262 -> 0.279 worse. Six propagations: a lights update 3-5x slower on llvmpipe.
     emitter_class_passes: bool = field(default=True, metadata={
         "doc": "a side takes in no light from sides facing its way (six propagations per bounce)"})
+    # On: the grid runs only its first near_steps and a grid of twice the cell (its own voxels and cells)
+    # carries the light further, each counting its absorption by time of flight (docs/DIFFUSION.md, "Far
+    # field"). grid_cells >= 32 (a coarser grid than 16 cells resolves too little of a room).
+    far_field: bool = field(default=True, metadata={
+        "doc": "carry light beyond the near steps on a grid of twice the cell size (fewer fine steps)"})
+    near_steps: int = _num(0, 0, 4096, "far field: steps the fine grid runs (0: the grid's longest side)")
 
 
 @dataclass(frozen=True)

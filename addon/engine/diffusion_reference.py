@@ -6,6 +6,8 @@ forms, tests/gpu/test_diffusion.py checks the GPU passes against it. It mirrors
 - passes/diffusion_cells.py (gpu_shaders/diffusion/cells.comp.glsl): `cells`;
 - passes/diffusion_propagate.py (diffusion/emit.comp.glsl, diffusion/propagate.comp.glsl): `emit`,
   `face_fluxes`, `step`;
+- passes/diffusion_far_field.py (diffusion/far_field_source.comp.glsl, far_field_add.comp.glsl):
+  `far_source`, `far_add`;
 - passes/diffusion_lookup.py (diffusion/lookup.comp.glsl): `lookup`.
 docs/DIFFUSION.md derives the equations. float64 here, fp32 on the GPU.
 
@@ -304,6 +306,66 @@ def propagate(field: np.ndarray, cell: dict, steps: int,
         plus += p
         minus += m
     return field, plus, minus
+
+
+# -- far field -----------------------------------------------------------------------------------------
+# passes/diffusion_far_field.py: a coarse grid of twice the cell carries light beyond the fine grid's
+# near steps. Coarse cell j holds fine cells 2j .. 2j + 1 on each axis.
+def _agrees(normal: np.ndarray, coarse_normal: np.ndarray) -> np.ndarray:
+    """(z, y, x) bool: whether each fine cell's plus side pairs with its coarse cell's plus side (their
+    normals at most 90 degrees apart)."""
+    nz, ny, nx = normal.shape[:3]
+    up = coarse_normal[np.arange(nz)[:, None, None] // 2, np.arange(ny)[None, :, None] // 2,
+                       np.arange(nx)[None, None, :] // 2]
+    return np.sum(normal * up, axis=-1) >= 0.0
+
+
+def _coarse_sum(fine: np.ndarray, coarse_shape: tuple) -> np.ndarray:
+    """Per coarse cell the sum of its fine cells (fine cells past an odd edge hold nothing)."""
+    padded = np.zeros(tuple(2 * n for n in coarse_shape))
+    padded[tuple(slice(0, n) for n in fine.shape)] = fine
+    cz, cy, cx = coarse_shape
+    return padded.reshape(cz, 2, cy, 2, cx, 2).sum(axis=(1, 3, 5))
+
+
+def far_source(flux_plus: np.ndarray, flux_minus: np.ndarray, cell: dict, coarse_normal: np.ndarray,
+               albedo: np.ndarray | float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """The coarse grid's emitted flux per side (plus, minus), W: the fine sides' albedo x flux summed, a
+    side into the coarse side it pairs with (`_agrees`), an empty fine cell's half into each. Nothing is
+    lost or gained: the two sum to the fine flux."""
+    fp = np.asarray(flux_plus, np.float64) * albedo
+    fm = np.asarray(flux_minus, np.float64) * albedo
+    agrees = _agrees(cell["normal"], coarse_normal)
+    occupied = cell["occupied"]
+    to_plus = np.where(occupied, np.where(agrees, fp, fm), 0.5 * (fp + fm))
+    to_minus = np.where(occupied, np.where(agrees, fm, fp), 0.5 * (fp + fm))
+    shape = coarse_normal.shape[:3]
+    return _coarse_sum(to_plus, shape), _coarse_sum(to_minus, shape)
+
+
+def far_add(far_plus: np.ndarray, far_minus: np.ndarray, coarse_cell: dict, cell: dict) -> tuple[np.ndarray, np.ndarray]:
+    """What the fine sides (plus, minus) take of the coarse grid's absorbed flux, W: each fine side that
+    light can reach takes from the coarse side it pairs with area / max(coarse area, the paired fine
+    sides' areas summed), areas in fine cells^2 (4 per coarse cell^2). The fine sides then read the coarse
+    side's flux / area where their areas agree and never more, and together take at most its flux."""
+    agrees = _agrees(cell["normal"], coarse_cell["normal"])
+    own_plus = cell["area"] * cell["receives"][..., 0]
+    own_minus = cell["area"] * cell["receives"][..., 1]
+    to_coarse_plus = np.where(agrees, own_plus, own_minus)  # the fine side paired with the coarse plus side
+    to_coarse_minus = np.where(agrees, own_minus, own_plus)
+    shape = coarse_cell["normal"].shape[:3]
+    coarse_area = 4.0 * coarse_cell["area"]
+
+    def share(to_side, coarse_flux):
+        denominator = np.maximum(coarse_area, _coarse_sum(to_side, shape))
+        per_area = np.divide(coarse_flux, denominator, out=np.zeros(shape), where=denominator > 0)
+        nz, ny, nx = to_side.shape
+        return to_side * per_area[np.arange(nz)[:, None, None] // 2, np.arange(ny)[None, :, None] // 2,
+                                  np.arange(nx)[None, None, :] // 2]
+
+    from_plus = share(to_coarse_plus, np.asarray(far_plus, np.float64))
+    from_minus = share(to_coarse_minus, np.asarray(far_minus, np.float64))
+    return np.where(agrees, from_plus, from_minus), np.where(agrees, from_minus, from_plus)
 
 
 # -- reconstruction ------------------------------------------------------------------------------------

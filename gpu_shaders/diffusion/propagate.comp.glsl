@@ -5,7 +5,8 @@
 // surface (if any) absorbs block[axis] of each face's inflow, on the side the light travels into; the
 // rest is carried on in the transfer's shape: cone, a uniform intensity over the face's cone, 3 / (2 pi)
 // T_f per W (the normalisation that keeps a uniform field unchanged); DIRECTIONAL, M_d L per W of it.
-// Absorbed flux (W, per side) goes to acc_plus / acc_minus (first_step: written, else added).
+// Absorbed flux (W, per side) times `weight` (1, or a far field's share of this step by time of flight,
+// passes/diffusion_far_field.py) goes to acc_plus / acc_minus (first_step: written, else added).
 #include "diffusion/cell.glsl"
 
 #ifdef DIRECTIONAL
@@ -120,6 +121,8 @@ void main() {
     imageStore(dst_r, c, r);
     imageStore(dst_g, c, g);
     imageStore(dst_b, c, b);
+    plus *= weight;
+    minus *= weight;
     if (first_step == 0) {
         plus += imageLoad(acc_plus, c).rgb;
         minus += imageLoad(acc_minus, c).rgb;

@@ -1,4 +1,4 @@
-"""The `diffusion` passes (cells, inject, emit, propagate, add, lookup) against their numpy twin,
+"""The `diffusion` passes (cells, inject, emit, propagate, add, far field, lookup) against their numpy twin,
 addon/engine/diffusion_reference.py, whose own closed-form checks are tests/unit/test_diffusion_reference.py.
 
 The GPU computes in fp32 what the twin computes in float64: sums of a few dozen products of numbers of
@@ -14,7 +14,14 @@ from addon.engine import diffusion_reference as ref
 from addon.engine import sh
 from addon.engine.grid import Grid
 from addon.engine.passes import atlas as atlas_pass
-from addon.engine.passes import diffusion_cells, diffusion_inject, diffusion_lookup, diffusion_propagate
+from addon.engine.passes import (
+    diffusion_cells,
+    diffusion_far_field,
+    diffusion_inject,
+    diffusion_lookup,
+    diffusion_propagate,
+    lpv_far_field,
+)
 
 pytestmark = pytest.mark.gpu
 
@@ -99,7 +106,8 @@ def sh_volumes(gl, grid, data=None):
 @pytest.mark.parametrize("transfer", ref.TRANSFERS)
 def test_propagation_steps_are_the_twins(gl, transfer):
     # Two steps through random cells: the next fields, and the absorbed flux written by the first step
-    # and added by the second (stale contents in the accumulation are overwritten by the first).
+    # and added by the second (stale contents in the accumulation are overwritten by the first), the
+    # second's counted at a far field's weight 0.25 (the field it carries on is unchanged by it).
     rng = np.random.default_rng(2)
     voxels = random_voxels(rng, GRID)
     _, cells = gpu_cells(gl, voxels)
@@ -110,13 +118,13 @@ def test_propagation_steps_are_the_twins(gl, transfer):
     cell = ref_cells(voxels)
     want = [np.asarray(f, np.float64) for f in fields]
     plus, minus = np.zeros((3, *zyx(GRID, 0)[:3])), np.zeros((3, *zyx(GRID, 0)[:3]))
-    for i in range(2):
+    for i, weight in enumerate((1.0, 0.25)):
         diffusion_propagate.run(gl, sets[i % 2], sets[(i + 1) % 2], absorbed, cells, GRID, first_step=i == 0,
-                                transfer=transfer)
+                                transfer=transfer, weight=weight)
         for ch in range(3):
             want[ch], p, m = ref.step(want[ch], cell, transfer)
-            plus[ch] += p
-            minus[ch] += m
+            plus[ch] += weight * p
+            minus[ch] += weight * m
         got = [gl.read(sets[(i + 1) % 2][f"sh_{c}"]) for c in "rgb"]
         for ch in range(3):
             np.testing.assert_allclose(got[ch], want[ch], rtol=0, atol=RTOL * np.abs(want[ch]).max())
@@ -125,6 +133,16 @@ def test_propagation_steps_are_the_twins(gl, transfer):
     for ch in range(3):
         np.testing.assert_allclose(got_plus[..., ch], plus[ch], rtol=0, atol=RTOL * plus.max())
         np.testing.assert_allclose(got_minus[..., ch], minus[ch], rtol=0, atol=RTOL * minus.max())
+
+
+def atlas_of(gl, atlas, grid, volume):
+    """The injection atlas (layer z as tile z) holding a (z, y, x, 4) volume."""
+    a = np.zeros((atlas.size[1], atlas.size[0], 4), np.float32)
+    nx, ny, _ = grid.dims
+    for z in range(grid.dims[2]):
+        tx, ty = z % atlas.tiles_x, z // atlas.tiles_x
+        a[ty * ny:(ty + 1) * ny, tx * nx:(tx + 1) * nx] = volume[z]
+    return gl.texture(atlas.size, "RGBA32F", a)
 
 
 @pytest.mark.parametrize("emitter_class", [ref.EVERY_CLASS, 0, 5])
@@ -139,14 +157,7 @@ def test_emitters_are_the_twins(gl, emitter_class):
     fp, fm = (rng.uniform(0.0, 2.0, zyx(GRID)).astype(np.float32) for _ in range(2))
     atlas, injected, _ = diffusion_inject.atlas_target(gl, GRID)
     assert atlas.tiles_x == 2  # 4 layers as 2 x 2 tiles: the tiling is exercised
-    tiles = {}
-    for name, vol in (("flux_plus", fp), ("flux_minus", fm)):
-        a = np.zeros((atlas.size[1], atlas.size[0], 4), np.float32)
-        nx, ny, _ = GRID.dims
-        for z in range(GRID.dims[2]):
-            tx, ty = z % atlas.tiles_x, z // atlas.tiles_x
-            a[ty * ny:(ty + 1) * ny, tx * nx:(tx + 1) * nx] = vol[z]
-        tiles[name] = gl.texture(atlas.size, "RGBA32F", a)
+    tiles = {"flux_plus": atlas_of(gl, atlas, GRID, fp), "flux_minus": atlas_of(gl, atlas, GRID, fm)}
     volumes = {"flux_plus": gl.texture(GRID.dims, "RGBA32F", fp), "flux_minus": gl.texture(GRID.dims, "RGBA32F", fm)}
     for source, albedo in ((tiles, None), (volumes, voxels["vox_albedo"])):
         out = sh_volumes(gl, GRID, [np.full(zyx(GRID), 9.0, np.float32)] * 3)
@@ -238,6 +249,63 @@ def test_add_skips_the_sides_of_the_propagated_class(gl, skip_class):
             assert skipped.any() and not skipped.all()
             kept = 0.0 if first else b
             np.testing.assert_allclose(gl.read(total[side]), np.where(skipped, kept, kept + a), rtol=1e-7)
+
+
+def far_grids(gl, rng):
+    """Random fine cells on GRID (6 x 5 x 4: the odd y side leaves the last coarse layer half empty) and
+    independent random cells on its far-field grid (3 x 3 x 2), both dense enough that coarse cells
+    hold several occupied fine cells of both pairings."""
+    coarse = lpv_far_field.grid_for(GRID)
+    assert coarse.dims == (3, 3, 2)
+    fine_voxels, coarse_voxels = random_voxels(rng, GRID, share=0.6), random_voxels(rng, coarse, share=0.8)
+    fine_textures, fine_cells = gpu_cells(gl, fine_voxels)
+    _, coarse_cells = gpu_cells(gl, coarse_voxels, coarse)
+    return coarse, fine_voxels, fine_textures, fine_cells, ref_cells(fine_voxels), coarse_cells, \
+        ref_cells(coarse_voxels)
+
+
+def test_far_field_sources_are_the_twins(gl):
+    # From the injection atlas (the first bounce) and from absorbed flux volumes times the fine albedo:
+    # each coarse side sums the fine sides paired with it, an empty fine cell's flux half to each.
+    rng = np.random.default_rng(11)
+    coarse, voxels, textures, cells, cell, coarse_cells, coarse_cell = far_grids(gl, rng)
+    fp, fm = (rng.uniform(0.0, 2.0, zyx(GRID)).astype(np.float32) for _ in range(2))
+    atlas, _, _ = diffusion_inject.atlas_target(gl, GRID)
+    atlases = {"flux_plus": atlas_of(gl, atlas, GRID, fp), "flux_minus": atlas_of(gl, atlas, GRID, fm)}
+    volumes = {"flux_plus": gl.texture(GRID.dims, "RGBA32F", fp), "flux_minus": gl.texture(GRID.dims, "RGBA32F", fm)}
+    agrees = ref._agrees(cell["normal"], coarse_cell["normal"])
+    assert (agrees & cell["occupied"]).any() and (~agrees & cell["occupied"]).any()
+    for flux, albedo in ((atlases, None), (volumes, voxels["vox_albedo"])):
+        out = {k: gl.texture(coarse.dims, "RGBA32F", np.full(zyx(coarse), 9.0, np.float32))
+               for k in ("flux_plus", "flux_minus")}
+        diffusion_far_field.source(gl, flux, cells, GRID, out, coarse_cells, coarse,
+                                   atlas=atlas if albedo is None else None,
+                                   vox_albedo=None if albedo is None else textures["vox_albedo"])
+        got_plus, got_minus = gl.read(out["flux_plus"]), gl.read(out["flux_minus"])
+        for ch in range(3):
+            a = 1.0 if albedo is None else albedo[..., ch]
+            plus, minus = ref.far_source(fp[..., ch], fm[..., ch], cell, coarse_cell["normal"], a)
+            np.testing.assert_allclose(got_plus[..., ch], plus, rtol=0, atol=RTOL * plus.max())
+            np.testing.assert_allclose(got_minus[..., ch], minus, rtol=0, atol=RTOL * minus.max())
+
+
+def test_far_field_add_is_the_twins(gl):
+    # The coarse absorbed flux shared out to the fine sides light can reach, by area, added to what the
+    # fine grid absorbed itself.
+    rng = np.random.default_rng(12)
+    coarse, _, _, cells, cell, coarse_cells, coarse_cell = far_grids(gl, rng)
+    far_plus, far_minus = (rng.uniform(0.0, 2.0, zyx(coarse)).astype(np.float32) for _ in range(2))
+    own = rng.uniform(0.0, 1.0, zyx(GRID)).astype(np.float32)
+    absorbed = {k: gl.texture(GRID.dims, "RGBA32F", own) for k in ("flux_plus", "flux_minus")}
+    far = {"flux_plus": gl.texture(coarse.dims, "RGBA32F", far_plus),
+           "flux_minus": gl.texture(coarse.dims, "RGBA32F", far_minus)}
+    diffusion_far_field.add(gl, far, coarse_cells, absorbed, cells, GRID)
+    got_plus, got_minus = gl.read(absorbed["flux_plus"]), gl.read(absorbed["flux_minus"])
+    for ch in range(3):
+        plus, minus = ref.far_add(far_plus[..., ch], far_minus[..., ch], coarse_cell, cell)
+        assert plus.max() > 0 and minus.max() > 0
+        np.testing.assert_allclose(got_plus[..., ch] - own[..., ch], plus, rtol=0, atol=RTOL * plus.max())
+        np.testing.assert_allclose(got_minus[..., ch] - own[..., ch], minus, rtol=0, atol=RTOL * minus.max())
 
 
 def test_lookup_is_the_twins(gl):

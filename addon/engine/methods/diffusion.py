@@ -7,7 +7,10 @@ bounce and emitter class (six with DiffusionConfig.emitter_class_passes, else on
 sides' flux as Lambertian L1 SH lobes about their normals: the injected direct light, then each bounce's
 absorbed flux times albedo), steps x diffusion_propagate (gather form, ping-pong, absorbed flux
 accumulated per side), the class's light added to the bounce's at every side of another class, and the
-bounce added to the light field (diffusion_propagate.add); the gather: diffusion_lookup -> `indirect`
+bounce added to the light field (diffusion_propagate.add); with DiffusionConfig.far_field (grids of
+diffusion_far_field.MIN_GRID_CELLS and more) the grid runs only its near steps and a grid of twice the
+cell (its own voxelizer and cells) the rest, each bounce's emitters summed into it and each class's
+absorbed flux shared back (diffusion_far_field); the gather: diffusion_lookup -> `indirect`
 (Cycles' Diffuse Indirect). The light field does not depend on the camera: a camera move re-runs only
 the lookup.
 docs/DIFFUSION.md derives the transport and measures it; diffusion_reference.py is its numpy twin.
@@ -23,9 +26,11 @@ from ..grid import Grid
 from ..passes import (
     declare,
     diffusion_cells,
+    diffusion_far_field,
     diffusion_inject,
     diffusion_lookup,
     diffusion_propagate,
+    lpv_far_field,
     voxelize,
     zero,
 )
@@ -42,16 +47,31 @@ def steps_per_bounce(config: DiffusionConfig, grid: Grid, bounces: int) -> int:
     return max(1, min(per_bounce, config.max_steps // bounces))
 
 
+class FarGrid:
+    """The far field's grid (diffusion_far_field): twice the fine grid's cell, its own voxels and cells,
+    the emitted flux summed from the fine grid's, two snapshots and what its surfaces absorb."""
+
+    def __init__(self, backend, fine: Grid):
+        self.grid = lpv_far_field.grid_for(fine)
+        self.voxelizer = Voxelizer(backend, self.grid)
+        self.cells = diffusion_cells.textures(backend, self.grid)
+        self.snapshots = [{f"sh_{c}": backend.texture(self.grid.dims) for c in "rgb"} for _ in range(2)]
+        self.emitted = diffusion_propagate.sides(backend, self.grid)
+        self.absorbed = diffusion_propagate.sides(backend, self.grid)
+
+
 class DiffusionMethod(OneBounceMethod):
     spec = registry.get("diffusion")
     PASSES = declare.extend(OneBounceMethod.PASSES, setup=(voxelize.DECL, diffusion_cells.DECL),
-                            solve=(diffusion_inject.DECL, diffusion_inject.EMIT_DECL, diffusion_propagate.DECL),
+                            solve=(diffusion_inject.DECL, diffusion_inject.EMIT_DECL, diffusion_propagate.DECL,
+                                   diffusion_far_field.DECL),
                             gather=(diffusion_lookup.DECL,))
 
     def __init__(self, backend, gi, rsm_config, diffusion_config: DiffusionConfig | None = None):
         super().__init__(backend, gi, rsm_config)
         self.diffusion_config = diffusion_config if diffusion_config is not None else DiffusionConfig()
         self.grid: Grid | None = None
+        self.far: FarGrid | None = None
 
     def set_scene(self, scene) -> None:
         """Upload the scene; while the grid (fitted to the bounds) stays, the voxelizer redraws only the
@@ -61,6 +81,8 @@ class DiffusionMethod(OneBounceMethod):
         grid = Grid.fit(*self.bounds_m, max_cells=self.diffusion_config.grid_cells)
         if grid.same_cells(self.grid):
             self.voxelizer.update(self.scene)
+            if self.far is not None:
+                self.far.voxelizer.update(self.scene)
         else:
             self.grid = grid
             self.voxelizer = Voxelizer(be, grid)
@@ -74,8 +96,14 @@ class DiffusionMethod(OneBounceMethod):
             self.bounce_flux = ([diffusion_propagate.sides(be, grid) for _ in range(min(2, self.gi.bounces))]
                                 if self.diffusion_config.emitter_class_passes else [self.absorbed])
             self.accumulated = diffusion_propagate.sides(be, grid) if self.gi.bounces > 1 else self.bounce_flux[0]
+            self.far = (FarGrid(be, grid) if self.diffusion_config.far_field
+                        and max(grid.dims) >= diffusion_far_field.MIN_GRID_CELLS else None)
+            if self.far is not None:
+                self.far.voxelizer.set_scene(self.scene)
         self.voxels = self.voxelizer.run()
         diffusion_cells.run(be, self.voxels, self.cells, self.grid)
+        if self.far is not None:
+            diffusion_cells.run(be, self.far.voxelizer.run(), self.far.cells, self.far.grid)
 
     def begin_solve(self, timings: dict[str, float]) -> None:
         zero.images(self.backend, list(self.injected.values()))
@@ -88,16 +116,27 @@ class DiffusionMethod(OneBounceMethod):
 
     def finish_solve(self, timings: dict[str, float]) -> None:
         """Each bounce: per emitter class, its emitters (the injected light, then the last bounce's
-        absorbed flux x albedo) and their propagation into `absorbed`, added to the bounce's flux at the
-        sides of the other classes; the bounce added to `accumulated` (the same volumes with one bounce)."""
-        be, grid, cells = self.backend, self.grid, self.cells
+        absorbed flux x albedo) and their propagation into `absorbed` (with a far field, the near steps'
+        share plus the far grid's), added to the bounce's flux at the sides of the other classes; the
+        bounce added to `accumulated` (the same volumes with one bounce)."""
+        be, grid, cells, far = self.backend, self.grid, self.cells, self.far
         steps = steps_per_bounce(self.diffusion_config, grid, self.gi.bounces)
+        near = diffusion_far_field.near_steps(self.diffusion_config.near_steps, grid, steps) if far else steps
+        # Without a far field every step counts whole; with one the fine grid's count falls to 0 at `near`.
+        fine_weights = ([lpv_far_field.fine_weight(i, near) for i in range(1, max(2, near))] if far
+                        else [1.0] * steps)
         transfer = self.diffusion_config.transfer
         classes = (diffusion_inject.EMITTER_CLASSES if self.diffusion_config.emitter_class_passes
                    else (diffusion_inject.EVERY_CLASS,))
         previous = None  # the last bounce's flux, which the next one re-emits
         for bounce in range(1, self.gi.bounces + 1):
             flux = self.bounce_flux[bounce % len(self.bounce_flux)]
+            if far is not None:
+                with self.step(timings, diffusion_far_field.DECL):
+                    diffusion_far_field.source(be, self.injected if previous is None else previous, cells, grid,
+                                               far.emitted, far.cells, far.grid,
+                                               atlas=self.atlas if previous is None else None,
+                                               vox_albedo=None if previous is None else self.voxels["vox_albedo"])
             for k in classes:
                 with self.step(timings, diffusion_inject.EMIT_DECL):
                     if previous is None:
@@ -107,10 +146,14 @@ class DiffusionMethod(OneBounceMethod):
                         diffusion_inject.emit(be, previous, cells, self.snapshots[0], grid,
                                               vox_albedo=self.voxels["vox_albedo"], emitter_class=k)
                 with self.step(timings, diffusion_propagate.DECL):
-                    for i in range(steps):
+                    for i, weight in enumerate(fine_weights):
                         diffusion_propagate.run(be, self.snapshots[i % 2], self.snapshots[(i + 1) % 2], self.absorbed,
-                                                cells, grid, first_step=i == 0, transfer=transfer)
-                    if flux is not self.absorbed:
+                                                cells, grid, first_step=i == 0, transfer=transfer, weight=weight)
+                if far is not None:
+                    with self.step(timings, diffusion_far_field.DECL):
+                        self._propagate_far(k, near, transfer)
+                if flux is not self.absorbed:
+                    with self.step(timings, diffusion_propagate.DECL):
                         diffusion_propagate.add(be, self.absorbed, flux, grid, first=k == classes[0],
                                                 cell_normal=cells["cell_normal"], skip_class=k)
             if self.accumulated is not flux:
@@ -118,6 +161,17 @@ class DiffusionMethod(OneBounceMethod):
                     diffusion_propagate.add(be, flux, self.accumulated, grid, first=bounce == 1,
                                             cell_normal=cells["cell_normal"])
             previous = flux
+
+    def _propagate_far(self, emitter_class: int, near: int, transfer: str) -> None:
+        """The far grid's propagation of one emitter class (its whole span, each step counted by its
+        share of the time of flight the fine grid's `near` steps leave), added to the fine `absorbed`."""
+        be, far = self.backend, self.far
+        diffusion_inject.emit(be, far.emitted, far.cells, far.snapshots[0], far.grid, emitter_class=emitter_class)
+        for i in range(steps_per_bounce(self.diffusion_config, far.grid, self.gi.bounces)):
+            diffusion_propagate.run(be, far.snapshots[i % 2], far.snapshots[(i + 1) % 2], far.absorbed, far.cells,
+                                    far.grid, first_step=i == 0, transfer=transfer,
+                                    weight=lpv_far_field.coarse_weight(i + 1, near))
+        diffusion_far_field.add(be, far.absorbed, far.cells, self.absorbed, self.cells, self.grid)
 
     def gather_pixels(self, timings: dict[str, float]) -> None:
         with self.step(timings, diffusion_lookup.DECL):

@@ -38,7 +38,7 @@ def _spec(transfer: str) -> ShaderSpec:
                   Sampler("cell_block", "3D")),
         images=(*(Image(f"dst_{c}", "3D", "RGBA32F", "write") for c in "rgb"),
                 Image("acc_plus", "3D", "RGBA32F", "read_write"), Image("acc_minus", "3D", "RGBA32F", "read_write")),
-        uniforms=(Var("dims", "ivec3"), Var("first_step", "int"))
+        uniforms=(Var("dims", "ivec3"), Var("first_step", "int"), Var("weight", "float"))
         + ((Var("m_cross", "float"), Var("m_along", "float"), Var("m_side", "float"), Var("flux_cross", "float"))
            if directional else ()),
         defines=(("DIRECTIONAL", "1"),) if directional else (),
@@ -92,11 +92,11 @@ def sides(backend: Backend, grid: Grid) -> dict:
 
 
 def run(backend: Backend, src: dict, dst: dict, absorbed: dict, cells: dict, grid: Grid, first_step: bool,
-        transfer: str = "cone") -> None:
-    """One step: src (sh_r/g/b) -> dst, the flux absorbed written (first_step) or added into `absorbed`
-    (flux_plus / flux_minus)."""
+        transfer: str = "cone", weight: float = 1.0) -> None:
+    """One step: src (sh_r/g/b) -> dst, the flux absorbed times `weight` (a far field's share of the step,
+    diffusion_far_field) written (first_step) or added into `absorbed` (flux_plus / flux_minus)."""
     spec = SPECS[transfer]
-    uniforms = {"dims": grid.dims, "first_step": int(first_step)}
+    uniforms = {"dims": grid.dims, "first_step": int(first_step), "weight": weight}
     if transfer == "directional":
         c = improved_constants()
         uniforms.update(m_cross=c["m_cross"], m_along=c["m_along"], m_side=c["m_side"], flux_cross=flux_cross())
