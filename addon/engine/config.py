@@ -311,10 +311,11 @@ class DiffusionConfig(_Validated):
         "doc": "a side takes in no light from sides facing its way (six propagations per bounce)"})
     # On: the grid runs only its first near_steps and a grid of twice the cell (its own voxels and cells)
     # carries the light further, each counting its absorption by time of flight (docs/DIFFUSION.md, "Far
-    # field"). grid_cells >= 32 (a coarser grid than 16 cells resolves too little of a room).
+    # field"). grid_cells >= 32 (a coarser grid than 16 cells resolves too little of a room). The flags
+    # --far-field / --near-steps set lpv's and diffusion's alike (same name, same default).
     far_field: bool = field(default=True, metadata={
         "doc": "carry light beyond the near steps on a grid of twice the cell size (fewer fine steps)"})
-    near_steps: int = _num(0, 0, 4096, "far field: steps the fine grid runs (0: the grid's longest side)")
+    near_steps: int = _num(0, 0, 256, "far field: steps the fine grid runs (0: half of grid_cells)")
 
 
 @dataclass(frozen=True)

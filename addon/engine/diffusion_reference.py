@@ -6,8 +6,8 @@ forms, tests/gpu/test_diffusion.py checks the GPU passes against it. It mirrors
 - passes/diffusion_cells.py (gpu_shaders/diffusion/cells.comp.glsl): `cells`;
 - passes/diffusion_propagate.py (diffusion/emit.comp.glsl, diffusion/propagate.comp.glsl): `emit`,
   `face_fluxes`, `step`;
-- passes/diffusion_far_field.py (diffusion/far_field_source.comp.glsl, far_field_add.comp.glsl):
-  `far_source`, `far_add`;
+- passes/diffusion_far_field.py (diffusion/far_field_move, far_field_weights, far_field_add.comp.glsl):
+  `far_move_enclosed`, `far_weights`, `far_add`;
 - passes/diffusion_lookup.py (diffusion/lookup.comp.glsl): `lookup`.
 docs/DIFFUSION.md derives the equations. float64 here, fp32 on the GPU.
 
@@ -281,19 +281,26 @@ def step(field: np.ndarray, cell: dict, transfer: str = "cone") -> tuple[np.ndar
     """One gather step: (next field, flux absorbed on the plus side, on the minus side), W.
 
     Each cell gathers its neighbours' face fluxes a_d (`face_fluxes`, `inflow`). An occupied cell's
-    surface absorbs block[axis(d)] x a_d, split between its sides (`side_weights`); the rest, and all of
-    an empty cell's inflow, is carried on as the transfer's SH per W (`carried_shapes`): the next field
-    is sum_d carried_d x shape_d, of flux sum_d carried_d (nothing is gained). Absorbed light is not
-    re-emitted within the step: each bounce is its own propagation (`emit` makes the next emitters)."""
+    surface absorbs block[axis(d)] x a_d (`step_by_face`), split between its sides (`side_weights`); the
+    rest, and all of an empty cell's inflow, is carried on as the transfer's SH per W
+    (`carried_shapes`): the next field is sum_d carried_d x shape_d, of flux sum_d carried_d (nothing
+    is gained). Absorbed light is not re-emitted within the step: each bounce is its own propagation
+    (`emit` makes the next emitters)."""
+    nxt, absorbed = step_by_face(field, cell, transfer)
+    plus = side_weights(cell["normal"])
+    return nxt, np.sum(absorbed * plus, -1), np.sum(absorbed * (1.0 - plus), -1)
+
+
+def step_by_face(field: np.ndarray, cell: dict, transfer: str = "cone") -> tuple[np.ndarray, np.ndarray]:
+    """One gather step (`step`): (next field, flux absorbed by the face it came through (z, y, x, 6), W),
+    as the far field's grid keeps it (diffusion_far_field)."""
     out = face_fluxes(field, cell["open"], transfer)
     a = inflow(out)
     shape = inflow(np.ascontiguousarray(carried_shapes(field, cell["open"], out, transfer)))
     axis_of_face = np.array([axis for axis, _ in AXES])
     absorbed = a * cell["block"][..., axis_of_face]
-    carried = a - absorbed
-    plus = side_weights(cell["normal"])
-    nxt = np.einsum("...d,...dk->...k", carried, shape)
-    return nxt, np.sum(absorbed * plus, -1), np.sum(absorbed * (1.0 - plus), -1)
+    nxt = np.einsum("...d,...dk->...k", a - absorbed, shape)
+    return nxt, absorbed
 
 
 def propagate(field: np.ndarray, cell: dict, steps: int,
@@ -309,63 +316,125 @@ def propagate(field: np.ndarray, cell: dict, steps: int,
 
 
 # -- far field -----------------------------------------------------------------------------------------
-# passes/diffusion_far_field.py: a coarse grid of twice the cell carries light beyond the fine grid's
-# near steps. Coarse cell j holds fine cells 2j .. 2j + 1 on each axis.
-def _agrees(normal: np.ndarray, coarse_normal: np.ndarray) -> np.ndarray:
-    """(z, y, x) bool: whether each fine cell's plus side pairs with its coarse cell's plus side (their
-    normals at most 90 degrees apart)."""
-    nz, ny, nx = normal.shape[:3]
-    up = coarse_normal[np.arange(nz)[:, None, None] // 2, np.arange(ny)[None, :, None] // 2,
-                       np.arange(nx)[None, None, :] // 2]
-    return np.sum(normal * up, axis=-1) >= 0.0
+# passes/diffusion_far_field.py: a grid of twice the cell carries light beyond the fine grid's near steps;
+# far cell j holds fine cells 2j and 2j + 1 on each axis.
+_NEIGHBOURS_18 = [o for o in np.ndindex(3, 3, 3) if sum(abs(v - 1) for v in o) in (1, 2)]  # (z, y, x) + 1
 
 
-def _coarse_sum(fine: np.ndarray, coarse_shape: tuple) -> np.ndarray:
-    """Per coarse cell the sum of its fine cells (fine cells past an odd edge hold nothing)."""
-    padded = np.zeros(tuple(2 * n for n in coarse_shape))
-    padded[tuple(slice(0, n) for n in fine.shape)] = fine
-    cz, cy, cx = coarse_shape
+def _enclosed(cell: dict) -> np.ndarray:
+    return cell["occupied"] & ~cell["open"].any(-1)
+
+
+def far_move_enclosed(fields: np.ndarray, far_cell: dict) -> np.ndarray:
+    """The far grid's emitters (3, z, y, x, 4: rgb fields summed from the fine grid's) with the light of
+    each enclosed cell (occupied, no open face) moved to its face and edge neighbours that are not
+    enclosed, in proportion to 1e-3 + max(0, u.w): u the unit offset, w the mean direction of the cell's
+    light (band 1 of its channels' sum, (y, z, x) in SH order). It stays where no neighbour takes it."""
+    enclosed = _enclosed(far_cell)
+    out = np.array(fields, np.float64)
+    shape = enclosed.shape
+    for z, y, x in zip(*np.nonzero(enclosed), strict=True):
+        band1 = fields[:, z, y, x, 1:].sum(axis=0)  # y, z, x
+        w = np.array([band1[2], band1[0], band1[1]])
+        w = w / np.linalg.norm(w) if np.linalg.norm(w) > 0 else w
+        takers, weights = [], []
+        for oz, oy, ox in _NEIGHBOURS_18:
+            n = (z + oz - 1, y + oy - 1, x + ox - 1)
+            if all(0 <= v < m for v, m in zip(n, shape, strict=True)) and not enclosed[n]:
+                u = np.array([ox - 1, oy - 1, oz - 1], np.float64)
+                takers.append(n)
+                weights.append(1e-3 + max(0.0, float(u @ w) / np.linalg.norm(u)))
+        if not takers:
+            continue
+        light = np.array(fields[:, z, y, x])
+        out[:, z, y, x] -= light
+        for n, share in zip(takers, np.array(weights) / sum(weights), strict=True):
+            out[:, n[0], n[1], n[2]] += share * light
+    return out
+
+
+def _fine_face_weights(cell: dict) -> tuple[np.ndarray, np.ndarray]:
+    """(plus, minus), each (z, y, x, 6): a fine side's weight for light through face d: its block on d's
+    axis times the share landing on it (`side_weights`), 0 on a side no light reaches."""
+    axis_of_face = np.array([axis for axis, _ in AXES])
+    to_plus = side_weights(cell["normal"])
+    block = cell["block"][..., axis_of_face] * cell["occupied"][..., None]
+    return block * to_plus * cell["receives"][..., 0:1], block * (1.0 - to_plus) * cell["receives"][..., 1:2]
+
+
+def _face_shift(a: np.ndarray, axis: int, sign: float, fill) -> np.ndarray:
+    """a (z, y, x, ...) read at cell + sign x the unit vector of `axis` (x, y, z), `fill` outside."""
+    zyx = 2 - axis
+    pad = [(0, 0)] * a.ndim
+    pad[zyx] = (1, 1)
+    padded = np.pad(a, pad, constant_values=fill)
+    index = [slice(None)] * a.ndim
+    index[zyx] = slice(1 + int(sign), padded.shape[zyx] - 1 + int(sign))
+    return padded[tuple(index)]
+
+
+def _tents(shape: tuple, far_shape: tuple, shift: tuple):
+    """For each of the 8 far cells around every fine cell centre (the trilinear corners): the index arrays
+    of that far cell (clipped) and the tent weight (0 where it is outside the far grid), (z, y, x); the
+    far grid starts `shift` (x, y, z) fine cells before the fine one."""
+    at = [(np.arange(n) + s + 0.5) * 0.5 - 0.5 for n, s in zip(shape, shift[::-1], strict=True)]
+    base = [np.floor(a).astype(int) for a in at]
+    for corner in np.ndindex(2, 2, 2):
+        idx, tent = [], 1.0
+        for axis in range(3):
+            j = base[axis] + corner[axis]
+            t = at[axis] - base[axis]
+            w = (t if corner[axis] else 1.0 - t) * ((j >= 0) & (j < far_shape[axis]))
+            shape_of = [-1 if a == axis else 1 for a in range(3)]
+            idx.append(np.clip(j, 0, far_shape[axis] - 1).reshape(shape_of))
+            tent = tent * w.reshape(shape_of)
+        yield tuple(idx), tent
+
+
+def far_weights(far_cell: dict, cell: dict, shift: tuple = (0, 0, 0)) -> np.ndarray:
+    """(far z, y, x, 6): per far cell and face, the sum over the fine cells within one far cell of its
+    centre of their sides' weight for the face x the trilinear tent (far_field_weights.comp.glsl says
+    why), where the far cell's light through that face came straight from open space (the cell it comes
+    from, cell - d, is in the grid and empty); else 0."""
+    w_plus, w_minus = _fine_face_weights(cell)
+    fine_weight = (w_plus + w_minus) * cell["occupied"][..., None]
+    far_shape = far_cell["occupied"].shape
+    total = np.zeros((*far_shape, 6))
+    for idx, tent in _tents(cell["occupied"].shape, far_shape, shift):
+        np.add.at(total, idx, tent[..., None] * fine_weight)
+    for f, (axis, sign) in enumerate(AXES):
+        from_empty = ~_face_shift(far_cell["occupied"], axis, -sign, True)
+        total[..., f] *= from_empty & far_cell["occupied"]
+    return total
+
+
+def far_add(far_faces: np.ndarray, weights: np.ndarray, cell: dict,
+            shift: tuple = (0, 0, 0)) -> tuple[np.ndarray, np.ndarray]:
+    """What the fine sides (plus, minus; (z, y, x), W) take of the flux the far grid absorbed by the face
+    it came through, `far_faces` (far z, y, x, 6): from each of the 8 far cells around the fine centre
+    with `weights` (`far_weights`) > 0, the side's weight (`_fine_face_weights`) x the tent x that cell's
+    flux / weights. Each far cell's light is shared out whole, and only it."""
+    w_plus, w_minus = _fine_face_weights(cell)
+    per_weight = np.divide(far_faces, weights, out=np.zeros(weights.shape), where=weights > 0)
+    take = np.zeros(w_plus.shape)
+    for idx, tent in _tents(cell["occupied"].shape, weights.shape[:3], shift):
+        take += tent[..., None] * per_weight[idx]
+    take *= cell["occupied"][..., None]
+    return np.sum(w_plus * take, -1), np.sum(w_minus * take, -1)
+
+
+def _coarse_sum_field(field: np.ndarray, far_shape: tuple, shift: tuple = (0, 0, 0)) -> np.ndarray:
+    """A fine field (z, y, x, k) summed per far cell (lpv_far_field.source: radiant intensity adds)."""
+    return np.stack([_coarse_sum(field[..., k], far_shape, shift) for k in range(field.shape[-1])], -1)
+
+
+def _coarse_sum(fine: np.ndarray, far_shape: tuple, shift: tuple = (0, 0, 0)) -> np.ndarray:
+    """Per far cell the sum of its fine cells, the far grid starting `shift` (x, y, z) fine cells before
+    the fine one (fine cells outside the fine grid hold nothing)."""
+    padded = np.zeros(tuple(2 * n for n in far_shape))
+    padded[tuple(slice(s, s + n) for n, s in zip(fine.shape, shift[::-1], strict=True))] = fine
+    cz, cy, cx = far_shape
     return padded.reshape(cz, 2, cy, 2, cx, 2).sum(axis=(1, 3, 5))
-
-
-def far_source(flux_plus: np.ndarray, flux_minus: np.ndarray, cell: dict, coarse_normal: np.ndarray,
-               albedo: np.ndarray | float = 1.0) -> tuple[np.ndarray, np.ndarray]:
-    """The coarse grid's emitted flux per side (plus, minus), W: the fine sides' albedo x flux summed, a
-    side into the coarse side it pairs with (`_agrees`), an empty fine cell's half into each. Nothing is
-    lost or gained: the two sum to the fine flux."""
-    fp = np.asarray(flux_plus, np.float64) * albedo
-    fm = np.asarray(flux_minus, np.float64) * albedo
-    agrees = _agrees(cell["normal"], coarse_normal)
-    occupied = cell["occupied"]
-    to_plus = np.where(occupied, np.where(agrees, fp, fm), 0.5 * (fp + fm))
-    to_minus = np.where(occupied, np.where(agrees, fm, fp), 0.5 * (fp + fm))
-    shape = coarse_normal.shape[:3]
-    return _coarse_sum(to_plus, shape), _coarse_sum(to_minus, shape)
-
-
-def far_add(far_plus: np.ndarray, far_minus: np.ndarray, coarse_cell: dict, cell: dict) -> tuple[np.ndarray, np.ndarray]:
-    """What the fine sides (plus, minus) take of the coarse grid's absorbed flux, W: each fine side that
-    light can reach takes from the coarse side it pairs with area / max(coarse area, the paired fine
-    sides' areas summed), areas in fine cells^2 (4 per coarse cell^2). The fine sides then read the coarse
-    side's flux / area where their areas agree and never more, and together take at most its flux."""
-    agrees = _agrees(cell["normal"], coarse_cell["normal"])
-    own_plus = cell["area"] * cell["receives"][..., 0]
-    own_minus = cell["area"] * cell["receives"][..., 1]
-    to_coarse_plus = np.where(agrees, own_plus, own_minus)  # the fine side paired with the coarse plus side
-    to_coarse_minus = np.where(agrees, own_minus, own_plus)
-    shape = coarse_cell["normal"].shape[:3]
-    coarse_area = 4.0 * coarse_cell["area"]
-
-    def share(to_side, coarse_flux):
-        denominator = np.maximum(coarse_area, _coarse_sum(to_side, shape))
-        per_area = np.divide(coarse_flux, denominator, out=np.zeros(shape), where=denominator > 0)
-        nz, ny, nx = to_side.shape
-        return to_side * per_area[np.arange(nz)[:, None, None] // 2, np.arange(ny)[None, :, None] // 2,
-                                  np.arange(nx)[None, None, :] // 2]
-
-    from_plus = share(to_coarse_plus, np.asarray(far_plus, np.float64))
-    from_minus = share(to_coarse_minus, np.asarray(far_minus, np.float64))
-    return np.where(agrees, from_plus, from_minus), np.where(agrees, from_minus, from_plus)
 
 
 # -- reconstruction ------------------------------------------------------------------------------------

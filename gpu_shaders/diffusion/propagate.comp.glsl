@@ -5,9 +5,14 @@
 // surface (if any) absorbs block[axis] of each face's inflow, on the side the light travels into; the
 // rest is carried on in the transfer's shape: cone, a uniform intensity over the face's cone, 3 / (2 pi)
 // T_f per W (the normalisation that keeps a uniform field unchanged); DIRECTIONAL, M_d L per W of it.
-// Absorbed flux (W, per side) times `weight` (1, or a far field's share of this step by time of flight,
-// passes/diffusion_far_field.py) goes to acc_plus / acc_minus (first_step: written, else added).
+// Absorbed flux (W) times `weight` (1, or a far field's share of this step by time of flight,
+// passes/diffusion_far_field.py) goes to acc_plus / acc_minus, per side of the plane (first_step: written,
+// else added); FACES (the far field's grid): to acc_0..4, per face it came through, whose direction the
+// fine grid's planes then sort onto their own sides (diffusion/far_field_add.comp.glsl).
 #include "diffusion/cell.glsl"
+#ifdef FACES
+#include "diffusion/faces.glsl"
+#endif
 
 #ifdef DIRECTIONAL
 // M_d L for face f (lpv/transfer.glsl's symmetric form: M00 = 1/6, m_cross from c0 to the face axis's
@@ -83,24 +88,30 @@ vec3 outflow(ivec3 i, int face, out vec4 carried_r, out vec4 carried_g, out vec4
                 channel_outflow(texelFetch(src_b, i, 0), open_plus, open_minus, face, carried_b));
 }
 
-// Face f's inflow into cell c: absorbed by c's surface (plus / minus: the side it lands on) or carried.
+// Face f's inflow into cell c: returned, the flux c's surface absorbs (per colour, W); the rest carried on.
 // Called with a constant f for each face (main): the indices into vectors then fold at compile time,
 // where a loop over f indexed them at run time (llvmpipe: the step took 1.3x lpv's; docs/DIFFUSION.md).
-void inflow(ivec3 c, int f, bool occupied, vec4 block, vec3 n, inout vec3 plus, inout vec3 minus,
-            inout vec4 r, inout vec4 g, inout vec4 b) {
+vec3 inflow(ivec3 c, int f, bool occupied, vec4 block, inout vec4 r, inout vec4 g, inout vec4 b) {
     vec3 d = diffusion_direction(f);
     vec4 carried_r, carried_g, carried_b;
     vec3 a = outflow(c - ivec3(d), f, carried_r, carried_g, carried_b);
     float absorb = occupied ? block[f >> 1] : 0.0;
-    vec3 absorbed = a * absorb;
-    float dn = dot(d, n);
-    float to_plus = dn < -DIFFUSION_SIDE_EPSILON ? 1.0 : (dn > DIFFUSION_SIDE_EPSILON ? 0.0 : 0.5);
-    plus += absorbed * to_plus;
-    minus += absorbed * (1.0 - to_plus);
     r += (1.0 - absorb) * carried_r;
     g += (1.0 - absorb) * carried_g;
     b += (1.0 - absorb) * carried_b;
+    return a * absorb;
 }
+
+#ifndef FACES
+// The side of the plane (normal n) that light absorbed through face f lands on: plus when it travels
+// against n.
+void to_sides(int f, vec3 absorbed, vec3 n, inout vec3 plus, inout vec3 minus) {
+    float dn = dot(diffusion_direction(f), n);
+    float to_plus = dn < -DIFFUSION_SIDE_EPSILON ? 1.0 : (dn > DIFFUSION_SIDE_EPSILON ? 0.0 : 0.5);
+    plus += absorbed * to_plus;
+    minus += absorbed * (1.0 - to_plus);
+}
+#endif
 
 void main() {
     ivec3 c = ivec3(gl_GlobalInvocationID);
@@ -109,24 +120,46 @@ void main() {
     }
     vec4 block = texelFetch(cell_block, c, 0);
     bool occupied = diffusion_occupied(block);
-    vec3 n = texelFetch(cell_normal, c, 0).xyz;
     vec4 r = vec4(0.0), g = vec4(0.0), b = vec4(0.0);
-    vec3 plus = vec3(0.0), minus = vec3(0.0);
-    inflow(c, 0, occupied, block, n, plus, minus, r, g, b);
-    inflow(c, 1, occupied, block, n, plus, minus, r, g, b);
-    inflow(c, 2, occupied, block, n, plus, minus, r, g, b);
-    inflow(c, 3, occupied, block, n, plus, minus, r, g, b);
-    inflow(c, 4, occupied, block, n, plus, minus, r, g, b);
-    inflow(c, 5, occupied, block, n, plus, minus, r, g, b);
+    vec3 a0 = weight * inflow(c, 0, occupied, block, r, g, b);
+    vec3 a1 = weight * inflow(c, 1, occupied, block, r, g, b);
+    vec3 a2 = weight * inflow(c, 2, occupied, block, r, g, b);
+    vec3 a3 = weight * inflow(c, 3, occupied, block, r, g, b);
+    vec3 a4 = weight * inflow(c, 4, occupied, block, r, g, b);
+    vec3 a5 = weight * inflow(c, 5, occupied, block, r, g, b);
     imageStore(dst_r, c, r);
     imageStore(dst_g, c, g);
     imageStore(dst_b, c, b);
-    plus *= weight;
-    minus *= weight;
+#ifdef FACES
+    // The flux absorbed by the face it came through (diffusion/faces.glsl packs the 18 numbers).
+    vec4 p0, p1, p2, p3, p4;
+    diffusion_pack_faces(a0, a1, a2, a3, a4, a5, p0, p1, p2, p3, p4);
+    if (first_step == 0) {
+        p0 += imageLoad(acc_0, c);
+        p1 += imageLoad(acc_1, c);
+        p2 += imageLoad(acc_2, c);
+        p3 += imageLoad(acc_3, c);
+        p4 += imageLoad(acc_4, c);
+    }
+    imageStore(acc_0, c, p0);
+    imageStore(acc_1, c, p1);
+    imageStore(acc_2, c, p2);
+    imageStore(acc_3, c, p3);
+    imageStore(acc_4, c, p4);
+#else
+    vec3 n = texelFetch(cell_normal, c, 0).xyz;
+    vec3 plus = vec3(0.0), minus = vec3(0.0);
+    to_sides(0, a0, n, plus, minus);
+    to_sides(1, a1, n, plus, minus);
+    to_sides(2, a2, n, plus, minus);
+    to_sides(3, a3, n, plus, minus);
+    to_sides(4, a4, n, plus, minus);
+    to_sides(5, a5, n, plus, minus);
     if (first_step == 0) {
         plus += imageLoad(acc_plus, c).rgb;
         minus += imageLoad(acc_minus, c).rgb;
     }
     imageStore(acc_plus, c, vec4(plus, 0.0));
     imageStore(acc_minus, c, vec4(minus, 0.0));
+#endif
 }

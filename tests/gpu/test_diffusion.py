@@ -20,7 +20,6 @@ from addon.engine.passes import (
     diffusion_inject,
     diffusion_lookup,
     diffusion_propagate,
-    lpv_far_field,
 )
 
 pytestmark = pytest.mark.gpu
@@ -251,61 +250,110 @@ def test_add_skips_the_sides_of_the_propagated_class(gl, skip_class):
             np.testing.assert_allclose(gl.read(total[side]), np.where(skipped, kept, kept + a), rtol=1e-7)
 
 
-def far_grids(gl, rng):
-    """Random fine cells on GRID (6 x 5 x 4: the odd y side leaves the last coarse layer half empty) and
-    independent random cells on its far-field grid (3 x 3 x 2), both dense enough that coarse cells
-    hold several occupied fine cells of both pairings."""
-    coarse = lpv_far_field.grid_for(GRID)
-    assert coarse.dims == (3, 3, 2)
-    fine_voxels, coarse_voxels = random_voxels(rng, GRID, share=0.6), random_voxels(rng, coarse, share=0.8)
-    fine_textures, fine_cells = gpu_cells(gl, fine_voxels)
-    _, coarse_cells = gpu_cells(gl, coarse_voxels, coarse)
-    return coarse, fine_voxels, fine_textures, fine_cells, ref_cells(fine_voxels), coarse_cells, \
-        ref_cells(coarse_voxels)
+def faces_of(volumes):
+    """(z, y, x, 6, 3) from the five packed volumes of flux per face (diffusion/faces.glsl: number 3 f +
+    channel at volume (3 f + channel) // 4, component (3 f + channel) % 4)."""
+    flat = np.concatenate([volumes[i] for i in range(5)], axis=-1)  # (z, y, x, 20)
+    return flat[..., :18].reshape(*flat.shape[:3], 6, 3)
 
 
-def test_far_field_sources_are_the_twins(gl):
-    # From the injection atlas (the first bounce) and from absorbed flux volumes times the fine albedo:
-    # each coarse side sums the fine sides paired with it, an empty fine cell's flux half to each.
-    rng = np.random.default_rng(11)
-    coarse, voxels, textures, cells, cell, coarse_cells, coarse_cell = far_grids(gl, rng)
-    fp, fm = (rng.uniform(0.0, 2.0, zyx(GRID)).astype(np.float32) for _ in range(2))
-    atlas, _, _ = diffusion_inject.atlas_target(gl, GRID)
-    atlases = {"flux_plus": atlas_of(gl, atlas, GRID, fp), "flux_minus": atlas_of(gl, atlas, GRID, fm)}
-    volumes = {"flux_plus": gl.texture(GRID.dims, "RGBA32F", fp), "flux_minus": gl.texture(GRID.dims, "RGBA32F", fm)}
-    agrees = ref._agrees(cell["normal"], coarse_cell["normal"])
-    assert (agrees & cell["occupied"]).any() and (~agrees & cell["occupied"]).any()
-    for flux, albedo in ((atlases, None), (volumes, voxels["vox_albedo"])):
-        out = {k: gl.texture(coarse.dims, "RGBA32F", np.full(zyx(coarse), 9.0, np.float32))
-               for k in ("flux_plus", "flux_minus")}
-        diffusion_far_field.source(gl, flux, cells, GRID, out, coarse_cells, coarse,
-                                   atlas=atlas if albedo is None else None,
-                                   vox_albedo=None if albedo is None else textures["vox_albedo"])
-        got_plus, got_minus = gl.read(out["flux_plus"]), gl.read(out["flux_minus"])
+def test_propagation_by_face_is_the_twins(gl):
+    # The far grid's steps: the same next fields, the absorbed flux kept by the face it came through
+    # (written by the first step, added by the second at weight 0.5).
+    rng = np.random.default_rng(10)
+    voxels = random_voxels(rng, GRID, share=0.5)
+    _, cells = gpu_cells(gl, voxels)
+    fields = random_fields(rng, GRID)
+    sets = [sh_volumes(gl, GRID, fields), sh_volumes(gl, GRID)]
+    absorbed = diffusion_propagate.faces(gl, GRID)
+    cell = ref_cells(voxels)
+    want = [np.asarray(f, np.float64) for f in fields]
+    faces = np.zeros((3, *zyx(GRID, 0)[:3], 6))
+    for i, weight in enumerate((1.0, 0.5)):
+        diffusion_propagate.run(gl, sets[i % 2], sets[(i + 1) % 2], absorbed, cells, GRID, first_step=i == 0,
+                                transfer="directional", weight=weight)
         for ch in range(3):
-            a = 1.0 if albedo is None else albedo[..., ch]
-            plus, minus = ref.far_source(fp[..., ch], fm[..., ch], cell, coarse_cell["normal"], a)
-            np.testing.assert_allclose(got_plus[..., ch], plus, rtol=0, atol=RTOL * plus.max())
-            np.testing.assert_allclose(got_minus[..., ch], minus, rtol=0, atol=RTOL * minus.max())
+            want[ch], a = ref.step_by_face(want[ch], cell, "directional")
+            faces[ch] += weight * a
+    for ch, c in enumerate("rgb"):
+        got = gl.read(sets[0][f"sh_{c}"])
+        np.testing.assert_allclose(got, want[ch], rtol=0, atol=RTOL * np.abs(want[ch]).max())
+    got = faces_of([gl.read(absorbed[f"acc_{i}"]) for i in range(5)])
+    assert (faces > 0).sum(axis=(0, 1, 2, 3)).min() > 0  # light came through every face
+    for ch in range(3):
+        np.testing.assert_allclose(got[..., ch], faces[ch], rtol=0, atol=RTOL * faces.max())
 
 
-def test_far_field_add_is_the_twins(gl):
-    # The coarse absorbed flux shared out to the fine sides light can reach, by area, added to what the
-    # fine grid absorbed itself.
+def far_cells_pair(gl, rng, shift):
+    """Random fine cells on GRID (6 x 5 x 4) and independent random cells on its far grid starting `shift`
+    fine cells before it (odd sides leave far layers half covered), dense enough that far cells share
+    light through some faces and not others."""
+    far = diffusion_far_field.grid_for(GRID, shift)
+    voxels, far_voxels = random_voxels(rng, GRID, share=0.6), random_voxels(rng, far.grid, share=0.5)
+    _, cells = gpu_cells(gl, voxels)
+    _, far_cells = gpu_cells(gl, far_voxels, far.grid)
+    return far, cells, far_cells, ref_cells(voxels), ref_cells(far_voxels)
+
+
+@pytest.mark.parametrize("shift", [(0, 0, 0), (1, 0, 1)])
+def test_far_field_weights_and_add_are_the_twins(gl, shift):
+    # The far grid's absorbed flux per face shared onto the fine sides light can reach, by their block
+    # on the face's axis and the trilinear tents of the far cells around them, added to what the fine
+    # grid absorbed itself; every far cell that shares gives out exactly its flux.
     rng = np.random.default_rng(12)
-    coarse, _, _, cells, cell, coarse_cells, coarse_cell = far_grids(gl, rng)
-    far_plus, far_minus = (rng.uniform(0.0, 2.0, zyx(coarse)).astype(np.float32) for _ in range(2))
+    far, cells, far_cells, cell, far_cell = far_cells_pair(gl, rng, shift)
+    far_grid = far.grid
+    weights = diffusion_far_field.weights(gl, far_cells, far, cells, GRID)
+    got_weights = np.concatenate([gl.read(weights["weight_0"]), gl.read(weights["weight_1"])[..., :2]], -1)
+    want_weights = ref.far_weights(far_cell, cell, shift)
+    assert (want_weights > 0).any() and (want_weights == 0).any()
+    np.testing.assert_allclose(got_weights, want_weights, rtol=0, atol=RTOL * want_weights.max())
+    far_faces = rng.uniform(0.0, 2.0, (*zyx(far_grid, 0)[:3], 6, 3))
+    flat = np.zeros((*zyx(far_grid, 0)[:3], 20), np.float32)
+    flat[..., :18] = far_faces.reshape(*far_faces.shape[:3], 18)
+    far_absorbed = {f"acc_{i}": gl.texture(far_grid.dims, "RGBA32F", np.ascontiguousarray(flat[..., 4 * i:4 * i + 4]))
+                    for i in range(5)}
     own = rng.uniform(0.0, 1.0, zyx(GRID)).astype(np.float32)
     absorbed = {k: gl.texture(GRID.dims, "RGBA32F", own) for k in ("flux_plus", "flux_minus")}
-    far = {"flux_plus": gl.texture(coarse.dims, "RGBA32F", far_plus),
-           "flux_minus": gl.texture(coarse.dims, "RGBA32F", far_minus)}
-    diffusion_far_field.add(gl, far, coarse_cells, absorbed, cells, GRID)
+    diffusion_far_field.add(gl, far_absorbed, weights, far, absorbed, cells, GRID)
     got_plus, got_minus = gl.read(absorbed["flux_plus"]), gl.read(absorbed["flux_minus"])
     for ch in range(3):
-        plus, minus = ref.far_add(far_plus[..., ch], far_minus[..., ch], coarse_cell, cell)
+        plus, minus = ref.far_add(far_faces[..., ch], want_weights, cell, shift)
         assert plus.max() > 0 and minus.max() > 0
         np.testing.assert_allclose(got_plus[..., ch] - own[..., ch], plus, rtol=0, atol=RTOL * plus.max())
         np.testing.assert_allclose(got_minus[..., ch] - own[..., ch], minus, rtol=0, atol=RTOL * minus.max())
+        shared = np.sum(np.where(want_weights > 0, far_faces[..., ch], 0.0))
+        np.testing.assert_allclose(plus.sum() + minus.sum(), shared, rtol=1e-12)
+
+
+def test_far_field_emitters_free_enclosed_cells(gl):
+    # The fine emitters summed per far cell, the light of cells with no open face moved to the face and
+    # edge neighbours that have one, mostly along the light's direction; no light made or lost where a
+    # neighbour takes it.
+    # A far grid of 5 x 5 x 5 starting a fine cell before the fine grid on y (faces out of the grid count
+    # as open, so a small grid has no enclosed cell), 85 % occupied: enclosed cells with and without a
+    # neighbour to take their light.
+    rng = np.random.default_rng(13)
+    fine = Grid(np.zeros(3), 0.5, (10, 9, 10))
+    far = diffusion_far_field.grid_for(fine, (0, 1, 0))
+    far_grid = far.grid
+    assert far_grid.dims == (5, 5, 5)
+    far_voxels = random_voxels(rng, far_grid, share=0.85)
+    _, far_cells = gpu_cells(gl, far_voxels, far_grid)
+    far_cell = ref_cells(far_voxels)
+    enclosed = far_cell["occupied"] & ~far_cell["open"].any(-1)
+    assert enclosed.sum() > 5 and (~enclosed).any()
+    fields = random_fields(rng, fine, emitters=200)
+    snapshots = [sh_volumes(gl, far_grid), sh_volumes(gl, far_grid)]
+    diffusion_far_field.emitters(gl, sh_volumes(gl, fine, fields), fine, snapshots, far_cells, far)
+    summed = np.stack([ref._coarse_sum_field(np.asarray(f, np.float64), zyx(far_grid, 0)[:3], far.shift)
+                       for f in fields])
+    want = ref.far_move_enclosed(summed, far_cell)
+    assert not np.allclose(want, summed)  # some light moved
+    for ch, c in enumerate("rgb"):
+        np.testing.assert_allclose(gl.read(snapshots[0][f"sh_{c}"]), want[ch], rtol=0,
+                                   atol=RTOL * np.abs(want[ch]).max())
+    np.testing.assert_allclose(want[..., 0].sum(), summed[..., 0].sum(), rtol=1e-12)
 
 
 def test_lookup_is_the_twins(gl):

@@ -10,6 +10,8 @@ import pytest
 
 from addon.engine import diffusion_reference as ref
 from addon.engine import sh
+from addon.engine.grid import Grid
+from addon.engine.passes import diffusion_far_field
 
 DIMS_ZYX = (6, 7, 8)
 
@@ -330,3 +332,47 @@ def test_the_lookup_skips_a_side_no_light_can_reach():
     points = np.array([[0.9, 1.5, 0.5], [0.5, 1.5, 0.5]])
     value = ref.lookup(points, np.array([[0.0, 0.0, 1.0]] * 2), cell, flux, np.zeros(dims), 1.0)
     np.testing.assert_allclose(value, 2.0 / np.pi, rtol=1e-14)
+
+
+def test_the_far_grid_keeps_a_two_cell_wall_in_one_far_cell():
+    # A wall two fine cells thick at x = 1, 2 (and a floor at z = 3, 4) falls across far cells' borders at
+    # shift 0 and fills two far cells; starting the far grid one fine cell earlier on those axes puts it
+    # in one. Occupancy (z, y, x); the shift is (x, y, z).
+    occupied = np.zeros((8, 6, 8), bool)
+    occupied[:, :, 1:3] = True
+    occupied[3:5, :, :] = True
+    assert diffusion_far_field.best_shift(occupied) == (1, 0, 1)
+    occupied[:, :, 1:3] = False
+    occupied[:, :, 2:4] = True
+    assert diffusion_far_field.best_shift(occupied) == (0, 0, 1)
+    far = diffusion_far_field.grid_for(Grid(np.zeros(3), 0.5, (7, 6, 8)), (1, 0, 1))
+    assert far.grid.dims == (4, 3, 5) and far.grid.cell_size_m == 1.0  # covers fine cells -1 .. 7 on x
+    np.testing.assert_allclose(far.grid.origin_m, [-0.5, 0.0, -0.5])
+
+
+@pytest.mark.parametrize("shift", [(0, 0, 0), (1, 1, 0)])
+def test_the_far_field_reads_an_evenly_lit_floor_evenly(shift):
+    # A floor one fine cell thick (layer z = 1, normal +z) and its far cells (layer 0) that absorbed 4 W
+    # each through face -z (light travelling down): every fine floor cell away from the grid's sides
+    # reads the far flux per area, 4 W / 4 fine cells, whatever the tents' alignment, and the fine cells
+    # together take exactly the 4 W per far cell. The far cells at the sides reach fewer fine cells
+    # (their tents hang over the grid), so the 3 fine cells nearest each side read more; none beyond.
+    n = 12
+    occupied = np.zeros((4, n, n), bool)
+    occupied[1] = True
+    normal = np.zeros((4, n, n, 3))
+    normal[occupied] = (0.0, 0.0, 1.0)
+    cell = ref.cells(occupied, normal, normal)
+    far_n = (n + shift[0] + 1) // 2, (n + shift[1] + 1) // 2
+    far_occupied = np.zeros((2, far_n[1], far_n[0]), bool)
+    far_occupied[0] = True
+    far_normal = np.zeros((*far_occupied.shape, 3))
+    far_normal[far_occupied] = (0.0, 0.0, 1.0)
+    far_cell = ref.cells(far_occupied, far_normal, far_normal)
+    faces = np.zeros((*far_occupied.shape, 6))
+    faces[0, :, :, 5] = 4.0
+    weights = ref.far_weights(far_cell, cell, shift)
+    plus, minus = ref.far_add(faces, weights, cell, shift)
+    np.testing.assert_allclose(plus[1, 3:-3, 3:-3], 1.0, rtol=1e-12)
+    assert np.all(minus == 0) and np.all(plus[[0, 2, 3]] == 0)
+    np.testing.assert_allclose(plus.sum(), faces.sum(), rtol=1e-12)

@@ -9,8 +9,8 @@ absorbed flux times albedo), steps x diffusion_propagate (gather form, ping-pong
 accumulated per side), the class's light added to the bounce's at every side of another class, and the
 bounce added to the light field (diffusion_propagate.add); with DiffusionConfig.far_field (grids of
 diffusion_far_field.MIN_GRID_CELLS and more) the grid runs only its near steps and a grid of twice the
-cell (its own voxelizer and cells) the rest, each bounce's emitters summed into it and each class's
-absorbed flux shared back (diffusion_far_field); the gather: diffusion_lookup -> `indirect`
+cell (its own voxelizer and cells) the rest, each class's emitters summed into it and its absorbed flux
+sorted back onto the fine sides (diffusion_far_field); the gather: diffusion_lookup -> `indirect`
 (Cycles' Diffuse Indirect). The light field does not depend on the camera: a camera move re-runs only
 the lookup.
 docs/DIFFUSION.md derives the transport and measures it; diffusion_reference.py is its numpy twin.
@@ -47,17 +47,19 @@ def steps_per_bounce(config: DiffusionConfig, grid: Grid, bounces: int) -> int:
     return max(1, min(per_bounce, config.max_steps // bounces))
 
 
-class FarGrid:
-    """The far field's grid (diffusion_far_field): twice the fine grid's cell, its own voxels and cells,
-    the emitted flux summed from the fine grid's, two snapshots and what its surfaces absorb."""
+class FarField:
+    """The far field's grid and state (diffusion_far_field): the far grid (and its shift), its own
+    voxelizer and cells, two snapshots, what its surfaces absorb by the face the light came through, and
+    the weights that share it onto the fine sides (per voxelization)."""
 
-    def __init__(self, backend, fine: Grid):
-        self.grid = lpv_far_field.grid_for(fine)
-        self.voxelizer = Voxelizer(backend, self.grid)
-        self.cells = diffusion_cells.textures(backend, self.grid)
-        self.snapshots = [{f"sh_{c}": backend.texture(self.grid.dims) for c in "rgb"} for _ in range(2)]
-        self.emitted = diffusion_propagate.sides(backend, self.grid)
-        self.absorbed = diffusion_propagate.sides(backend, self.grid)
+    def __init__(self, backend, far: diffusion_far_field.FarGrid, scene):
+        self.far = far
+        self.voxelizer = Voxelizer(backend, far.grid)
+        self.voxelizer.set_scene(scene)
+        self.cells = diffusion_cells.textures(backend, far.grid)
+        self.snapshots = [{f"sh_{c}": backend.texture(far.grid.dims) for c in "rgb"} for _ in range(2)]
+        self.absorbed = diffusion_propagate.faces(backend, far.grid)
+        self.weights = None
 
 
 class DiffusionMethod(OneBounceMethod):
@@ -71,7 +73,7 @@ class DiffusionMethod(OneBounceMethod):
         super().__init__(backend, gi, rsm_config)
         self.diffusion_config = diffusion_config if diffusion_config is not None else DiffusionConfig()
         self.grid: Grid | None = None
-        self.far: FarGrid | None = None
+        self.far: FarField | None = None
 
     def set_scene(self, scene) -> None:
         """Upload the scene; while the grid (fitted to the bounds) stays, the voxelizer redraws only the
@@ -81,8 +83,6 @@ class DiffusionMethod(OneBounceMethod):
         grid = Grid.fit(*self.bounds_m, max_cells=self.diffusion_config.grid_cells)
         if grid.same_cells(self.grid):
             self.voxelizer.update(self.scene)
-            if self.far is not None:
-                self.far.voxelizer.update(self.scene)
         else:
             self.grid = grid
             self.voxelizer = Voxelizer(be, grid)
@@ -96,14 +96,25 @@ class DiffusionMethod(OneBounceMethod):
             self.bounce_flux = ([diffusion_propagate.sides(be, grid) for _ in range(min(2, self.gi.bounces))]
                                 if self.diffusion_config.emitter_class_passes else [self.absorbed])
             self.accumulated = diffusion_propagate.sides(be, grid) if self.gi.bounces > 1 else self.bounce_flux[0]
-            self.far = (FarGrid(be, grid) if self.diffusion_config.far_field
-                        and max(grid.dims) >= diffusion_far_field.MIN_GRID_CELLS else None)
-            if self.far is not None:
-                self.far.voxelizer.set_scene(self.scene)
+            self.far = None
         self.voxels = self.voxelizer.run()
         diffusion_cells.run(be, self.voxels, self.cells, self.grid)
-        if self.far is not None:
-            diffusion_cells.run(be, self.far.voxelizer.run(), self.far.cells, self.far.grid)
+        if self.diffusion_config.far_field and max(grid.dims) >= diffusion_far_field.MIN_GRID_CELLS:
+            self._set_far_field()
+
+    def _set_far_field(self) -> None:
+        """The far grid aligned to the fine voxels (diffusion_far_field.best_shift, from the occupancy read
+        back once per geometry change), rebuilt when its alignment moves, else updated as the fine one."""
+        be = self.backend
+        occupied = be.read(self.voxels["vox_albedo"])[..., 3] > 0
+        far = diffusion_far_field.grid_for(self.grid, diffusion_far_field.best_shift(occupied))
+        if self.far is not None and self.far.far.shift == far.shift:  # the same fine grid (set_scene)
+            self.far.voxelizer.update(self.scene)
+        else:
+            self.far = FarField(be, far, self.scene)
+        f = self.far
+        diffusion_cells.run(be, f.voxelizer.run(), f.cells, far.grid)
+        f.weights = diffusion_far_field.weights(be, f.cells, far, self.cells, self.grid, f.weights)
 
     def begin_solve(self, timings: dict[str, float]) -> None:
         zero.images(self.backend, list(self.injected.values()))
@@ -131,12 +142,6 @@ class DiffusionMethod(OneBounceMethod):
         previous = None  # the last bounce's flux, which the next one re-emits
         for bounce in range(1, self.gi.bounces + 1):
             flux = self.bounce_flux[bounce % len(self.bounce_flux)]
-            if far is not None:
-                with self.step(timings, diffusion_far_field.DECL):
-                    diffusion_far_field.source(be, self.injected if previous is None else previous, cells, grid,
-                                               far.emitted, far.cells, far.grid,
-                                               atlas=self.atlas if previous is None else None,
-                                               vox_albedo=None if previous is None else self.voxels["vox_albedo"])
             for k in classes:
                 with self.step(timings, diffusion_inject.EMIT_DECL):
                     if previous is None:
@@ -145,13 +150,16 @@ class DiffusionMethod(OneBounceMethod):
                     else:
                         diffusion_inject.emit(be, previous, cells, self.snapshots[0], grid,
                                               vox_albedo=self.voxels["vox_albedo"], emitter_class=k)
+                if far is not None:  # its emitters before the fine steps overwrite snapshot 0
+                    with self.step(timings, diffusion_far_field.DECL):
+                        diffusion_far_field.emitters(be, self.snapshots[0], grid, far.snapshots, far.cells, far.far)
                 with self.step(timings, diffusion_propagate.DECL):
                     for i, weight in enumerate(fine_weights):
                         diffusion_propagate.run(be, self.snapshots[i % 2], self.snapshots[(i + 1) % 2], self.absorbed,
                                                 cells, grid, first_step=i == 0, transfer=transfer, weight=weight)
                 if far is not None:
                     with self.step(timings, diffusion_far_field.DECL):
-                        self._propagate_far(k, near, transfer)
+                        self._propagate_far(near, transfer)
                 if flux is not self.absorbed:
                     with self.step(timings, diffusion_propagate.DECL):
                         diffusion_propagate.add(be, self.absorbed, flux, grid, first=k == classes[0],
@@ -162,16 +170,17 @@ class DiffusionMethod(OneBounceMethod):
                                             cell_normal=cells["cell_normal"])
             previous = flux
 
-    def _propagate_far(self, emitter_class: int, near: int, transfer: str) -> None:
-        """The far grid's propagation of one emitter class (its whole span, each step counted by its
-        share of the time of flight the fine grid's `near` steps leave), added to the fine `absorbed`."""
-        be, far = self.backend, self.far
-        diffusion_inject.emit(be, far.emitted, far.cells, far.snapshots[0], far.grid, emitter_class=emitter_class)
-        for i in range(steps_per_bounce(self.diffusion_config, far.grid, self.gi.bounces)):
-            diffusion_propagate.run(be, far.snapshots[i % 2], far.snapshots[(i + 1) % 2], far.absorbed, far.cells,
-                                    far.grid, first_step=i == 0, transfer=transfer,
+    def _propagate_far(self, near: int, transfer: str) -> None:
+        """The far grid's propagation of the emitters in its snapshot 0 (its whole span, each step counted
+        by its share of the time of flight the fine grid's `near` steps leave), added to the fine
+        `absorbed`."""
+        be, f = self.backend, self.far
+        grid = f.far.grid
+        for i in range(steps_per_bounce(self.diffusion_config, grid, self.gi.bounces)):
+            diffusion_propagate.run(be, f.snapshots[i % 2], f.snapshots[(i + 1) % 2], f.absorbed, f.cells, grid,
+                                    first_step=i == 0, transfer=transfer,
                                     weight=lpv_far_field.coarse_weight(i + 1, near))
-        diffusion_far_field.add(be, far.absorbed, far.cells, self.absorbed, self.cells, self.grid)
+        diffusion_far_field.add(be, f.absorbed, f.weights, f.far, self.absorbed, self.cells, self.grid)
 
     def gather_pixels(self, timings: dict[str, float]) -> None:
         with self.step(timings, diffusion_lookup.DECL):

@@ -2,97 +2,147 @@
 (docs/DIFFUSION.md, "Far field"; the scheme of lpv_far_field, for absorbed flux instead of accumulated SH).
 
 A bounce's light needs twice the grid's span of steps to settle (DiffusionConfig.span_multiple). Here the
-fine grid runs only its first `near_steps` K, and a coarse grid (lpv_far_field.grid_for: same origin, cell
-2h; its own voxelization and cells) the whole span, in half as many steps at 1/8 of the cells. Both count
-what their surfaces absorb by time of flight (lpv_far_field.fine_weight / coarse_weight, the
-`weight` of diffusion_propagate.run): light absorbed at fine time t is counted w(t) on the fine grid and
-1 - w(t) on the coarse one, so once in sum. Absorbed light leaves the flight, so weighting the count does
-not change the transport of either grid.
+fine grid runs only its first `near_steps` K, and a far grid (`grid_for`: cell 2h, its own voxelization
+and cells, aligned by `best_shift`) the whole span, in half as many steps at 1/8 of the cells. Both count
+what their surfaces absorb by time of flight (lpv_far_field.fine_weight / coarse_weight, the `weight` of
+diffusion_propagate.run): light absorbed at fine time t is counted w(t) on the fine grid and 1 - w(t) on
+the far one, so once in sum. Absorbed light leaves the flight, so weighting the count changes neither
+grid's transport.
 
-`source`: the fine grid's emitted flux per side (the injection atlas, or a bounce's absorbed flux times
-the fine albedo) -> the coarse grid's, summed over each coarse cell's 2 x 2 x 2 fine cells, a side to the
-coarse side its normal agrees with (far_field_source.comp.glsl); the coarse grid then emits it as its own
-(diffusion_inject.emit from volumes) per emitter class. `add`: the coarse grid's absorbed flux shared out
-to the fine sides by receiving area, never more irradiance than the coarse side's and never more flux
-than it absorbed, added to the fine grid's absorbed flux (far_field_add.comp.glsl); everything
-downstream (the class and bounce sums, the next bounce's emitters, the lookup) reads the sum.
-Twins: diffusion_reference.far_source / far_add.
+`emitters`: the far grid's emitters are the fine grid's summed per far cell (lpv_far_field.source:
+radiant intensity adds), per emitter class and bounce; a far cell on the edge where a wall meets a floor
+is walled in by occupied cells, and its light, which could not leave, is moved to the neighbours it can
+leave from (far_field_move.comp.glsl). The far grid keeps what it absorbs by the face the light came
+through (diffusion_propagate.faces): its cells are too coarse to have one plane (a cell holding a wall
+and the floor of the room behind it has a normal between the two, whose sides would mix the rooms).
+`add` shares each face's flux onto the fine planes' sides, which the light's direction sorts as a fine
+step would, by their absorption on that axis and the far cells' trilinear tents, so the far light is
+smooth across far cells and each far cell gives out exactly what it absorbed (`weights`, once per
+voxelization: each far cell's share denominators, far_field_weights.comp.glsl; far_field_add.comp.glsl).
+Everything downstream (the class and bounce sums, the next bounce's emitters, the lookup) reads the sum.
+Twins: diffusion_reference.far_move_enclosed, far_weights, far_add.
 """
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
+import numpy as np
+
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
-from .declare import VOX_ALBEDO, PassDecl
+from . import lpv_far_field
+from .declare import PassDecl
 from .diffusion_cells import CELL_BLOCK, CELL_NORMAL
-from .diffusion_inject import INJECTED
-from .diffusion_propagate import ABSORBED
+from .diffusion_inject import SNAPSHOT
+from .diffusion_propagate import ABSORBED, FACE_TEXELS
 
-# The fine grid's longest side from which the far field runs: its 16-cell coarse grid is the coarsest
-# that resolves a room (one 16-cell grid: window-room rel_rmse_8 1.160 against 0.366 at 32, docs/DIFFUSION.md).
+# The fine grid's longest side from which the far field runs: its 16-cell far grid is the coarsest that
+# resolves a room (one 16-cell grid: window-room rel_rmse_8 1.160 against 0.366 at 32, docs/DIFFUSION.md).
 MIN_GRID_CELLS = 32
 
+MOVE = ShaderSpec(
+    name="diffusion_far_field_move",
+    compute="diffusion/far_field_move.comp.glsl",
+    local_size=(4, 4, 4),
+    samplers=(*(Sampler(f"src_{c}", "3D") for c in "rgb"), Sampler("cell_block", "3D")),
+    images=tuple(Image(f"sh_{c}", "3D", "RGBA32F", "write") for c in "rgb"),
+    uniforms=(Var("dims", "ivec3"),),
+)
 
-def _source_spec(atlas: bool) -> ShaderSpec:
-    dim = "2D" if atlas else "3D"
-    return ShaderSpec(
-        name="diffusion_far_field_source" + ("_atlas" if atlas else "_albedo"),
-        compute="diffusion/far_field_source.comp.glsl",
-        local_size=(4, 4, 4),
-        samplers=(Sampler("flux_plus", dim), Sampler("flux_minus", dim), Sampler("cell_normal", "3D"),
-                  Sampler("cell_block", "3D"), Sampler("coarse_normal", "3D"))
-        + (() if atlas else (Sampler("vox_albedo", "3D"),)),
-        images=(Image("coarse_plus", "3D", "RGBA32F", "write"), Image("coarse_minus", "3D", "RGBA32F", "write")),
-        uniforms=(Var("dims", "ivec3"), Var("coarse_dims", "ivec3")) + ((Var("tiles_x", "int"),) if atlas else ()),
-        defines=(("ATLAS", "1"),) if atlas else (),
-    )
-
-
-SOURCE_SPECS = {atlas: _source_spec(atlas) for atlas in (True, False)}
+WEIGHTS = ShaderSpec(
+    name="diffusion_far_field_weights",
+    compute="diffusion/far_field_weights.comp.glsl",
+    local_size=(4, 4, 4),
+    samplers=(Sampler("far_block", "3D"), Sampler("cell_normal", "3D"), Sampler("cell_block", "3D")),
+    images=(Image("weight_0", "3D", "RGBA32F", "write"), Image("weight_1", "3D", "RGBA32F", "write")),
+    uniforms=(Var("dims", "ivec3"), Var("fine_dims", "ivec3"), Var("fine_shift", "ivec3")),
+)
 
 ADD = ShaderSpec(
     name="diffusion_far_field_add",
     compute="diffusion/far_field_add.comp.glsl",
     local_size=(4, 4, 4),
-    samplers=(Sampler("far_plus", "3D"), Sampler("far_minus", "3D"), Sampler("coarse_normal", "3D"),
-              Sampler("cell_normal", "3D"), Sampler("cell_block", "3D")),
+    samplers=(*(Sampler(f"far_{i}", "3D") for i in range(FACE_TEXELS)), Sampler("weight_0", "3D"),
+              Sampler("weight_1", "3D"), Sampler("cell_normal", "3D"), Sampler("cell_block", "3D")),
     images=(Image("acc_plus", "3D", "RGBA32F", "read_write"), Image("acc_minus", "3D", "RGBA32F", "read_write")),
-    uniforms=(Var("dims", "ivec3"),),
+    uniforms=(Var("dims", "ivec3"), Var("far_dims", "ivec3"), Var("fine_shift", "ivec3")),
 )
 
-DECL = PassDecl("diffusion_far_field", "solve", (INJECTED, ABSORBED, CELL_NORMAL, CELL_BLOCK, VOX_ALBEDO),
-                (ABSORBED,), "light beyond the near steps carried on a grid of twice the cell (its emitters "
-                "summed from the fine grid's, its absorbed flux shared back)")
+DECL = PassDecl("diffusion_far_field", "solve", (SNAPSHOT, ABSORBED, CELL_NORMAL, CELL_BLOCK), (ABSORBED,),
+                "light beyond the near steps carried on a grid of twice the cell (its emitters summed from "
+                "the fine grid's, its absorbed flux sorted back onto the fine sides)")
+
+
+class FarGrid(NamedTuple):
+    """A far grid: twice the fine grid's cell, starting `shift` fine cells (0 or 1 per axis, x y z) before
+    it, so far cell j holds fine cells 2j - shift and 2j - shift + 1 on each axis."""
+
+    grid: Grid
+    shift: tuple[int, int, int]
+
+
+def grid_for(fine: Grid, shift: tuple[int, int, int] = (0, 0, 0)) -> FarGrid:
+    """The far grid of `fine` starting `shift` fine cells before it; it covers the fine grid."""
+    s = np.array(shift)
+    dims = tuple(int(d) for d in (np.array(fine.dims) + s + 1) // 2)
+    return FarGrid(Grid(np.asarray(fine.origin_m) - s * fine.cell_size_m, 2.0 * fine.cell_size_m, dims),
+                   tuple(int(v) for v in shift))
+
+
+def best_shift(occupied: np.ndarray) -> tuple[int, int, int]:
+    """The shift (x, y, z) whose far grid has the fewest cells holding a fine occupied cell, of the 8
+    (ties: the first in x, y, z order from (0, 0, 0)). Occupancy is binary in the far grid as in the fine
+    one, so a wall two fine cells thick across a far cells' border fills two far cells: every wall of a
+    room then stands a far cell into it, and a room of 12 fine cells becomes one of 5 far cells (the
+    thin-wall scene at 32 cells: 1046 far cells occupied at shift 0, 528 at (1, 1, 1)). `occupied` is
+    (z, y, x) bool."""
+    best, fewest = (0, 0, 0), None
+    for shift in np.ndindex(2, 2, 2):
+        padded = np.pad(occupied, [(shift[2], 0), (shift[1], 0), (shift[0], 0)])
+        padded = np.pad(padded, [(0, n % 2) for n in padded.shape])
+        z, y, x = padded.shape
+        count = int(padded.reshape(z // 2, 2, y // 2, 2, x // 2, 2).any(axis=(1, 3, 5)).sum())
+        if fewest is None or count < fewest:
+            best, fewest = tuple(int(v) for v in shift), count
+    return best
 
 
 def near_steps(configured: int, grid: Grid, steps: int) -> int:
-    """The fine grid's steps K with a far field: `configured`, or (0) the grid's longest side, at most the
-    bounce's own `steps`."""
-    return max(1, min(configured or max(grid.dims), steps))
+    """The fine grid's steps K with a far field: `configured`, or (0) half the grid's longest side, at
+    most the bounce's own `steps`."""
+    return max(2, min(configured or max(grid.dims) // 2, steps))
 
 
-def source(backend: Backend, flux: dict, cells: dict, fine: Grid, coarse_flux: dict, coarse_cells: dict,
-           coarse: Grid, atlas=None, vox_albedo=None) -> None:
-    """coarse_flux (flux_plus / flux_minus, W, every coarse cell written) := the fine grid's emitted flux
-    per side summed into its coarse cells: `flux` the injection atlases (`atlas` given) or volumes of
-    absorbed flux times the fine `vox_albedo`."""
-    spec = SOURCE_SPECS[atlas is not None]
-    uniforms = {"dims": fine.dims, "coarse_dims": coarse.dims}
-    samplers = {"flux_plus": flux["flux_plus"], "flux_minus": flux["flux_minus"], **cells,
-                "coarse_normal": coarse_cells["cell_normal"]}
-    if atlas is not None:
-        uniforms["tiles_x"] = atlas.tiles_x
-    else:
-        samplers["vox_albedo"] = vox_albedo
-    backend.dispatch(backend.program(spec), group_count(coarse.dims, spec.local_size), uniforms=uniforms,
-                     samplers=samplers,
-                     images={"coarse_plus": coarse_flux["flux_plus"], "coarse_minus": coarse_flux["flux_minus"]})
+def emitters(backend: Backend, snapshot: dict, fine: Grid, far_snapshots: list, far_cells: dict, far: FarGrid) -> None:
+    """far_snapshots[0] (sh_r/g/b) := the far grid's emitters: the fine `snapshot` summed per far cell
+    (lpv_far_field.source, into far_snapshots[1]), the light of enclosed far cells moved to their
+    neighbours (far_field_move.comp.glsl)."""
+    lpv_far_field.source(backend, snapshot, fine, far_snapshots[1], far.grid, far.shift)
+    backend.dispatch(backend.program(MOVE), group_count(far.grid.dims, MOVE.local_size),
+                     uniforms={"dims": far.grid.dims},
+                     samplers={**{f"src_{c}": far_snapshots[1][f"sh_{c}"] for c in "rgb"},
+                               "cell_block": far_cells["cell_block"]},
+                     images=far_snapshots[0])
 
 
-def add(backend: Backend, coarse_absorbed: dict, coarse_cells: dict, absorbed: dict, cells: dict, fine: Grid) -> None:
-    """absorbed (the fine grid's flux_plus / flux_minus, W) += the coarse grid's absorbed flux shared out
-    to the fine sides (far_field_add.comp.glsl)."""
-    backend.dispatch(backend.program(ADD), group_count(fine.dims, ADD.local_size), uniforms={"dims": fine.dims},
-                     samplers={"far_plus": coarse_absorbed["flux_plus"], "far_minus": coarse_absorbed["flux_minus"],
-                               "coarse_normal": coarse_cells["cell_normal"], **cells},
+def weights(backend: Backend, far_cells: dict, far: FarGrid, cells: dict, fine: Grid, out: dict | None = None) -> dict:
+    """The far cells' weights per face (weight_0 / weight_1, far_field_weights.comp.glsl): what their
+    absorbed flux is shared out by; once per voxelization. `out`'s textures, or new ones."""
+    out = out or {k: backend.texture(far.grid.dims) for k in ("weight_0", "weight_1")}
+    backend.dispatch(backend.program(WEIGHTS), group_count(far.grid.dims, WEIGHTS.local_size),
+                     uniforms={"dims": far.grid.dims, "fine_dims": fine.dims, "fine_shift": far.shift},
+                     samplers={"far_block": far_cells["cell_block"], **cells}, images=out)
+    return out
+
+
+def add(backend: Backend, far_absorbed: dict, far_weights: dict, far: FarGrid, absorbed: dict, cells: dict,
+        fine: Grid) -> None:
+    """absorbed (the fine grid's flux_plus / flux_minus, W) += the far grid's absorbed flux per face
+    (acc_0 .. acc_4, diffusion_propagate.faces) shared onto the fine sides by `far_weights` (`weights`)
+    and the far cells' trilinear tents (far_field_add.comp.glsl)."""
+    backend.dispatch(backend.program(ADD), group_count(fine.dims, ADD.local_size),
+                     uniforms={"dims": fine.dims, "far_dims": far.grid.dims, "fine_shift": far.shift},
+                     samplers={**{f"far_{i}": far_absorbed[f"acc_{i}"] for i in range(FACE_TEXELS)}, **far_weights,
+                               **cells},
                      images={"acc_plus": absorbed["flux_plus"], "acc_minus": absorbed["flux_minus"]})

@@ -36,26 +36,24 @@ DECL = PassDecl("diffusion_inject", "solve", (*RSM, CELL_NORMAL), (INJECTED,),
                 "each face's VPLs splatted by side of their cell's plane")
 
 
-def _emit_spec(source: str) -> ShaderSpec:
-    atlas = source == "atlas"
+def _emit_spec(atlas: bool) -> ShaderSpec:
     dim = "2D" if atlas else "3D"
     samplers = (Sampler("flux_plus", dim), Sampler("flux_minus", dim), Sampler("cell_normal", "3D"),
                 Sampler("cell_block", "3D"))
     uniforms = (Var("dims", "ivec3"), Var("emitting_class", "int"))
     if atlas:
         uniforms += (Var("tiles_x", "int"),)
-    if source == "albedo":
+    else:
         samplers += (Sampler("vox_albedo", "3D"),)
-    return ShaderSpec(name=f"diffusion_emit_{source}", compute="diffusion/emit.comp.glsl",
+    return ShaderSpec(name="diffusion_emit" + ("_atlas" if atlas else "_albedo"), compute="diffusion/emit.comp.glsl",
                       local_size=(4, 4, 4), samplers=samplers,
                       images=tuple(Image(f"sh_{c}", "3D", "RGBA32F", "write") for c in "rgb"), uniforms=uniforms,
-                      defines={"atlas": (("ATLAS", "1"),), "albedo": (("ALBEDO", "1"),), "volume": ()}[source])
+                      defines=(("ATLAS", "1"),) if atlas else (("ALBEDO", "1"),))
 
 
-# From the injection atlases (the first bounce: VPL flux is reflected light already), from a bounce's
-# absorbed flux times the voxels' albedo (the next bounce), or from volumes of emitted flux as they are
-# (a far field's, diffusion_far_field.source, which applied the fine voxels' albedo).
-EMIT_SPECS = {source: _emit_spec(source) for source in ("atlas", "albedo", "volume")}
+# From the injection atlases (the first bounce: VPL flux is reflected light already), or from a bounce's
+# absorbed flux times the voxels' albedo (the next bounce).
+EMIT_SPECS = {True: _emit_spec(True), False: _emit_spec(False)}
 EMIT_DECL = PassDecl("diffusion_emit", "solve", (INJECTED, CELL_NORMAL, CELL_BLOCK, VOX_ALBEDO), (SNAPSHOT,),
                      "each side's flux as a Lambertian lobe about its normal (x albedo for later bounces)")
 
@@ -75,16 +73,15 @@ def run(backend: Backend, target, points, rsm: dict, grid: Grid, atlas: Atlas, c
 def emit(backend: Backend, flux: dict, cells: dict, snapshot: dict, grid: Grid, atlas: Atlas | None = None,
          vox_albedo=None, emitter_class: int = EVERY_CLASS) -> None:
     """snapshot (sh_r/g/b) := the emitters of `flux` (flux_plus / flux_minus): the injection atlases
-    (`atlas` given), volumes of absorbed flux re-emitted times `vox_albedo`, or (neither given) volumes
-    of flux emitted as it is; of the sides of
+    (`atlas` given), or volumes of absorbed flux re-emitted times `vox_albedo`; of the sides of
     `emitter_class` alone (0..5: the dominant signed axis of the side's normal, as the faces +x -x +y -y
     +z -z) unless it is EVERY_CLASS. Every cell written."""
-    spec = EMIT_SPECS["atlas" if atlas is not None else "albedo" if vox_albedo is not None else "volume"]
+    spec = EMIT_SPECS[atlas is not None]
     samplers = {"flux_plus": flux["flux_plus"], "flux_minus": flux["flux_minus"], **cells}
     uniforms = {"dims": grid.dims, "emitting_class": emitter_class}
     if atlas is not None:
         uniforms["tiles_x"] = atlas.tiles_x
-    if vox_albedo is not None:
+    else:
         samplers["vox_albedo"] = vox_albedo
     backend.dispatch(backend.program(spec), group_count(grid.dims, spec.local_size), uniforms=uniforms,
                      samplers=samplers, images=snapshot)

@@ -28,25 +28,30 @@ ABSORBED = Port("diffusion", "absorbed", "RGBA32F", "grid", "one bounce's flux (
 ACCUMULATED = Port("diffusion", "accumulated", "RGBA32F", "grid",
                    "every bounce's flux (W) absorbed on each side of a plane: the light field")
 
-def _spec(transfer: str) -> ShaderSpec:
+def _spec(transfer: str, faces: bool) -> ShaderSpec:
     directional = transfer == "directional"
+    accumulators = (tuple(Image(f"acc_{i}", "3D", "RGBA32F", "read_write") for i in range(FACE_TEXELS)) if faces
+                    else (Image("acc_plus", "3D", "RGBA32F", "read_write"),
+                          Image("acc_minus", "3D", "RGBA32F", "read_write")))
     return ShaderSpec(
-        name=f"diffusion_propagate_{transfer}",
+        name=f"diffusion_propagate_{transfer}" + ("_faces" if faces else ""),
         compute="diffusion/propagate.comp.glsl",
         local_size=(4, 4, 4),
-        samplers=(*(Sampler(f"src_{c}", "3D") for c in "rgb"), Sampler("cell_normal", "3D"),
+        samplers=(*(Sampler(f"src_{c}", "3D") for c in "rgb"), *(() if faces else (Sampler("cell_normal", "3D"),)),
                   Sampler("cell_block", "3D")),
-        images=(*(Image(f"dst_{c}", "3D", "RGBA32F", "write") for c in "rgb"),
-                Image("acc_plus", "3D", "RGBA32F", "read_write"), Image("acc_minus", "3D", "RGBA32F", "read_write")),
+        images=(*(Image(f"dst_{c}", "3D", "RGBA32F", "write") for c in "rgb"), *accumulators),
         uniforms=(Var("dims", "ivec3"), Var("first_step", "int"), Var("weight", "float"))
         + ((Var("m_cross", "float"), Var("m_along", "float"), Var("m_side", "float"), Var("flux_cross", "float"))
            if directional else ()),
-        defines=(("DIRECTIONAL", "1"),) if directional else (),
+        defines=(("DIRECTIONAL", "1"),) * directional + (("FACES", "1"),) * faces,
     )
 
 
+# The flux per face of a cell, 6 faces x rgb, packed into this many RGBA volumes (diffusion/faces.glsl).
+FACE_TEXELS = 5
 # cone: the paper's face-cone transfer, normalised; directional: LPV's improved transfer (docs/DIFFUSION.md).
-SPECS = {t: _spec(t) for t in ("cone", "directional")}
+# faces: the absorbed flux kept by the face it came through (the far field's grid, diffusion_far_field).
+SPECS = {(t, faces): _spec(t, faces) for t in ("cone", "directional") for faces in (False, True)}
 
 ADD = ShaderSpec(
     name="diffusion_add",
@@ -91,19 +96,27 @@ def sides(backend: Backend, grid: Grid) -> dict:
     return {k: backend.texture(grid.dims) for k in ("flux_plus", "flux_minus")}
 
 
+def faces(backend: Backend, grid: Grid) -> dict:
+    """Volumes of flux per face of a cell (acc_0 .. acc_4, diffusion/faces.glsl's packing)."""
+    return {f"acc_{i}": backend.texture(grid.dims) for i in range(FACE_TEXELS)}
+
+
 def run(backend: Backend, src: dict, dst: dict, absorbed: dict, cells: dict, grid: Grid, first_step: bool,
         transfer: str = "cone", weight: float = 1.0) -> None:
     """One step: src (sh_r/g/b) -> dst, the flux absorbed times `weight` (a far field's share of the step,
-    diffusion_far_field) written (first_step) or added into `absorbed` (flux_plus / flux_minus)."""
-    spec = SPECS[transfer]
+    diffusion_far_field) written (first_step) or added into `absorbed`: per side (flux_plus / flux_minus,
+    from `sides`) or per face it came through (acc_0 .. acc_4, from `faces`)."""
+    by_face = "acc_0" in absorbed
+    spec = SPECS[transfer, by_face]
     uniforms = {"dims": grid.dims, "first_step": int(first_step), "weight": weight}
     if transfer == "directional":
         c = improved_constants()
         uniforms.update(m_cross=c["m_cross"], m_along=c["m_along"], m_side=c["m_side"], flux_cross=flux_cross())
+    images = (dict(absorbed) if by_face
+              else {"acc_plus": absorbed["flux_plus"], "acc_minus": absorbed["flux_minus"]})
     backend.dispatch(backend.program(spec), group_count(grid.dims, spec.local_size), uniforms=uniforms,
                      samplers={**{f"src_{c}": src[f"sh_{c}"] for c in "rgb"}, **cells},
-                     images={**{f"dst_{c}": dst[f"sh_{c}"] for c in "rgb"}, "acc_plus": absorbed["flux_plus"],
-                             "acc_minus": absorbed["flux_minus"]})
+                     images={**{f"dst_{c}": dst[f"sh_{c}"] for c in "rgb"}, **images})
 
 
 def add(backend: Backend, bounce: dict, total: dict, grid: Grid, first: bool, cell_normal,

@@ -49,7 +49,7 @@ SOURCE = ShaderSpec(
     local_size=(4, 4, 4),
     samplers=tuple(Sampler(f"fine_{c}", "3D") for c in "rgb"),
     images=tuple(Image(f"sh_{c}", "3D", "RGBA32F", "write") for c in "rgb"),
-    uniforms=(Var("dims", "ivec3"), Var("fine_dims", "ivec3")),
+    uniforms=(Var("dims", "ivec3"), Var("fine_dims", "ivec3"), Var("fine_shift", "ivec3")),
 )
 
 VOXELS = ShaderSpec(
@@ -90,10 +90,12 @@ def add(backend: Backend, coarse_acc: dict, coarse: Grid, fine_acc: dict, fine: 
                      samplers={f"far_{c}": coarse_acc[f"acc_{c}"] for c in "rgb"}, images=fine_acc)
 
 
-def source(backend: Backend, fine_snapshot: dict, fine: Grid, coarse_snapshot: dict, coarse: Grid) -> None:
-    """coarse_snapshot (keys sh_r/g/b) = per coarse cell the sum of its fine cells in fine_snapshot."""
+def source(backend: Backend, fine_snapshot: dict, fine: Grid, coarse_snapshot: dict, coarse: Grid,
+           fine_shift: tuple[int, int, int] = (0, 0, 0)) -> None:
+    """coarse_snapshot (keys sh_r/g/b) = per coarse cell the sum of its fine cells in fine_snapshot: coarse
+    cell j holds fine cells 2j - fine_shift .. 2j - fine_shift + 1 per axis (0: `grid_for`'s)."""
     backend.dispatch(backend.program(SOURCE), group_count(coarse.dims, SOURCE.local_size),
-                     uniforms={"dims": coarse.dims, "fine_dims": fine.dims},
+                     uniforms={"dims": coarse.dims, "fine_dims": fine.dims, "fine_shift": tuple(fine_shift)},
                      samplers={f"fine_{c}": fine_snapshot[f"sh_{c}"] for c in "rgb"}, images=coarse_snapshot)
 
 
