@@ -17,13 +17,15 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..engine import choice, config
-from ..engine.config import GIConfig, LpvConfig, RsmConfig, VctConfig
+from ..engine.config import DiffusionConfig, GIConfig, LpvConfig, RsmConfig, VctConfig
 from ..engine.errors import ConfigError
 
 CONFIGS = tuple(config.GROUPS.values())
 
 # GIConfig and RsmConfig both have `resolution` and they are different ideas (image vs. shadow map).
-_PRIMARY = {(RsmConfig, "resolution"): "--rsm-resolution"}
+_PRIMARY = {(RsmConfig, "resolution"): "--rsm-resolution",
+            # lpv's near_steps defaults to half its grid, diffusion's to half its steps per bounce.
+            (DiffusionConfig, "near_steps"): "--diffusion-near-steps"}
 
 # The short spellings of earlier releases: the README, tests and benchmarks use them.
 _ALIASES = {

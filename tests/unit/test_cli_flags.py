@@ -97,7 +97,8 @@ def test_help_shows_choices_defaults_and_ranges(capsys):
     assert "range [8, 256] (default: 32; LpvConfig.grid_cells, DiffusionConfig.grid_cells)" in text
     assert "--visibility {none,voxel}" in text and "one of none, voxel (default: none;" in text
     assert f"(default: {GIConfig().method}; GIConfig.method)" in text
-    assert "--far-field, --no-far-field" in text and "(default: on; LpvConfig.far_field)" in text
+    assert "--far-field, --no-far-field" in text
+    assert "(default: on; LpvConfig.far_field, DiffusionConfig.far_field)" in text
 
 
 def test_render_and_bake_share_the_method_default():

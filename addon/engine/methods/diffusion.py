@@ -132,7 +132,7 @@ class DiffusionMethod(OneBounceMethod):
         bounce added to `accumulated` (the same volumes with one bounce)."""
         be, grid, cells, far = self.backend, self.grid, self.cells, self.far
         steps = steps_per_bounce(self.diffusion_config, grid, self.gi.bounces)
-        near = diffusion_far_field.near_steps(self.diffusion_config.near_steps, grid, steps) if far else steps
+        near = diffusion_far_field.near_steps(self.diffusion_config.near_steps, steps) if far else steps
         # Without a far field every step counts whole; with one the fine grid's count falls to 0 at `near`.
         fine_weights = ([lpv_far_field.fine_weight(i, near) for i in range(1, max(2, near))] if far
                         else [1.0] * steps)

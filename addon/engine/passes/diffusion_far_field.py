@@ -108,10 +108,10 @@ def best_shift(occupied: np.ndarray) -> tuple[int, int, int]:
     return best
 
 
-def near_steps(configured: int, grid: Grid, steps: int) -> int:
-    """The fine grid's steps K with a far field: `configured`, or (0) half the grid's longest side, at
-    most the bounce's own `steps`."""
-    return max(2, min(configured or max(grid.dims) // 2, steps))
+def near_steps(configured: int, steps: int) -> int:
+    """The fine grid's steps K with a far field, of a bounce's `steps`: `configured`, or (0) half of them
+    (the grid's span at span_multiple 2), at least 2 (the fine grid runs K - 1 steps) and at most `steps`."""
+    return max(2, min(configured or steps // 2, steps))
 
 
 def emitters(backend: Backend, snapshot: dict, fine: Grid, far_snapshots: list, far_cells: dict, far: FarGrid) -> None:
