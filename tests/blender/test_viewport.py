@@ -209,10 +209,13 @@ def test_navigating_gives_preview_then_full_quality(cornell):
 
 @pytest.mark.parametrize("name", ["direct", "direct-world", "direct-area", "direct-emissive", "rsm", "lpv",
                                   "lpv-far-field", "lpv-emitter-classes",
-                                  "lpv-octree", "lpv-octree-index", "vct", "vct-filtered", "diffusion", "probes",
+                                  "lpv-octree", "lpv-octree-index", "vct", "vct-filtered", "diffusion",
+                                  "diffusion-far-field", "probes",
                                   "probes-irradiance", "probes-relocate", "probes-area", "gather", "gather-point"])
 def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, name):
     # lpv at 16 cells runs one grid; "lpv-far-field" at 32 cells adds the far field's passes;
+    # "diffusion-far-field" (32 cells) diffusion's: the far grid's voxels, cells, weights, emitters
+    # (moved where enclosed), its steps by face (eight images) and their share onto the fine sides;
     # "lpv-emitter-classes" (16 cells) the classes' injection, unpacks and own-light lookups;
     # "lpv-octree" (16 cells) every level's injection and the time merge, "lpv-octree-index" the
     # downsampling and the index merge's shader;
@@ -242,7 +245,7 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
                 "direct-emissive": "emissive", "probes-area": "cornell-large-area"}
     scenes.build(scene_of.get(name, "cornell-glossy" if name.startswith("vct") else "cornell"))
     scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), 64, 48)
-    method_name, grid_cells = ("lpv", 32) if name == "lpv-far-field" else (name.split("-")[0], 16)
+    method_name, grid_cells = (name.split("-")[0], 32) if name.endswith("far-field") else (name.split("-")[0], 16)
     gi = GIConfig(method=method_name, resolution=64)
     rsm = RsmConfig(resolution=128, vpl_samples=64)
     results = []
@@ -252,7 +255,7 @@ def test_blender_gpu_run_equals_moderngl_run(gl, blender_backend, fresh_blend, n
                         octree_merge="index" if name == "lpv-octree-index" else "time")
         vct = VctConfig(voxel_cells=16, diffuse_cones=6, filtered_injection=name == "vct-filtered")
         method = methods.create(be, {"gi": gi, "rsm": rsm, "lpv": lpv, "vct": vct,
-                                     "diffusion": DiffusionConfig(grid_cells=16),
+                                     "diffusion": DiffusionConfig(grid_cells=grid_cells),
                                      "probes": ProbesConfig(probes_per_side=6, encoding="irradiance"
                                                             if name == "probes-irradiance" else "sh",
                                                             relocate=name == "probes-relocate",

@@ -30,7 +30,6 @@ from ..passes import (
     diffusion_inject,
     diffusion_lookup,
     diffusion_propagate,
-    lpv_far_field,
     voxelize,
     zero,
 )
@@ -127,15 +126,12 @@ class DiffusionMethod(OneBounceMethod):
 
     def finish_solve(self, timings: dict[str, float]) -> None:
         """Each bounce: per emitter class, its emitters (the injected light, then the last bounce's
-        absorbed flux x albedo) and their propagation into `absorbed` (with a far field, the near steps'
-        share plus the far grid's), added to the bounce's flux at the sides of the other classes; the
-        bounce added to `accumulated` (the same volumes with one bounce)."""
+        absorbed flux x albedo) and their propagation into `absorbed` (with a far field, the near steps
+        and then the far grid's from the light still in flight), added to the bounce's flux at the sides of
+        the other classes; the bounce added to `accumulated` (the same volumes with one bounce)."""
         be, grid, cells, far = self.backend, self.grid, self.cells, self.far
         steps = steps_per_bounce(self.diffusion_config, grid, self.gi.bounces)
         near = diffusion_far_field.near_steps(self.diffusion_config.near_steps, steps) if far else steps
-        # Without a far field every step counts whole; with one the fine grid's count falls to 0 at `near`.
-        fine_weights = ([lpv_far_field.fine_weight(i, near) for i in range(1, max(2, near))] if far
-                        else [1.0] * steps)
         transfer = self.diffusion_config.transfer
         classes = (diffusion_inject.EMITTER_CLASSES if self.diffusion_config.emitter_class_passes
                    else (diffusion_inject.EVERY_CLASS,))
@@ -150,16 +146,13 @@ class DiffusionMethod(OneBounceMethod):
                     else:
                         diffusion_inject.emit(be, previous, cells, self.snapshots[0], grid,
                                               vox_albedo=self.voxels["vox_albedo"], emitter_class=k)
-                if far is not None:  # its emitters before the fine steps overwrite snapshot 0
-                    with self.step(timings, diffusion_far_field.DECL):
-                        diffusion_far_field.emitters(be, self.snapshots[0], grid, far.snapshots, far.cells, far.far)
                 with self.step(timings, diffusion_propagate.DECL):
-                    for i, weight in enumerate(fine_weights):
+                    for i in range(near):
                         diffusion_propagate.run(be, self.snapshots[i % 2], self.snapshots[(i + 1) % 2], self.absorbed,
-                                                cells, grid, first_step=i == 0, transfer=transfer, weight=weight)
+                                                cells, grid, first_step=i == 0, transfer=transfer)
                 if far is not None:
                     with self.step(timings, diffusion_far_field.DECL):
-                        self._propagate_far(near, transfer)
+                        self._propagate_far(self.snapshots[near % 2], steps - near, transfer)
                 if flux is not self.absorbed:
                     with self.step(timings, diffusion_propagate.DECL):
                         diffusion_propagate.add(be, self.absorbed, flux, grid, first=k == classes[0],
@@ -170,16 +163,15 @@ class DiffusionMethod(OneBounceMethod):
                                             cell_normal=cells["cell_normal"])
             previous = flux
 
-    def _propagate_far(self, near: int, transfer: str) -> None:
-        """The far grid's propagation of the emitters in its snapshot 0 (its whole span, each step counted
-        by its share of the time of flight the fine grid's `near` steps leave), added to the fine
-        `absorbed`."""
+    def _propagate_far(self, in_flight: dict, fine_steps_left: int, transfer: str) -> None:
+        """The light still in flight after the near steps, summed into the far grid, propagated there for
+        the rest of the bounce (half as many steps: a far step moves light two fine cells), and what its
+        surfaces absorb added to the fine `absorbed`."""
         be, f = self.backend, self.far
-        grid = f.far.grid
-        for i in range(steps_per_bounce(self.diffusion_config, grid, self.gi.bounces)):
-            diffusion_propagate.run(be, f.snapshots[i % 2], f.snapshots[(i + 1) % 2], f.absorbed, f.cells, grid,
-                                    first_step=i == 0, transfer=transfer,
-                                    weight=lpv_far_field.coarse_weight(i + 1, near))
+        diffusion_far_field.emitters(be, in_flight, self.grid, f.snapshots, f.cells, f.far)
+        for i in range(max(1, (fine_steps_left + 1) // 2)):
+            diffusion_propagate.run(be, f.snapshots[i % 2], f.snapshots[(i + 1) % 2], f.absorbed, f.cells,
+                                    f.far.grid, first_step=i == 0, transfer=transfer)
         diffusion_far_field.add(be, f.absorbed, f.weights, f.far, self.absorbed, self.cells, self.grid)
 
     def gather_pixels(self, timings: dict[str, float]) -> None:

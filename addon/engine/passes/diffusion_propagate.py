@@ -40,7 +40,7 @@ def _spec(transfer: str, faces: bool) -> ShaderSpec:
         samplers=(*(Sampler(f"src_{c}", "3D") for c in "rgb"), *(() if faces else (Sampler("cell_normal", "3D"),)),
                   Sampler("cell_block", "3D")),
         images=(*(Image(f"dst_{c}", "3D", "RGBA32F", "write") for c in "rgb"), *accumulators),
-        uniforms=(Var("dims", "ivec3"), Var("first_step", "int"), Var("weight", "float"))
+        uniforms=(Var("dims", "ivec3"), Var("first_step", "int"))
         + ((Var("m_cross", "float"), Var("m_along", "float"), Var("m_side", "float"), Var("flux_cross", "float"))
            if directional else ()),
         defines=(("DIRECTIONAL", "1"),) * directional + (("FACES", "1"),) * faces,
@@ -102,13 +102,13 @@ def faces(backend: Backend, grid: Grid) -> dict:
 
 
 def run(backend: Backend, src: dict, dst: dict, absorbed: dict, cells: dict, grid: Grid, first_step: bool,
-        transfer: str = "cone", weight: float = 1.0) -> None:
-    """One step: src (sh_r/g/b) -> dst, the flux absorbed times `weight` (a far field's share of the step,
-    diffusion_far_field) written (first_step) or added into `absorbed`: per side (flux_plus / flux_minus,
-    from `sides`) or per face it came through (acc_0 .. acc_4, from `faces`)."""
+        transfer: str = "cone") -> None:
+    """One step: src (sh_r/g/b) -> dst, the flux absorbed written (first_step) or added into `absorbed`:
+    per side (flux_plus / flux_minus, from `sides`) or per face it came through (acc_0 .. acc_4, from
+    `faces`; the far field's grid, which also absorbs light an occupied cell holds and cannot send on)."""
     by_face = "acc_0" in absorbed
     spec = SPECS[transfer, by_face]
-    uniforms = {"dims": grid.dims, "first_step": int(first_step), "weight": weight}
+    uniforms = {"dims": grid.dims, "first_step": int(first_step)}
     if transfer == "directional":
         c = improved_constants()
         uniforms.update(m_cross=c["m_cross"], m_along=c["m_along"], m_side=c["m_side"], flux_cross=flux_cross())
