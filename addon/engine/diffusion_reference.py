@@ -291,25 +291,15 @@ def step(field: np.ndarray, cell: dict, transfer: str = "cone") -> tuple[np.ndar
     return nxt, np.sum(absorbed * plus, -1), np.sum(absorbed * (1.0 - plus), -1)
 
 
-def step_by_face(field: np.ndarray, cell: dict, transfer: str = "cone",
-                 absorb_trapped: bool = False) -> tuple[np.ndarray, np.ndarray]:
+def step_by_face(field: np.ndarray, cell: dict, transfer: str = "cone") -> tuple[np.ndarray, np.ndarray]:
     """One gather step (`step`): (next field, flux absorbed by the face it came through (z, y, x, 6), W),
-    as the far field's grid keeps it (diffusion_far_field). `absorb_trapped` (the far grid's steps): an
-    occupied cell whose light no open face carries (no open face has a positive raw flux) absorbs it
-    itself, by the face each share travels toward (the raw fluxes' shares): the far grid starts from the
-    fine grid's light in flight, which may be travelling into a surface inside its far cell."""
+    as the far field's grid keeps it (diffusion_far_field)."""
     out = face_fluxes(field, cell["open"], transfer)
     a = inflow(out)
     shape = inflow(np.ascontiguousarray(carried_shapes(field, cell["open"], out, transfer)))
     axis_of_face = np.array([axis for axis, _ in AXES])
     absorbed = a * cell["block"][..., axis_of_face]
     nxt = np.einsum("...d,...dk->...k", a - absorbed, shape)
-    if absorb_trapped:
-        raw = np.maximum(face_transport(field, transfer)[0], 0.0)
-        all_sum = raw.sum(-1, keepdims=True)
-        stuck = cell["occupied"][..., None] & ((raw * cell["open"]).sum(-1, keepdims=True) <= 0) & (all_sum > 0)
-        total = np.maximum(FLUX_PER_C0 * field[..., :1], 0.0)
-        absorbed = absorbed + np.where(stuck, raw * total / np.where(all_sum > 0, all_sum, 1.0), 0.0)
     return nxt, absorbed
 
 

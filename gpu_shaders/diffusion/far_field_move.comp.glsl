@@ -1,9 +1,10 @@
-// Diffusion far field, enclosed emitters: the far grid's emitters (the fine grid's summed per far cell,
-// lpv_far_field.source, in src_r/g/b) with the light of every enclosed cell - occupied, no open face -
-// moved to its neighbours (passes/diffusion_far_field.py; twin: diffusion_reference.far_move_enclosed).
-// Light leaves an occupied cell only by open faces, and where a wall meets a floor or ceiling the far
-// cell on the edge is walled in by occupied cells (wall, floor and the edge cells beside it) though the
-// fine emitters in it face the room: about a quarter of a room's wall light was trapped there (thin-wall).
+// Diffusion far field, enclosed cells: the far grid's starting light (the fine grid's light in flight
+// summed per far cell, lpv_far_field.source, in src_r/g/b) with the light of every enclosed cell -
+// occupied, no open face - moved to its neighbours (passes/diffusion_far_field.py; twin:
+// diffusion_reference.far_move_enclosed). Light leaves an occupied cell only by open faces, and where a
+// wall meets a floor or ceiling the far cell on the edge is walled in by occupied cells (wall, floor and
+// the edge cells beside it) though the fine light in it is in the room: summing the fine emitters into
+// the far grid trapped a quarter of thin-wall's wall light there.
 // An enclosed cell's light goes to its 18 face and edge neighbours that are not enclosed, in proportion
 // to 1e-3 + max(0, u.w), u the unit offset, w the mean direction of its light (the band-1 vector of its
 // channels' sum): mostly to the room diagonal it faces, keeping its direction of travel. With no such

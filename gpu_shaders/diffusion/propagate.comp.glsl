@@ -101,23 +101,7 @@ vec3 inflow(ivec3 c, int f, bool occupied, vec4 block, inout vec4 r, inout vec4 
     return a * absorb;
 }
 
-#ifdef FACES
-// Of one channel's field c in an occupied cell: the flux that no open face carries, by the face it
-// travels toward, (+x +y +z) and (-x -y -z), where no open face has a positive raw flux; else 0. Such
-// light is absorbed where it is. An emitter faces open space, but the far grid starts from the fine
-// grid's light in flight (passes/diffusion_far_field.py), and a far cell holding a wall can hold light
-// travelling into it, which `channel_outflow` would drop.
-void trapped(vec4 c, vec3 open_plus, vec3 open_minus, out vec3 plus, out vec3 minus) {
-    vec3 along = c.wyz;
-    plus = max(RAW_K0 * c.x + RAW_K1 * along, vec3(0.0));
-    minus = max(RAW_K0 * c.x - RAW_K1 * along, vec3(0.0));
-    float open_sum = dot(plus * open_plus + minus * open_minus, vec3(1.0));
-    float all_sum = dot(plus + minus, vec3(1.0));
-    float scale = open_sum <= 0.0 && all_sum > 0.0 ? max(DIFFUSION_FLUX_PER_C0 * c.x, 0.0) / all_sum : 0.0;
-    plus *= scale;
-    minus *= scale;
-}
-#else
+#ifndef FACES
 // The side of the plane (normal n) that light absorbed through face f lands on: plus when it travels
 // against n.
 void to_sides(int f, vec3 absorbed, vec3 n, inout vec3 plus, inout vec3 minus) {
@@ -146,23 +130,7 @@ void main() {
     imageStore(dst_g, c, g);
     imageStore(dst_b, c, b);
 #ifdef FACES
-    // The flux absorbed by the face it came through (diffusion/faces.glsl packs the 18 numbers), and the
-    // light trapped in this cell by the face it travels toward.
-    if (occupied) {
-        int mask = int(block.w) - 1;
-        vec3 open_plus = vec3(notEqual(ivec3(mask & 1, mask & 4, mask & 16), ivec3(0)));
-        vec3 open_minus = vec3(notEqual(ivec3(mask & 2, mask & 8, mask & 32), ivec3(0)));
-        vec3 rp, rm, gp, gm, bp, bm;
-        trapped(texelFetch(src_r, c, 0), open_plus, open_minus, rp, rm);
-        trapped(texelFetch(src_g, c, 0), open_plus, open_minus, gp, gm);
-        trapped(texelFetch(src_b, c, 0), open_plus, open_minus, bp, bm);
-        a0 += vec3(rp.x, gp.x, bp.x);
-        a1 += vec3(rm.x, gm.x, bm.x);
-        a2 += vec3(rp.y, gp.y, bp.y);
-        a3 += vec3(rm.y, gm.y, bm.y);
-        a4 += vec3(rp.z, gp.z, bp.z);
-        a5 += vec3(rm.z, gm.z, bm.z);
-    }
+    // The flux absorbed by the face it came through (diffusion/faces.glsl packs the 18 numbers).
     vec4 p0, p1, p2, p3, p4;
     diffusion_pack_faces(a0, a1, a2, a3, a4, a5, p0, p1, p2, p3, p4);
     if (first_step == 0) {

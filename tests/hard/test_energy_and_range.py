@@ -35,7 +35,8 @@ FACES = [ax for ax in np.eye(3).tolist() + (-np.eye(3)).tolist()]
 # diffusion at 16 cells as well as its default 32: the walls pass through cell centres, so the half
 # cells along every edge lie in cells no light can reach and their pixels read the neighbouring cells'
 # flux / area: the image reads 1.045 P at 16 cells, beyond the bound (a known defect, conftest.py), and
-# 1.001 P at 32 (docs/DIFFUSION.md, "Coarse grids over-read near edges").
+# 0.947 P at 32 with its far field, 1.001 P on one grid (docs/DIFFUSION.md, "Coarse grids over-read
+# near edges", "Far field").
 @pytest.mark.parametrize("name", (*ALL_METHODS, "diffusion+cells16"))
 def test_white_closed_box_conserves_flux(gl, figures, name):
     # A cube [-1, 1]^3, albedo 1 everywhere, a P = 100 W point light at L = (0.2, -0.1, 0.3) inside.

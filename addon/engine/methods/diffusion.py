@@ -8,9 +8,9 @@ sides' flux as Lambertian L1 SH lobes about their normals: the injected direct l
 absorbed flux times albedo), steps x diffusion_propagate (gather form, ping-pong, absorbed flux
 accumulated per side), the class's light added to the bounce's at every side of another class, and the
 bounce added to the light field (diffusion_propagate.add); with DiffusionConfig.far_field (grids of
-diffusion_far_field.MIN_GRID_CELLS and more) the grid runs only its near steps and a grid of twice the
-cell (its own voxelizer and cells) the rest, each class's emitters summed into it and its absorbed flux
-sorted back onto the fine sides (diffusion_far_field); the gather: diffusion_lookup -> `indirect`
+diffusion_far_field.MIN_GRID_CELLS and more) the grid runs only its near steps, and the light still in
+flight is handed to a grid of twice the cell (its own voxelizer and cells) for the rest of the bounce,
+whose absorbed flux is shared back onto the fine sides (diffusion_far_field); the gather: diffusion_lookup -> `indirect`
 (Cycles' Diffuse Indirect). The light field does not depend on the camera: a camera move re-runs only
 the lookup.
 docs/DIFFUSION.md derives the transport and measures it; diffusion_reference.py is its numpy twin.
@@ -165,11 +165,12 @@ class DiffusionMethod(OneBounceMethod):
 
     def _propagate_far(self, in_flight: dict, fine_steps_left: int, transfer: str) -> None:
         """The light still in flight after the near steps, summed into the far grid, propagated there for
-        the rest of the bounce (half as many steps: a far step moves light two fine cells), and what its
-        surfaces absorb added to the fine `absorbed`."""
+        as many steps as the bounce had left, and what its surfaces absorb added to the fine `absorbed`.
+        A far step moves light two fine cells, but light scatters at every cell and wanders: in a closed
+        white box half as many steps left 8 % of the light handed over in flight, as many 0.4 %."""
         be, f = self.backend, self.far
-        diffusion_far_field.emitters(be, in_flight, self.grid, f.snapshots, f.cells, f.far)
-        for i in range(max(1, (fine_steps_left + 1) // 2)):
+        diffusion_far_field.hand_over(be, in_flight, self.grid, f.snapshots, f.cells, f.far)
+        for i in range(max(1, fine_steps_left)):
             diffusion_propagate.run(be, f.snapshots[i % 2], f.snapshots[(i + 1) % 2], f.absorbed, f.cells,
                                     f.far.grid, first_step=i == 0, transfer=transfer)
         diffusion_far_field.add(be, f.absorbed, f.weights, f.far, self.absorbed, self.cells, self.grid)

@@ -1,26 +1,25 @@
-"""Diffusion far field: light beyond the fine grid's near steps carried on a grid of twice the cell size
-(docs/DIFFUSION.md, "Far field"; the scheme of lpv_far_field, for absorbed flux instead of accumulated SH).
+"""Diffusion far field: the light still in flight after the fine grid's near steps carried on to its end on
+a grid of twice the cell size (docs/DIFFUSION.md, "Far field"; lpv_far_field does the same for lpv).
 
 A bounce's light needs twice the grid's span of steps to settle (DiffusionConfig.span_multiple). Here the
-fine grid runs only its first `near_steps` K, and a far grid (`grid_for`: cell 2h, its own voxelization
-and cells, aligned by `best_shift`) the whole span, in half as many steps at 1/8 of the cells. Both count
-what their surfaces absorb by time of flight (lpv_far_field.fine_weight / coarse_weight, the `weight` of
-diffusion_propagate.run): light absorbed at fine time t is counted w(t) on the fine grid and 1 - w(t) on
-the far one, so once in sum. Absorbed light leaves the flight, so weighting the count changes neither
-grid's transport.
+fine grid runs only its first `near_steps` K; what is still in flight then is summed into a far grid
+(`grid_for`: cell 2h, its own voxelization and cells, aligned by `best_shift`), which runs the rest of
+the bounce in half as many steps (a far step moves light two fine cells) at 1/8 of the cells. Every watt
+is absorbed on one grid or the other, or is still in flight at the end: nothing is counted twice or
+dropped at the hand-over.
 
-`emitters`: the far grid's emitters are the fine grid's summed per far cell (lpv_far_field.source:
-radiant intensity adds), per emitter class and bounce; a far cell on the edge where a wall meets a floor
-is walled in by occupied cells, and its light, which could not leave, is moved to the neighbours it can
-leave from (far_field_move.comp.glsl). The far grid keeps what it absorbs by the face the light came
-through (diffusion_propagate.faces): its cells are too coarse to have one plane (a cell holding a wall
-and the floor of the room behind it has a normal between the two, whose sides would mix the rooms).
-`add` shares each face's flux onto the fine planes' sides, which the light's direction sorts as a fine
-step would, by their absorption on that axis and the far cells' trilinear tents, so the far light is
-smooth across far cells and each far cell gives out exactly what it absorbed (`weights`, once per
-voxelization: each far cell's share denominators, far_field_weights.comp.glsl; far_field_add.comp.glsl).
-Everything downstream (the class and bounce sums, the next bounce's emitters, the lookup) reads the sum.
-Twins: diffusion_reference.far_move_enclosed, far_weights, far_add.
+`hand_over`: the fine light in flight summed per far cell (lpv_far_field.source: radiant intensity adds),
+per emitter class and bounce; a far cell on the edge where a wall meets a floor is walled in by occupied
+cells, and the light in it, which could not leave, is moved to the neighbours it can leave from
+(far_field_move.comp.glsl). The far grid keeps what it absorbs by the face the light came through
+(diffusion_propagate.faces): its cells are too coarse to have one plane (a cell holding a wall and the
+floor of the room behind it has a normal between the two, whose sides would mix the rooms). `add`
+shares each face's flux onto the fine planes' sides, which the light's direction sorts as a fine step
+would, by their absorption on that axis and the far cells' trilinear tents, so the far light is smooth
+across far cells and each far cell gives out exactly what it absorbed (`weights`, once per voxelization:
+each far cell's share denominators, far_field_weights.comp.glsl; far_field_add.comp.glsl). Everything
+downstream (the class and bounce sums, the next bounce's emitters, the lookup) reads the sum.
+Twins: diffusion_reference.far_move_enclosed, step_by_face, far_weights, far_add.
 """
 
 from __future__ import annotations
@@ -70,8 +69,8 @@ ADD = ShaderSpec(
 )
 
 DECL = PassDecl("diffusion_far_field", "solve", (SNAPSHOT, ABSORBED, CELL_NORMAL, CELL_BLOCK), (ABSORBED,),
-                "light beyond the near steps carried on a grid of twice the cell (its emitters summed from "
-                "the fine grid's, its absorbed flux sorted back onto the fine sides)")
+                "the light in flight after the near steps carried on a grid of twice the cell, its absorbed "
+                "flux shared back onto the fine sides")
 
 
 class FarGrid(NamedTuple):
@@ -110,14 +109,14 @@ def best_shift(occupied: np.ndarray) -> tuple[int, int, int]:
 
 def near_steps(configured: int, steps: int) -> int:
     """The fine grid's steps K with a far field, of a bounce's `steps`: `configured`, or (0) half of them
-    (the grid's span at span_multiple 2), at least 2 (the fine grid runs K - 1 steps) and at most `steps`."""
-    return max(2, min(configured or steps // 2, steps))
+    (the grid's span at span_multiple 2), at least 1 and at most `steps`."""
+    return max(1, min(configured or steps // 2, steps))
 
 
-def emitters(backend: Backend, snapshot: dict, fine: Grid, far_snapshots: list, far_cells: dict, far: FarGrid) -> None:
-    """far_snapshots[0] (sh_r/g/b) := the far grid's emitters: the fine `snapshot` summed per far cell
-    (lpv_far_field.source, into far_snapshots[1]), the light of enclosed far cells moved to their
-    neighbours (far_field_move.comp.glsl)."""
+def hand_over(backend: Backend, snapshot: dict, fine: Grid, far_snapshots: list, far_cells: dict, far: FarGrid) -> None:
+    """far_snapshots[0] (sh_r/g/b) := the far grid's starting light: the fine `snapshot` (the light in
+    flight) summed per far cell (lpv_far_field.source, into far_snapshots[1]), the light of enclosed far
+    cells moved to their neighbours (far_field_move.comp.glsl)."""
     lpv_far_field.source(backend, snapshot, fine, far_snapshots[1], far.grid, far.shift)
     backend.dispatch(backend.program(MOVE), group_count(far.grid.dims, MOVE.local_size),
                      uniforms={"dims": far.grid.dims},

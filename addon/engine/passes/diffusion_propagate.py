@@ -105,7 +105,7 @@ def run(backend: Backend, src: dict, dst: dict, absorbed: dict, cells: dict, gri
         transfer: str = "cone") -> None:
     """One step: src (sh_r/g/b) -> dst, the flux absorbed written (first_step) or added into `absorbed`:
     per side (flux_plus / flux_minus, from `sides`) or per face it came through (acc_0 .. acc_4, from
-    `faces`; the far field's grid, which also absorbs light an occupied cell holds and cannot send on)."""
+    `faces`: the far field's grid)."""
     by_face = "acc_0" in absorbed
     spec = SPECS[transfer, by_face]
     uniforms = {"dims": grid.dims, "first_step": int(first_step)}
