@@ -309,16 +309,17 @@ class DiffusionConfig(_Validated):
     # cornell-area 0.262 -> 0.279 worse. Six propagations: a lights update 3-5x slower on llvmpipe.
     emitter_class_passes: bool = field(default=True, metadata={
         "doc": "a side takes in no light from sides facing its way (six propagations per bounce)"})
-    # On: the grid runs only its first near_steps and a grid of twice the cell (its own voxels and cells,
-    # aligned to the fine voxels) carries the light further, each counting its absorption by time of
-    # flight (docs/DIFFUSION.md, "Far field"). grid_cells >= 32: a coarser far grid resolves too little of
-    # a room. At 32 cells, one bounce, 128 px: cornell's lights update 1.6x faster, rel_rmse_8 0.412 ->
-    # 0.395; thin-wall 0.104 -> 0.105, window-room 0.361 -> 0.363, emissive 0.292 -> 0.334.
+    # On: the grid runs only its first near_steps and hands the light still in flight to a grid of twice
+    # the cell (its own voxels and cells, aligned to the fine voxels) for the rest of the bounce
+    # (docs/DIFFUSION.md, "Far field"). grid_cells >= 32: a coarser far grid resolves too little of a
+    # room. At 32 cells, 128 px on llvmpipe: a lights update 0.64-0.70x of one grid's on the Cornell
+    # boxes and thin-wall, 0.77-0.86x on window-room and the real scenes; rel_rmse_8 within 0.032
+    # (cornell 0.412 -> 0.424, thin-wall 0.104 -> 0.104, conference 0.230 -> 0.230).
     far_field: bool = field(default=True, metadata={
         "doc": "carry light beyond the near steps on a grid of twice the cell size (faster, less on-axis excess)"})
-    # Half the bounce's steps (the grid's span at span_multiple 2): with a quarter (16 at 32 cells) the
-    # update was 2.5x faster than without a far field but the rooms' error grew (conference 0.230 ->
-    # 0.358, thin-wall 0.104 -> 0.178; docs/DIFFUSION.md).
+    # Half the bounce's steps (the grid's span at span_multiple 2): a quarter (16 at 32 cells) made the
+    # boxes' update 0.44-0.55x of one grid's but the error grew by up to 0.056 (cornell-area 0.251 ->
+    # 0.307; docs/DIFFUSION.md).
     near_steps: int = _num(0, 0, 4096, "far field: steps the fine grid runs per bounce (0: half its steps per bounce)")
 
 
