@@ -26,8 +26,8 @@ void main() {
         float turn = 6.28318531 * random01(uint(c.x), uint(c.y), s);
         float jitter = random01(uint(c.x), uint(c.y), s ^ 65536u);
         float dither = random01(uint(c.x), uint(c.y), hash_u32(s ^ DITHER_STREAM));
-        e_pos = albedo.rgb * gather_diffuse(p, n, turn, jitter, dither).rgb;
-        e_neg = albedo.rgb * gather_diffuse(p, -n, turn, jitter, dither).rgb;
+        e_pos = albedo.rgb * gather_diffuse(p, n, turn, jitter, dither, 0, 1).rgb;
+        e_neg = albedo.rgb * gather_diffuse(p, -n, turn, jitter, dither, 0, 1).rgb;
     }
     // Light leaving along +axis comes from the side whose normal has a positive component on it.
     imageStore(next_px, c, vec4((n.x >= 0.0 ? e_pos : e_neg) * proj.x, 0.0));

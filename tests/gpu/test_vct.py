@@ -648,3 +648,23 @@ def test_pixels_the_filter_cannot_average_gather_more(gl):
     noise = [np.sqrt(np.mean((pole_vct(gl, g, seed=1)[0] - base)[pole] ** 2)) for g, base in ((1, one), (2, two))]
     print("pole noise, 2 gathers / 1:", noise[1] / noise[0])
     assert noise[1] < 0.85 * noise[0]
+
+
+def test_eight_gathers_of_a_pixel_spread_their_cones(gl):
+    """Eight gathers of a pixel (the pole's pixels: four from the budget, GIConfig.sample_budget_px, times
+    support_gathers 2) against four. Turned by g / 8 of a turn, eight gathers' cones stay on the azimuths
+    of four's (8 x the golden angle is 3.06 turns: vct/gather.comp.glsl), and the pole's spread over seeds
+    read 0.94 of four gathers'; as one spiral of 8 x 16 cones it reads 0.29. Bound 0.5, below the 0.71 of
+    independent draws (1 / sqrt(2)), which stratified cones beat. The pole's mean stays within 1 %: every
+    set of gathers is unbiased (measured 0.3 %)."""
+    budget = 4 * 64 * 64
+    spread, mean = {}, {}
+    for support_gathers in (1, 2):
+        runs = [pole_vct(gl, support_gathers, seed, sample_budget_px=budget) for seed in range(6)]
+        images, pole = np.stack([r[0] for r in runs]), runs[0][1]
+        assert np.isfinite(images).all() and images.min() >= 0.0
+        spread[support_gathers] = images.std(axis=0)[pole].mean()
+        mean[support_gathers] = images[:, pole].mean()
+    print("pole spread, 8 gathers / 4:", spread[2] / spread[1], "mean:", mean[2] / mean[1])
+    assert spread[2] < 0.5 * spread[1]
+    assert abs(mean[2] / mean[1] - 1.0) < 0.01
