@@ -186,9 +186,9 @@ class VctConfig(_Validated):
     gather_scale: int = _num(1, 1, 4, "cones at one pixel per n x n block, upsampled along edges (1: every pixel)")
     # Where the denoise filter finds little of a pixel's own surface around it (thin columns, leaves, the
     # last pixels before an edge) it cannot average the gather's noise, so those pixels gather this many
-    # times (gather.comp.glsl). Sponza 128 / 512 px: noise between seeds 0.118 / 0.058 -> 0.083 / 0.037
-    # at 2 (4: 0.072 at 128; 3: 0.035 at 512), for 18 % more gather half on llvmpipe; cornell unchanged
-    # (docs/VCT.md).
+    # times the image's gathers (gather.comp.glsl; 3, 8 or 16 gathers trace one spiral of cones). With one
+    # gather per pixel, Sponza 128 / 512 px: noise between seeds 0.118 / 0.058 -> 0.083 / 0.037 at 2 (4:
+    # 0.072 at 128; 3: 0.035 at 512), for 18 % more gather half on llvmpipe; cornell unchanged (docs/VCT.md).
     support_gathers: int = _num(2, 1, 4, "gathers at pixels whose denoise filter finds little of their surface around "
                                          "them (thin or small details; 1: one gather everywhere)")
     radiance: str = _choice("anisotropic", ("anisotropic", "isotropic"),
