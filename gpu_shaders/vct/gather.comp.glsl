@@ -50,9 +50,10 @@ void main() {
     // Gather g of n is turned, jittered and dithered a further g / n of the way, so the set stays
     // stratified; its cones are the first gather's turned. That leaves them on few azimuths where n x
     // the golden angle (cone i's azimuth is i x 0.382 of a turn) is near a whole number of turns: cone i
-    // of gather g then lies near (i x round(0.382 n) + g) / n of a turn, n lines a band apart. There the
-    // n gathers trace one spiral of n x diffuse_cones cones instead (vct/diffuse.glsl). Sponza, 128 px,
-    // every pixel n gathers, noise between seeds (docs/VCT.md, "Several gathers of a pixel"): turned,
+    // of gather g then lies near (i x round(0.382 n) + g) / n of a turn, on the same n azimuths in every
+    // gather. There the n gathers trace one spiral of n x diffuse_cones cones instead (vct/diffuse.glsl).
+    // Sponza, 128 px, every pixel n gathers, noise between seeds (docs/VCT.md, "Several gathers of a
+    // pixel"): turned,
     // n = 3 / 5 / 8 / 16 (0.146 / 0.090 / 0.056 / 0.111 of a turn from whole) 0.077 / 0.048 / 0.035 /
     // 0.015, against 0.024 / 0.022 / 0.018 / 0.014 at n = 6 / 7 / 9 / 12 (0.29 / 0.33 / 0.44 / 0.42);
     // one spiral 0.040 at 3 and 0.018 at 8, 0.010 at 16. Turned gathers stay where they are not near a
