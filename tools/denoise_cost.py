@@ -29,7 +29,7 @@ from addon.engine.passes import denoise  # noqa: E402
 from addon.engine.updates import update_costs  # noqa: E402
 
 
-def filter_ms(method, out, scratch, params: denoise.Params, repeat: int) -> float:
+def filter_ms(method, out, scratch, guide, params: denoise.Params, repeat: int) -> float:
     """Median wall time (ms) of the filter on the method's indirect, GPU work finished."""
     be = method.backend
     noisy = method.product_textures()["indirect"]
@@ -37,7 +37,7 @@ def filter_ms(method, out, scratch, params: denoise.Params, repeat: int) -> floa
     for _ in range(repeat + 1):  # the first run compiles the program
         be.finish()
         t0 = time.perf_counter()
-        denoise.run(be, method.gbuf, noisy, out, scratch, params)
+        denoise.run(be, method.gbuf, noisy, out, scratch, params, guide=guide)
         be.finish()
         samples.append((time.perf_counter() - t0) * 1e3)
     return statistics.median(samples[1:])
@@ -66,13 +66,13 @@ def measure(blend: Path, res: int, iterations: list[int], repeat: int, reference
     method.set_scene(scene)
     before = method.run().images["indirect"]  # also the warm-up
     update_ms = update_costs(method, repeat, kinds=("lights",))["lights"]  # the solve and gathers, no upload
-    out, scratch = be.texture((width, height)), be.texture((width, height))
+    out, scratch, guide = (be.texture((width, height)) for _ in range(3))
     reference = images.read_exr(references / str(res) / "indirect.exr") if references is not None else None
     row = {"res": res, "vct_update_ms": update_ms}
     if reference is not None:
         row["unfiltered"] = errors(before, reference)
     for k in iterations:
-        ms = filter_ms(method, out, scratch, denoise.Params(iterations=k), repeat)
+        ms = filter_ms(method, out, scratch, guide, denoise.Params(iterations=k), repeat)
         row[f"iterations_{k}"] = found = {"filter_ms": ms, "ratio": ms / update_ms}
         if reference is not None:
             found.update(errors(be.read(out)[::-1], reference))  # read-back rows: 0 = bottom

@@ -81,13 +81,13 @@ def filter_share(method, repeat: int) -> dict:
     be = method.backend
     update_ms = update_costs(method, repeat, kinds=("lights",))["lights"]
     size = method.gbuf["position"].size
-    noisy, out, scratch = be.texture(size), be.texture(size), be.texture(size)
+    noisy, out, scratch, guide = (be.texture(size) for _ in range(4))
     params = denoise.Params(iterations=denoise.iterations_for(max(size)))
     samples = []
     for _ in range(repeat + 1):  # the first run compiles the program
         be.finish()
         t0 = time.perf_counter()
-        denoise.run(be, method.gbuf, noisy, out, scratch, params)
+        denoise.run(be, method.gbuf, noisy, out, scratch, params, guide=guide)
         be.finish()
         samples.append((time.perf_counter() - t0) * 1e3)
     filter_ms = statistics.median(samples[1:])

@@ -418,7 +418,8 @@ def gpu_block(*runs: dict) -> str:
     if shares:
         lines += ["", "vct's denoise filter (GPU time) costs " + ", ".join(
             f"{100 * r['gpu']['denoise']['median'] / r['wall_total']['median']:.0f} % on {s}" for s, r in shares)
-            + " of its update (target <= 20 %)."]
+            + " of its update (target <= 20 %), three products on every scene in that run; cornell and window-sky"
+            " now filter two (docs/ARCHITECTURE.md, \"A clean preview\")."]
     return "\n".join(lines) + "\n"
 
 

@@ -16,15 +16,21 @@
 //
 // GUIDED (the last iteration, passes/denoise.py): a tap also weighs exp(-|l_q - l| / (luminance_sigma *
 // sd)), per product: l the luminance of its source (the geometric iterations' output), sd the noise
-// that output keeps: the standard deviation of its unfiltered `raw` luminance over the 5 x 5 taps 1 px
-// apart (the same G-buffer weights) times raw_noise_factor (denoise.noise_factor of the iterations
-// before). Where the
-// values differ by more than the noise explains (a real gradient) the taps stop; within the noise the
-// iteration widens the kernel (SVGF's edge-stopping function, Schied et al. 2017, from one frame).
+// that output keeps: the standard deviation of its unfiltered luminance over the 5 x 5 taps 1 px apart
+// (the same G-buffer weights) times raw_noise_factor (denoise.noise_factor of the iterations before).
+// Where the values differ by more than the noise explains (a real gradient) the taps stop; within the
+// noise the iteration widens the kernel (SVGF's edge-stopping function, Schied et al. 2017, from one
+// frame).
+//
+// FIRST (iteration 0) measures what the later ones reuse and writes it to `guide`: x the footprint
+// (-1 for an isolated pixel), 1 + k the k-th product's luminance spread over its taps. Its taps are
+// those the guided iteration's spread needs (1 px apart, unfiltered input, the same weights), so that
+// costs a few multiplies there instead of a second 5 x 5 loop; every later iteration reads its
+// footprint instead of fetching four neighbours again.
 
 #include "common/gbuffer_weight.glsl"
 
-// The k-th product's input, unfiltered input and output (k < PRODUCTS; a constant once loops unroll).
+// The k-th product's input and output (k < PRODUCTS; a constant once loops unroll).
 vec4 source_at(int k, ivec2 q) {
 #if PRODUCTS > 2
     if (k == 2) {
@@ -55,23 +61,7 @@ void store(int k, ivec2 px, vec4 value) {
     imageStore(filtered0, px, value);
 }
 
-#ifdef GUIDED
 const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);
-
-float raw_luminance(int k, ivec2 q) {
-#if PRODUCTS > 2
-    if (k == 2) {
-        return dot(texelFetch(raw2, q, 0).rgb, LUMA);
-    }
-#endif
-#if PRODUCTS > 1
-    if (k == 1) {
-        return dot(texelFetch(raw1, q, 0).rgb, LUMA);
-    }
-#endif
-    return dot(texelFetch(raw0, q, 0).rgb, LUMA);
-}
-#endif
 
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
@@ -87,55 +77,42 @@ void main() {
         return;
     }
     vec3 p = pos.xyz;
+#ifdef FIRST
     float footprint = max(axis_footprint(px, p, ivec2(1, 0), size), axis_footprint(px, p, ivec2(0, 1), size));
+#else
+    vec4 measured = texelFetch(guide, px, 0);  // FIRST's: (footprint, each product's luminance spread)
+    float footprint = measured.x;
+#endif
     if (footprint <= 0.0) {
         for (int k = 0; k < PRODUCTS; k++) {
             store(k, px, source_at(k, px));  // isolated pixel: no scale to compare with
         }
+#ifdef FIRST
+        imageStore(guide, px, vec4(-1.0, 0.0, 0.0, 0.0));
+#endif
         return;
     }
     vec3 n = texelFetch(gbuf_normal, px, 0).xyz;
 #ifdef GUIDED
-    // Per product: the standard deviation of the raw luminance over the 5 x 5 taps 1 px apart, with the
-    // filter's weights, scaled to the noise the geometric iterations left (raw_noise_factor).
-    float m1[PRODUCTS], m2[PRODUCTS];
-    for (int k = 0; k < PRODUCTS; k++) {
-        m1[k] = 0.0;
-        m2[k] = 0.0;
-    }
-    float raw_total = 0.0;
-    for (int j = -2; j <= 2; j++) {
-        for (int i = -2; i <= 2; i++) {
-            ivec2 q = px + ivec2(i, j);
-            if (!covered(q, size)) {
-                continue;
-            }
-            float w = b3(i) * b3(j);
-            if (i != 0 || j != 0) {
-                w *= geometry_weight(q, ivec2(i, j), p, n, footprint);
-            }
-            for (int k = 0; k < PRODUCTS; k++) {
-                float l = raw_luminance(k, q);
-                m1[k] += w * l;
-                m2[k] += w * l * l;
-            }
-            raw_total += w;
-        }
-    }
     float luminance[PRODUCTS], scale[PRODUCTS];
     for (int k = 0; k < PRODUCTS; k++) {
-        float mean = m1[k] / raw_total;
-        float deviation = sqrt(max(m2[k] / raw_total - mean * mean, 0.0));
         luminance[k] = dot(source_at(k, px).rgb, LUMA);
         // 1e-30: a noiseless neighbourhood stops every tap that differs at all (a flat field still averages).
-        scale[k] = luminance_sigma * deviation * raw_noise_factor + 1e-30;
+        scale[k] = luminance_sigma * measured[1 + k] * raw_noise_factor + 1e-30;
     }
 #endif
     vec4 sum[PRODUCTS];
     float total[PRODUCTS];
+#ifdef FIRST
+    float luminance_sum[PRODUCTS], luminance_square_sum[PRODUCTS];  // the spread's moments, weighted
+#endif
     for (int k = 0; k < PRODUCTS; k++) {
         sum[k] = vec4(0.0);
         total[k] = 0.0;
+#ifdef FIRST
+        luminance_sum[k] = 0.0;
+        luminance_square_sum[k] = 0.0;
+#endif
     }
     for (int j = -2; j <= 2; j++) {
         for (int i = -2; i <= 2; i++) {
@@ -156,6 +133,11 @@ void main() {
                     wk *= exp(-abs(dot(value.rgb, LUMA) - luminance[k]) / scale[k]);
                 }
 #endif
+#ifdef FIRST
+                float l = dot(value.rgb, LUMA);
+                luminance_sum[k] += w * l;
+                luminance_square_sum[k] += w * l * l;
+#endif
                 sum[k] += wk * value;
                 total[k] += wk;
             }
@@ -164,4 +146,12 @@ void main() {
     for (int k = 0; k < PRODUCTS; k++) {
         store(k, px, sum[k] / total[k]);  // total >= the centre's kernel weight > 0
     }
+#ifdef FIRST
+    vec4 spread = vec4(footprint, 0.0, 0.0, 0.0);
+    for (int k = 0; k < PRODUCTS; k++) {
+        float mean = luminance_sum[k] / total[k];
+        spread[1 + k] = sqrt(max(luminance_square_sum[k] / total[k] - mean * mean, 0.0));
+    }
+    imageStore(guide, px, spread);
+#endif
 }

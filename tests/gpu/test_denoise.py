@@ -58,8 +58,8 @@ def on_gpu(backend, position, normal, noisy, params=PARAMS):
     size = (position.shape[1], position.shape[0])
     tex = lambda a: backend.texture(size, data=np.asarray(a, np.float32))  # noqa: E731
     gbuf = {"position": tex(position), "normal": tex(normal)}
-    out, scratch = backend.texture(size), backend.texture(size)
-    denoise.run(backend, gbuf, tex(noisy), out, scratch, params)
+    out, scratch, guide = backend.texture(size), backend.texture(size), backend.texture(size)
+    denoise.run(backend, gbuf, tex(noisy), out, scratch, params, guide=guide)
     return backend.read(out)
 
 
@@ -228,13 +228,17 @@ def test_lightmap_charts_do_not_bleed_across_seams(gl):
 
 
 def test_iterations_never_read_what_they_write(gl):
-    # An iteration reads one texture and writes another: aliased arguments are refused.
-    tex = [gl.texture((4, 4)) for _ in range(3)]
+    # An iteration reads one texture and writes another: aliased arguments are refused, and so is a
+    # missing scratch or guide texture.
+    tex = [gl.texture((4, 4)) for _ in range(5)]
     gbuf = {"position": tex[0], "normal": tex[0]}
     with pytest.raises(ValueError, match="different textures"):
-        denoise.run(gl, gbuf, tex[1], tex[1], tex[2])
+        denoise.run(gl, gbuf, tex[1], tex[1], tex[2], guide=tex[4])
     with pytest.raises(ValueError, match="scratch"):
-        denoise.run(gl, gbuf, tex[1], tex[2], None, denoise.Params(iterations=2))
+        denoise.run(gl, gbuf, tex[1], tex[2], None, denoise.Params(iterations=2), guide=tex[4])
+    for guide in (None, tex[3]):
+        with pytest.raises(ValueError, match="guide"):
+            denoise.run(gl, gbuf, tex[1], tex[2], tex[3], guide=guide)
 
 
 @pytest.mark.parametrize("products", [2, 3])
@@ -251,7 +255,8 @@ def test_products_filtered_together_come_out_as_alone(gl, products):
     tex = lambda a: gl.texture(size, data=np.asarray(a, np.float32))  # noqa: E731
     gbuf = {"position": tex(pos), "normal": tex(nrm)}
     outs = [gl.texture(size) for _ in inputs]
-    denoise.run(gl, gbuf, [tex(a) for a in inputs], outs, [gl.texture(size) for _ in inputs], PARAMS)
+    denoise.run(gl, gbuf, [tex(a) for a in inputs], outs, [gl.texture(size) for _ in inputs], PARAMS,
+                guide=gl.texture(size))
     for image, out in zip(inputs, outs, strict=True):
         np.testing.assert_allclose(gl.read(out), on_gpu(gl, pos, nrm, image), atol=1e-6)
 
@@ -261,6 +266,6 @@ def test_product_lists_must_match(gl):
     tex = [gl.texture((4, 4)) for _ in range(13)]
     gbuf = {"position": tex[0], "normal": tex[0]}
     with pytest.raises(ValueError, match="as many"):
-        denoise.run(gl, gbuf, tex[1:3], tex[3:5], tex[5:6])
+        denoise.run(gl, gbuf, tex[1:3], tex[3:5], tex[5:6], guide=tex[12])
     with pytest.raises(ValueError, match="products per dispatch"):
-        denoise.run(gl, gbuf, tex[1:5], tex[5:9], tex[9:13])
+        denoise.run(gl, gbuf, tex[1:5], tex[5:9], tex[9:13], guide=tex[0])

@@ -393,6 +393,8 @@ class DirectMethod:
         self._noisy = {n: {"raw": be.texture(size), "mean": self._products[n],
                            **({"shown": be.texture(size), "scratch": be.texture(size)} if self.gi.denoise else {})}
                        for n in self.NOISY}
+        # What the filter's first iteration measures for the others (denoise.run's guide), for all products.
+        self._denoise_guide = be.texture(size) if self.gi.denoise and self.NOISY else None
         self.samples = 0  # gathers averaged into the noisy products since the last update
         # The running gather's index among them: 0 for an update's, n for the n-th refine (gather_seed;
         # vct's cones continue a low-discrepancy sequence over it).
@@ -616,7 +618,8 @@ class DirectMethod:
             roles = [self._noisy[name] for name in filtered]
             with self.step(timings, denoise.DECL):
                 denoise.run(self.backend, self.gbuf, [r["mean"] for r in roles], [r["shown"] for r in roles],
-                            [r["scratch"] for r in roles], denoise.Params(iterations=iterations))
+                            [r["scratch"] for r in roles], denoise.Params(iterations=iterations),
+                            guide=self._denoise_guide)
         for name, roles in self._noisy.items():
             shown = roles["shown" if name in filtered else "mean"]
             self._products[name] = shown

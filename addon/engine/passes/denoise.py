@@ -7,7 +7,9 @@ with w = coverage, normal unit), `noisy` (RGBA32F, same size: an irradiance-like
 channels filtered: indirect, glossy or ao, never anything already multiplied by albedo). Output: `out`
 (RGBA32F, same size, written), in the units of `noisy`. `scratch` (RGBA32F, same size) holds the odd
 iterations when there are two or more. `noisy`, `out` and `scratch` must be three different textures:
-an iteration reads one and writes another.
+an iteration reads one and writes another. `guide` (RGBA32F, same size) holds what the first iteration
+measures for the later ones: each pixel's footprint, and the luminance spread the guided iteration
+needs (its taps are the first iteration's), so neither is computed twice.
 
 Each iteration k (`Params.iterations` in all) replaces every covered pixel with the normalised,
 weighted mean of 5 x 5 taps 2^k pixels apart (the B3-spline kernel, `KERNEL`); the weights come only
@@ -109,25 +111,35 @@ _UNIFORMS = (Var("step_px", "int"), Var("normal_power", "float"), Var("plane_sig
              Var("position_sigma", "float"))
 
 
-@functools.cache  # one spec, hence one program, per (product count, iteration kind)
-def spec(products: int, guided: bool) -> ShaderSpec:
-    """The iteration filtering `products` images (source0.., written to filtered0..); `guided`: the
-    guided iteration, which also reads the unfiltered inputs raw0.. (their local spread estimates the
-    noise)."""
+# The three kinds of iteration (common/denoise.comp.glsl): the first measures each pixel's footprint and
+# its products' luminance spread into the guide texture, the geometric ones after it read the footprint,
+# the guided one both.
+STAGES = ("first", "next", "guided")
+
+
+@functools.cache  # one spec, hence one program, per (product count, stage)
+def spec(products: int, stage: str) -> ShaderSpec:
+    """The iteration filtering `products` images (source0.., written to filtered0..) at `stage`
+    (STAGES)."""
     if not 1 <= products <= MAX_PRODUCTS:
         raise ValueError(f"denoise: 1 to {MAX_PRODUCTS} products per dispatch, not {products}")
+    if stage not in STAGES:
+        raise ValueError(f"denoise: stage is one of {STAGES}, not {stage!r}")
+    first = stage == "first"
     samplers = (Sampler("gbuf_position", "2D"), Sampler("gbuf_normal", "2D"),
                 *(Sampler(f"source{k}", "2D") for k in range(products)),
-                *((Sampler(f"raw{k}", "2D") for k in range(products)) if guided else ()))
+                *(() if first else (Sampler("guide", "2D"),)))
+    guided = stage == "guided"
     uniforms = (*_UNIFORMS, Var("luminance_sigma", "float"), Var("raw_noise_factor", "float")) if guided else _UNIFORMS
     return ShaderSpec(
-        name=f"denoise{products}{'_guided' if guided else ''}",
+        name=f"denoise{products}_{stage}",
         compute="common/denoise.comp.glsl",
         local_size=(8, 8, 1),
         samplers=samplers,
-        images=tuple(Image(f"filtered{k}", "2D") for k in range(products)),
+        images=(*(Image(f"filtered{k}", "2D") for k in range(products)), *((Image("guide", "2D"),) if first else ())),
         uniforms=uniforms,
-        defines=(("PRODUCTS", str(products)), *((("GUIDED", "1"),) if guided else ())),
+        defines=(("PRODUCTS", str(products)), *((("FIRST", "1"),) if first else ()),
+                 *((("GUIDED", "1"),) if guided else ())),
     )
 
 
@@ -138,8 +150,6 @@ DECL = PassDecl("denoise", "gather", (GBUF_POSITION, GBUF_NORMAL, INDIRECT), (IN
 
 def _destinations(passes: int, noisy, out, scratch) -> list:
     """The texture each pass writes, alternating so that the last one writes `out`."""
-    if passes < 1:
-        raise ValueError(f"denoise: iterations must be >= 1, not {passes}")
     if passes > 1 and scratch is None:
         raise ValueError("denoise: two or more passes (iterations, and the guided one) need a scratch texture")
     if noisy is out or noisy is scratch or out is scratch:
@@ -151,30 +161,39 @@ def _as_list(textures) -> list:
     return list(textures) if isinstance(textures, (list, tuple)) else [textures]
 
 
-def run(backend: Backend, gbuf: dict, noisy, out, scratch=None, params: Params = Params()) -> None:
+def run(backend: Backend, gbuf: dict, noisy, out, scratch=None, params: Params = Params(), *, guide) -> None:
     """out := `noisy` filtered (module docstring); `scratch` is needed for two or more passes (the
     iterations, and the guided one). `noisy`, `out` and `scratch` are one texture each, or lists of as
     many (up to MAX_PRODUCTS) of the same size: products of one image, filtered in the same dispatches,
-    each exactly as alone."""
+    each exactly as alone. `guide` (RGBA32F, the same size, one for all products) holds what the first
+    iteration measures for the others: each pixel's footprint and its products' noise."""
     noisy, out = _as_list(noisy), _as_list(out)
     scratch = [None] * len(noisy) if scratch is None else _as_list(scratch)
     if not len(noisy) == len(out) == len(scratch):
         raise ValueError("denoise: as many noisy, out and scratch textures")
+    if params.iterations < 1:
+        raise ValueError(f"denoise: iterations must be >= 1, not {params.iterations}")
     passes = params.iterations + int(params.guided)
     dests = [_destinations(passes, *textures) for textures in zip(noisy, out, scratch, strict=True)]
-    groups = group_count(out[0].size, spec(len(noisy), False).local_size)
+    if guide is None or any(guide is t for t in (*noisy, *out, *scratch)):
+        raise ValueError("denoise: a guide texture of its own is needed")
+    groups = group_count(out[0].size, spec(len(noisy), "first").local_size)
     sources = noisy
     for k in range(passes):
-        guided = k == params.iterations
+        stage = "first" if k == 0 else ("guided" if k == params.iterations else "next")
         uniforms = {"step_px": 1 << k, **weight_uniforms(params)}
         samplers = {"gbuf_position": gbuf["position"], "gbuf_normal": gbuf["normal"],
                     **{f"source{i}": t for i, t in enumerate(sources)}}
-        if guided:
-            uniforms.update(luminance_sigma=params.luminance_sigma, raw_noise_factor=noise_factor(params.iterations))
-            samplers.update({f"raw{i}": t for i, t in enumerate(noisy)})
         written = [d[k] for d in dests]
-        backend.dispatch(backend.program(spec(len(noisy), guided)), groups, uniforms=uniforms, samplers=samplers,
-                         images={f"filtered{i}": t for i, t in enumerate(written)})
+        images = {f"filtered{i}": t for i, t in enumerate(written)}
+        if stage == "first":
+            images["guide"] = guide
+        else:
+            samplers["guide"] = guide
+        if stage == "guided":
+            uniforms.update(luminance_sigma=params.luminance_sigma, raw_noise_factor=noise_factor(params.iterations))
+        backend.dispatch(backend.program(spec(len(noisy), stage)), groups, uniforms=uniforms, samplers=samplers,
+                         images=images)
         sources = written
 
 
