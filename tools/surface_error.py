@@ -7,7 +7,8 @@ against a Cycles reference and its share of the image's squared error.
 
 The reference must be of the same scene, camera and size (bench's references are). bias = mean(ours) /
 mean(Cycles) over the group's pixels (luminance as the mean of r, g, b); share = the group's sum of
-squared differences over the whole image's. A group below 1 % of the covered pixels is not printed.
+squared differences over the whole image's; the line of all covered pixels also gives the image's
+rel_rmse_8 (the benchmark's error, addon/engine/metrics.py). A group below 1 % of the covered pixels is not printed.
 Prints one JSON line per group.
 """
 
@@ -62,22 +63,24 @@ def main() -> int:
 
     from addon.bridge import images, pipeline
     from addon.bridge.capture import SceneCache
-    from addon.engine import methods
+    from addon.engine import methods, metrics
 
     bpy.ops.wm.open_mainfile(filepath=str(Path(args.blend).resolve()))
     scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), args.res, args.res)
     be = pipeline.backend()
     method = methods.create(be, build_settings(args.method, args.res, parse_sets(args.sets)))
     method.set_scene(scene)
-    ours = method.run().images["indirect"][..., :3].mean(axis=-1).astype(np.float64)
-    reference = images.read_exr(args.reference)[..., :3].mean(axis=-1).astype(np.float64)
+    ours_rgb = method.run().images["indirect"][..., :3].astype(np.float64)
+    reference_rgb = images.read_exr(args.reference)[..., :3].astype(np.float64)
+    ours, reference = ours_rgb.mean(axis=-1), reference_rgb.mean(axis=-1)
     # The G-buffer is read with GL's row 0 at the bottom; the method's image has row 0 at the top.
     position, normal = (be.read(method.gbuf[k])[::-1] for k in ("position", "normal"))
     squared = (ours - reference) ** 2
     covered = position[..., 3] > 0
     total = squared[covered].sum()
     print(json.dumps({"group": "all", "pixels": int(covered.sum()),
-                      "bias": round(ours[covered].mean() / reference[covered].mean(), 3), "share": 1.0}))
+                      "bias": round(ours[covered].mean() / reference[covered].mean(), 3), "share": 1.0,
+                      "rel_rmse_8": round(metrics.rel_rmse_8(ours_rgb, reference_rgb), 3)}))
     for name, mask in groups(position, normal, args.bands).items():
         if mask.sum() < 0.01 * covered.sum():
             continue
