@@ -8,6 +8,10 @@ For each transfer (cone, the paper's; directional):
    (exact: the patch's view factor to the ceiling, about 0.23 at N = 32).
 2. An isotropic point source in an empty grid: r^2 x the irradiance on the +x axis at 2..12 cells
    (exact: 1 / (4 pi) at every r).
+3. (directional) The same cube with its whole floor lit, without and with a solid block standing on it
+   (about a fifth of the floor's width, 0.6 of the height, black: each bounce alone): the share of the
+   floor's light on the ceiling and on the block, against Monte Carlo over the floor's cosine-distributed
+   rays.
 
 `--alternatives`: sharper angular models than L1 tried on the same twin, carried as `directional` is
 (docs/DIFFUSION.md, "Small bright patches, and sharper angular models"): L2 with its exact face
@@ -33,6 +37,12 @@ from addon.engine import diffusion_reference as ref  # noqa: E402
 from addon.engine import sh  # noqa: E402
 
 
+def _cosine_directions(rng, count: int) -> np.ndarray:
+    """`count` cosine-distributed directions about +z (a Lambertian surface's light), (count, 3)."""
+    u, phi = rng.random(count), 2 * np.pi * rng.random(count)
+    return np.stack([np.sqrt(u) * np.cos(phi), np.sqrt(u) * np.sin(phi), np.sqrt(1 - u)], axis=-1)
+
+
 def ceiling_view_factor(n: int, half: int = 5, samples: int = 1_000_000) -> float:
     """The exact share of a lit floor patch's Lambertian light that reaches the ceiling of
     `closed_box_cells` (planes at the walls' cell centres: a cube of n - 3 cells; the patch 2 x half
@@ -41,10 +51,44 @@ def ceiling_view_factor(n: int, half: int = 5, samples: int = 1_000_000) -> floa
     rng = np.random.default_rng(0)
     side = n - 3.0
     x, y = (rng.uniform(n / 2 - half - 1.5, n / 2 + half - 1.5, samples) for _ in range(2))  # from the wall plane
-    u, phi = rng.random(samples), 2 * np.pi * rng.random(samples)
-    reach = side / np.sqrt(1 - u)  # the ray's length to the ceiling's plane, times sin(theta) below
-    hx, hy = x + np.sqrt(u) * np.cos(phi) * reach, y + np.sqrt(u) * np.sin(phi) * reach
+    d = _cosine_directions(rng, samples)
+    reach = side / d[:, 2]  # the ray's length to the ceiling's plane
+    hx, hy = x + d[:, 0] * reach, y + d[:, 1] * reach
     return float(np.mean((hx > 0) & (hx < side) & (hy > 0) & (hy < side)))
+
+
+def block_in_box(n: int) -> tuple[int, int, int]:
+    """The block of figure 3 in the closed box of n cells (ref.closed_box_cells' `block`): its sides over
+    cells lo..hi, its top at cell `top`, scaled with the box (16 inner cells: 8..11 and 12)."""
+    scale = (n - 3) / 16.0
+    return int(2 + 6 * scale), int(2 + 9 * scale), int(2 + 10 * scale)
+
+
+def floor_past_block(n: int, block, samples: int = 1_000_000) -> tuple[float, float]:
+    """Exact shares of a uniformly lit floor's Lambertian light (the floor outside the block's footprint;
+    `block` as block_in_box's, or None) that reach the ceiling and that hit the block, with the planes at
+    their cells' centres (the box's wall planes at 0 and n - 3), by Monte Carlo (seeded)."""
+    rng = np.random.default_rng(0)
+    side = n - 3.0
+    x, y = rng.uniform(0, side, samples), rng.uniform(0, side, samples)
+    if block is not None:
+        lo, hi, top = (v - 1.0 for v in block)  # a cell's centre, from the wall plane
+        outside = ~((x > lo) & (x < hi) & (y > lo) & (y < hi))
+        x, y = x[outside], y[outside]
+    origin = np.stack([x, y, np.zeros(len(x))], axis=-1)
+    d = _cosine_directions(rng, len(origin))
+    to_ceiling = side / d[:, 2]
+    hit = origin + d * to_ceiling[:, None]
+    on_ceiling = np.all((hit[:, :2] > 0) & (hit[:, :2] < side), axis=1)
+    if block is None:
+        return float(np.mean(on_ceiling)), 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):  # slab test against the block's box
+        t1 = (np.array([lo, lo, 0.0]) - origin) / d
+        t2 = (np.array([hi, hi, top]) - origin) / d
+    enter = np.nanmax(np.minimum(t1, t2), axis=1)
+    leave = np.nanmin(np.maximum(t1, t2), axis=1)
+    on_block = (leave >= np.maximum(enter, 0.0)) & (enter < to_ceiling)
+    return float(np.mean(on_ceiling & ~on_block)), float(np.mean(on_block))
 
 
 def _face_partition(w: np.ndarray) -> np.ndarray:
@@ -57,10 +101,7 @@ def lambertian_face_shares(transfer: str, samples: int = 1_000_000) -> None:
     face fluxes of its L1 field against the exact shares of its directions w through each face,
     mean over the cosine lobe of max(0, w . d) / |w|_1 (Monte Carlo, seeded). The L1 field is broader
     than the lobe it stands for, so it sends more light sideways at every step than the light has."""
-    rng = np.random.default_rng(0)
-    u, phi = rng.random(samples), 2 * np.pi * rng.random(samples)
-    w = np.stack([np.sqrt(u) * np.cos(phi), np.sqrt(u) * np.sin(phi), np.sqrt(1 - u)], axis=-1)
-    exact = _face_partition(w).mean(axis=0)
+    exact = _face_partition(_cosine_directions(np.random.default_rng(0), samples)).mean(axis=0)
     field = (sh.cosine_lobe_l1(np.array([0.0, 0.0, 1.0])) / np.pi).reshape(1, 1, 1, 4)
     ours = ref.face_fluxes(field, np.ones((1, 1, 1, 6)), transfer)[0, 0, 0] / ref.flux_w(field)
     print(f"{transfer}: an upward Lambertian lobe's shares through the faces +x -x +y -y +z -z")
@@ -87,6 +128,29 @@ def box_figures(n: int, transfer: str) -> None:
         ceiling = absorbed[n - 2, 2:-2, 2:-2].sum() / total
         share = absorbed.sum() / total
         print(f"{steps:5d}  {share:8.3f}  {floor:5.3f}  {ceiling:7.3f}  {share - floor - ceiling:5.3f}")
+
+
+def block_figures(n: int, transfer: str) -> None:
+    block = block_in_box(n)
+    lo, hi, top = block
+    print(f"{transfer}: closed box of {n} cells, its floor lit, a block on it (cells {lo}..{hi}, top {top}): "
+          "shares of the floor's light")
+    print("         ceiling  exact  ratio  block  exact")
+    for name, b in (("no block", None), ("block", block)):
+        cell = ref.closed_box_cells(n, b)
+        lit = np.zeros((n, n, n))
+        lit[1, 2:n - 2, 2:n - 2] = 1.0
+        if b is not None:
+            lit[1, lo:hi + 1, lo:hi + 1] = 0.0
+        field = ref.emit(lit, np.zeros_like(lit), cell["normal"], cell["occupied"])
+        total = ref.flux_w(field)
+        _, plus, minus = ref.propagate(field, cell, 2 * n, transfer)
+        absorbed = plus + minus
+        ceiling = absorbed[n - 2, 2:-2, 2:-2].sum() / total
+        on_block = 0.0 if b is None else absorbed[2:top + 1, lo:hi + 1, lo:hi + 1].sum() / total
+        exact_ceiling, exact_block = floor_past_block(n, b)
+        print(f"{name:8s} {ceiling:8.3f} {exact_ceiling:6.3f} {ceiling / exact_ceiling:6.3f} {on_block:6.3f} "
+              f"{exact_block:6.3f}")
 
 
 def point_source_figures(transfer: str, steps: int = 120, size: int = 41) -> None:
@@ -215,6 +279,7 @@ def main() -> None:
         lambertian_face_shares(transfer)
         box_figures(args.cells, transfer)
         point_source_figures(transfer)
+    block_figures(args.cells, "directional")  # the cone transfer's light falls back onto the floor itself
 
 
 if __name__ == "__main__":

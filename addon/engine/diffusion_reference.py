@@ -171,20 +171,33 @@ def emit(flux_plus: np.ndarray, flux_minus: np.ndarray, normal: np.ndarray, occu
     return np.where(np.asarray(occupied)[..., None], lobes / np.pi, iso)
 
 
-def closed_box_cells(n: int) -> dict[str, np.ndarray]:
+def closed_box_cells(n: int, block: tuple[int, int, int] | None = None) -> dict[str, np.ndarray]:
     """`cells` of a closed cube in an n^3 grid: one-cell walls one cell in from the grid's edge, each
-    fully blocking along its normal, which faces into the box (tools/diffusion_box.py, the tests)."""
+    fully blocking along its normal, which faces into the box (tools/diffusion_box.py, the tests).
+    `block` (lo, hi, top): also a solid block standing on the floor, its one-cell sides over cells lo..hi
+    in x and y and its top at z = top, their normals outwards."""
     dims = (n, n, n)
     occ = np.zeros(dims, bool)
     normal = np.zeros((*dims, 3))
     proj = np.zeros((*dims, 3))
+
+    def wall(where, sign: float, axis: int) -> None:
+        occ[where] = True
+        normal[where] += sign * np.eye(3)[axis]
+        proj[where] = np.maximum(proj[where], np.eye(3)[axis])
+
     for axis in range(3):
         for index, sign in ((1, 1.0), (n - 2, -1.0)):
             sl = [slice(None)] * 3
             sl[2 - axis] = index
-            occ[tuple(sl)] = True
-            normal[tuple(sl)] += sign * np.eye(3)[axis]
-            proj[tuple(sl)] = np.maximum(proj[tuple(sl)], np.eye(3)[axis])
+            wall(tuple(sl), sign, axis)
+    if block is not None:
+        lo, hi, top = block
+        up, across = slice(2, top + 1), slice(lo, hi + 1)
+        for index, sign in ((lo, -1.0), (hi, 1.0)):
+            wall((up, across, index), sign, 0)
+            wall((up, index, across), sign, 1)
+        wall((top, across, across), 1.0, 2)
     length = np.linalg.norm(normal, axis=-1, keepdims=True)
     normal = np.where(length > 0, normal / np.maximum(length, 1e-30), 0.0)
     return cells(occ, normal, proj)

@@ -157,6 +157,7 @@ def test_diffusion_box_prints_both_transfers():
         assert f"{transfer}: closed box of 12 cells" in out and f"{transfer}: point source" in out
         assert f"{transfer}: an upward Lambertian lobe's shares" in out
     assert "exact 0.138 0.138 0.138 0.138 0.449 0.000   L1 0.138 0.138 0.138 0.138 0.449 0.000" in out
+    assert "directional: closed box of 12 cells, its floor lit, a block on it (cells 5..7, top 7)" in out
 
 
 def test_surface_error_prints_each_surface_of_a_room(cornell, tmp_path):
