@@ -10,14 +10,14 @@ For each transfer (cone, the paper's; directional):
    (exact: 1 / (4 pi) at every r).
 3. (directional) The same cube with its whole floor lit, without and with a solid block standing on it
    (about a fifth of the floor's width, 0.6 of the height, black: each bounce alone): the share of the
-   floor's light on the ceiling and on the block, against Monte Carlo over the floor's cosine-distributed
-   rays.
+   floor's light on the ceiling and on the block, and the block's by layer of cells, against Monte Carlo
+   over the floor's cosine-distributed rays.
 
 `--alternatives`: sharper angular models than L1 tried on the same twin, carried as `directional` is
 (docs/DIFFUSION.md, "Small bright patches, and sharper angular models"): L2 with its exact face
-matrices, and a positive closure of the L1 field (M1-like). The ceiling's share from a 2 x 2 and a
-10 x 10 lit patch, and the point source at 4 and 8 cells (about four minutes at 16 cells: the closure
-integrates per cell).
+matrices, a positive closure of the L1 field (M1-like) and a flux limiter on L1. The ceiling's share
+from a 2 x 2 and a 10 x 10 lit patch, the point source at 4 and 8 cells, and figure 3's block (several
+minutes at 16 cells: the closure integrates per cell).
 
 Run: .venv/bin/python tools/diffusion_box.py [--cells 32] [--alternatives]  (both transfers; about a
 minute at 32 cells)
@@ -64,10 +64,11 @@ def block_in_box(n: int) -> tuple[int, int, int]:
     return int(2 + 6 * scale), int(2 + 9 * scale), int(2 + 10 * scale)
 
 
-def floor_past_block(n: int, block, samples: int = 1_000_000) -> tuple[float, float]:
+def floor_past_block(n: int, block, samples: int = 1_000_000, by_layer: bool = False):
     """Exact shares of a uniformly lit floor's Lambertian light (the floor outside the block's footprint;
     `block` as block_in_box's, or None) that reach the ceiling and that hit the block, with the planes at
-    their cells' centres (the box's wall planes at 0 and n - 3), by Monte Carlo (seeded)."""
+    their cells' centres (the box's wall planes at 0 and n - 3), by Monte Carlo (seeded). `by_layer`:
+    also the block's share per layer of cells, 2..top (the lowest from the floor's plane)."""
     rng = np.random.default_rng(0)
     side = n - 3.0
     x, y = rng.uniform(0, side, samples), rng.uniform(0, side, samples)
@@ -88,7 +89,14 @@ def floor_past_block(n: int, block, samples: int = 1_000_000) -> tuple[float, fl
     enter = np.nanmax(np.minimum(t1, t2), axis=1)
     leave = np.nanmin(np.maximum(t1, t2), axis=1)
     on_block = (leave >= np.maximum(enter, 0.0)) & (enter < to_ceiling)
-    return float(np.mean(on_ceiling & ~on_block)), float(np.mean(on_block))
+    shares = float(np.mean(on_ceiling & ~on_block)), float(np.mean(on_block))
+    if not by_layer:
+        return shares
+    height = (origin[:, 2] + d[:, 2] * enter)[on_block]
+    # Layer k's cells span k - 1.5 .. k - 0.5 from the floor's plane (cell 1's centre); the lowest starts at
+    # the floor, the top layer's sides end at the top's plane (its cells' centres).
+    edges = [0.0] + [k - 0.5 for k in range(2, block[2])] + [top + 1e-9]
+    return shares, np.histogram(height, bins=edges)[0] / len(origin)
 
 
 def _face_partition(w: np.ndarray) -> np.ndarray:
@@ -130,6 +138,33 @@ def box_figures(n: int, transfer: str) -> None:
         print(f"{steps:5d}  {share:8.3f}  {floor:5.3f}  {ceiling:7.3f}  {share - floor - ceiling:5.3f}")
 
 
+def lit_field(lit: np.ndarray, normal: np.ndarray, coefficients: int) -> np.ndarray:
+    """Lambertian emitters of flux `lit` (W per cell) about `normal`, in L1 (4) or L2 (9) coefficients."""
+    lobes = sh.cosine_lobe_l1(normal) if coefficients == 4 else sh.cosine_lobe_l2(normal)
+    return lit[..., None] * lobes / np.pi
+
+
+def block_shares(n: int, block, transfer, coefficients: int = 4, by_layer: bool = False):
+    """The shares of the lit floor's light (the floor outside the block's footprint) that the ceiling and
+    the block absorb in the closed box of n cells with `block` (block_in_box's, or None) standing on it,
+    after 2 n steps; `by_layer`: also the block's per layer of cells, 2..top."""
+    cell = ref.closed_box_cells(n, block)
+    lit = np.zeros((n, n, n))
+    lit[1, 2:n - 2, 2:n - 2] = 1.0
+    if block is not None:
+        lo, hi, top = block
+        lit[1, lo:hi + 1, lo:hi + 1] = 0.0
+    field = lit_field(lit, cell["normal"], coefficients)
+    total = ref.flux_w(field)
+    _, plus, minus = ref.propagate(field, cell, 2 * n, transfer)
+    absorbed = plus + minus
+    on_block = 0.0 if block is None else absorbed[2:top + 1, lo:hi + 1, lo:hi + 1].sum() / total
+    shares = float(absorbed[n - 2, 2:-2, 2:-2].sum() / total), float(on_block)
+    if not by_layer:
+        return shares
+    return shares, absorbed[2:top + 1, lo:hi + 1, lo:hi + 1].sum(axis=(1, 2)) / total
+
+
 def block_figures(n: int, transfer: str) -> None:
     block = block_in_box(n)
     lo, hi, top = block
@@ -137,20 +172,15 @@ def block_figures(n: int, transfer: str) -> None:
           "shares of the floor's light")
     print("         ceiling  exact  ratio  block  exact")
     for name, b in (("no block", None), ("block", block)):
-        cell = ref.closed_box_cells(n, b)
-        lit = np.zeros((n, n, n))
-        lit[1, 2:n - 2, 2:n - 2] = 1.0
-        if b is not None:
-            lit[1, lo:hi + 1, lo:hi + 1] = 0.0
-        field = ref.emit(lit, np.zeros_like(lit), cell["normal"], cell["occupied"])
-        total = ref.flux_w(field)
-        _, plus, minus = ref.propagate(field, cell, 2 * n, transfer)
-        absorbed = plus + minus
-        ceiling = absorbed[n - 2, 2:-2, 2:-2].sum() / total
-        on_block = 0.0 if b is None else absorbed[2:top + 1, lo:hi + 1, lo:hi + 1].sum() / total
+        ceiling, on_block = block_shares(n, b, transfer)
         exact_ceiling, exact_block = floor_past_block(n, b)
         print(f"{name:8s} {ceiling:8.3f} {exact_ceiling:6.3f} {ceiling / exact_ceiling:6.3f} {on_block:6.3f} "
               f"{exact_block:6.3f}")
+    ours = block_shares(n, block, transfer, by_layer=True)[1]
+    exact = floor_past_block(n, block, by_layer=True)[1]
+    print("the block's share by layer of cells, bottom to top:")
+    print("  ours  " + " ".join(f"{v:.3f}" for v in ours))
+    print("  exact " + " ".join(f"{v:.3f}" for v in exact))
 
 
 def point_source_figures(transfer: str, steps: int = 120, size: int = 41) -> None:
@@ -229,15 +259,39 @@ def closure_transfer(count: int = 2000, rho_max: float = 0.97):
     return transport
 
 
+def limited_transfer(knee: float = 2.0 / 3.0):
+    """`directional` with a flux limiter: each face's flux takes the isotropic part c0 / 6 times g, which
+    falls from 1 at the knee (a Lambertian lobe's anisotropy rho = |c1| / (sqrt 3 c0) = 2/3, whose
+    partition stays exact) to 0 for a collimated beam (rho = 1): a beam then crosses only the face it
+    heads for. The flux row of M_d changes with it, so each face still carries its raw flux's M_d L."""
+    m = ref.directional_matrices()
+
+    def transport(field: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        c0 = field[..., 0]
+        rho = np.linalg.norm(field[..., 1:], axis=-1) / (np.sqrt(3.0) * np.where(c0 > 0.0, c0, 1.0))
+        g = np.clip((1.0 - rho) / (1.0 - knee), 0.0, 1.0)
+        moved = np.einsum("dij,...j->...di", m, field)
+        moved[..., 0] += ((g - 1.0) * c0 / 6.0)[..., None]
+        raw = ref.FLUX_PER_C0 * moved[..., 0]
+        return raw, moved / np.where(raw > 0.0, raw, 1.0)[..., None]
+    return transport
+
+
 def alternative_figures(n: int) -> None:
-    models = (("directional", "directional", 4), ("L2", l2_transfer(), 9), ("closure", closure_transfer(), 4))
+    models = (("directional", "directional", 4), ("L2", l2_transfer(), 9), ("closure", closure_transfer(), 4),
+              ("limited", limited_transfer(), 4))
     cell = ref.closed_box_cells(n)
+    block = block_in_box(n)
     print(f"sharper angular models, closed box of {n} cells: per lit patch the share on the ceiling "
           "(exact: its view factor) and on the floor itself (exact 0); a point source's 4 pi r^2 E after 24 "
-          "steps (exact 1 once all of its light has arrived)")
-    print("model        up share  ceiling 2x2  floor 2x2  ceiling 10x10  floor 10x10  r=4   r=8")
+          "steps (exact 1 once all of its light has arrived); the whole floor lit with a block on it (figure "
+          "3): the shares on the ceiling and on the block")
+    print("model        up share  ceiling 2x2  floor 2x2  ceiling 10x10  floor 10x10  r=4   r=8   "
+          "block: ceiling  block")
     exact = [ceiling_view_factor(n, half) for half in (1, 5)]
-    print(f"exact           0.449  {exact[0]:11.3f}  {0:9.3f}  {exact[1]:13.3f}  {0:11.3f}  1.00  1.00")
+    exact_block = floor_past_block(n, block)
+    print(f"exact           0.449  {exact[0]:11.3f}  {0:9.3f}  {exact[1]:13.3f}  {0:11.3f}  1.00  1.00  "
+          f"{exact_block[0]:14.3f}  {exact_block[1]:5.3f}")
     up = np.array([0.0, 0.0, 1.0])
     for name, transfer, coefficients in models:
         lobe = sh.cosine_lobe_l1(up) if coefficients == 4 else sh.cosine_lobe_l2(up)
@@ -247,8 +301,7 @@ def alternative_figures(n: int) -> None:
         for half, width in ((1, 11), (5, 13)):
             lit = np.zeros((n, n, n))
             lit[1, n // 2 - half:n // 2 + half, n // 2 - half:n // 2 + half] = 1.0
-            lobes = sh.cosine_lobe_l1(cell["normal"]) if coefficients == 4 else sh.cosine_lobe_l2(cell["normal"])
-            field = lit[..., None] * lobes / np.pi
+            field = lit_field(lit, cell["normal"], coefficients)
             total = ref.flux_w(field)
             _, plus, minus = ref.propagate(field, cell, 2 * n, transfer)
             absorbed = plus + minus
@@ -263,6 +316,7 @@ def alternative_figures(n: int) -> None:
             through += ref.inflow(ref.face_fluxes(field, empty["open"], transfer))[centre, centre, :, 0]
             field, _, _ = ref.step(field, empty, transfer)
         row.append("  ".join(f"{4 * np.pi * r**2 * through[centre + r]:.2f}" for r in (4, 8)))
+        row.append("{:14.3f}  {:5.3f}".format(*block_shares(n, block, transfer, coefficients)))
         print("  ".join(row))
 
 

@@ -49,9 +49,11 @@ def test_the_alternatives_leave_a_lambertian_lobe_by_its_exact_shares():
     up = np.array([0.0, 0.0, 1.0])
     open_faces = np.ones((1, 1, 1, 6))
     for transfer, lobe, tolerance in ((diffusion_box.closure_transfer(), sh.cosine_lobe_l1(up), 1e-3),
-                                      (diffusion_box.l2_transfer(), sh.cosine_lobe_l2(up), 3.5e-3)):
+                                      (diffusion_box.l2_transfer(), sh.cosine_lobe_l2(up), 3.5e-3),
+                                      (diffusion_box.limited_transfer(), sh.cosine_lobe_l1(up), 1e-5)):
         # closure: the cosine power p = 1 itself, to the spiral's quadrature (it reads 0.44948); L2: its
-        # projection of the clamped cosine rings below the horizon and leaves 0.4467 up.
+        # projection of the clamped cosine rings below the horizon and leaves 0.4467 up; limited: at its
+        # knee the limiter is 1 and the flux row is directional's, exact but for the constant's digits.
         field = (lobe / np.pi).reshape(1, 1, 1, -1)
         shares = ref.face_fluxes(field, open_faces, transfer)[0, 0, 0] / ref.flux_w(field)
         assert abs(shares[4] - LAMBERTIAN_UP_SHARE) < tolerance
@@ -86,3 +88,17 @@ def test_a_block_stands_on_the_floor_with_its_normals_outwards():
     # 5 x 5 cells across, z 2..7: five layers of its 16-cell ring, then the 25 cells of its top
     assert cell["occupied"][2:top + 1, lo:hi + 1, lo:hi + 1].sum() == 5 * 16 + 25
     assert not cell["occupied"][3, 6, 6]  # the block's inside is air no light reaches
+
+
+def test_the_limiter_sends_a_beam_through_its_own_face_only_and_keeps_the_field():
+    beam = (np.array([sh.Y00, 0.0, sh.Y1, 0.0]) * 0.7).reshape(1, 1, 1, 4)  # a collimated beam up (1, y, z, x)
+    shares = ref.face_fluxes(beam, np.ones((1, 1, 1, 6)), diffusion_box.limited_transfer())[0, 0, 0]
+    np.testing.assert_allclose(shares / ref.flux_w(beam), [0, 0, 0, 0, 1, 0], atol=1e-12)
+    # Any field: the faces together carry the field itself (the residual takes what the clamped faces held).
+    fields = realizable_fields(30, seed=2)
+    open_faces = np.ones((30, 1, 1, 6))
+    out = ref.face_fluxes(fields, open_faces, diffusion_box.limited_transfer())
+    np.testing.assert_allclose(out.sum(-1), ref.FLUX_PER_C0 * fields[..., 0], rtol=1e-12)  # all its flux
+    shapes = ref.carried_shapes(fields, open_faces, out, diffusion_box.limited_transfer())
+    np.testing.assert_allclose((shapes * out[..., None]).sum(-2), fields, rtol=1e-10, atol=1e-15)
+
