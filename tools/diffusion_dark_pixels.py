@@ -67,25 +67,39 @@ def best_alignment(points_m, normals, grid, block, plane) -> np.ndarray:
     return best
 
 
-def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def parse_args(description: str) -> argparse.Namespace:
+    """BLEND --reference REF/indirect.exr [--set group.name=value ...]: the diffusion tools' arguments."""
+    parser = argparse.ArgumentParser(description=description)
     parser.add_argument("blend")
     parser.add_argument("--reference", required=True)
     parser.add_argument("--set", dest="sets", action="append", default=[], help="group.name=value")
-    args = parser.parse_args()
+    return parser.parse_args()
+
+
+def diffusion_at_reference(blend: str, reference_path: str, sets: list[str]):
+    """(backend, the diffusion method set to the scene at the reference's size with `sets`, the
+    reference's rgb in float64)."""
     import bpy
 
     from addon.bridge import images, pipeline
     from addon.bridge.capture import SceneCache
-    from addon.engine import diffusion_reference, methods, metrics
+    from addon.engine import methods
 
-    reference = images.read_exr(args.reference)[..., :3].astype(np.float64)
+    reference = images.read_exr(reference_path)[..., :3].astype(np.float64)
     height, width = reference.shape[:2]
-    bpy.ops.wm.open_mainfile(filepath=str(Path(args.blend).resolve()))
+    bpy.ops.wm.open_mainfile(filepath=str(Path(blend).resolve()))
     scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), width, height)
     be = pipeline.backend()
-    method = methods.create(be, build_settings("diffusion", max(width, height), parse_sets(args.sets)))
+    method = methods.create(be, build_settings("diffusion", max(width, height), parse_sets(sets)))
     method.set_scene(scene)
+    return be, method, reference
+
+
+def main() -> int:
+    args = parse_args(__doc__.splitlines()[0])
+    from addon.engine import diffusion_reference, metrics
+
+    be, method, reference = diffusion_at_reference(args.blend, args.reference, args.sets)
     ours = method.run().images["indirect"][..., :3].astype(np.float64)
     # The G-buffer is read with GL's row 0 at the bottom; the method's image has row 0 at the top.
     position, normal = (be.read(method.gbuf[k])[::-1] for k in ("position", "normal"))

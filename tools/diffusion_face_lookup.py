@@ -22,7 +22,6 @@ blended as the sides lookup blends them, each by its trilinear weight times sum 
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 from pathlib import Path
@@ -33,7 +32,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tools"))
 
-from noise_table import build_settings, parse_sets  # noqa: E402
+from diffusion_dark_pixels import diffusion_at_reference, parse_args  # noqa: E402
 
 from addon.engine.diffusion_reference import DIRECTIONS  # noqa: E402
 
@@ -76,27 +75,12 @@ def face_lookup(points_m: np.ndarray, normals: np.ndarray, origin_m, cell_m: flo
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("blend")
-    parser.add_argument("--reference", required=True)
-    parser.add_argument("--set", dest="sets", action="append", default=[], help="group.name=value")
-    args = parser.parse_args()
-    import bpy
-
-    from addon.bridge import images, pipeline
-    from addon.bridge.capture import SceneCache
-    from addon.engine import methods, metrics
+    args = parse_args(__doc__.splitlines()[0])
+    from addon.engine import metrics
     from addon.engine.methods.diffusion import steps_per_bounce
     from addon.engine.passes import diffusion_inject, diffusion_propagate
 
-    reference = images.read_exr(args.reference)[..., :3].astype(np.float64)
-    height, width = reference.shape[:2]
-    bpy.ops.wm.open_mainfile(filepath=str(Path(args.blend).resolve()))
-    scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), width, height)
-    be = pipeline.backend()
-    settings = build_settings("diffusion", max(width, height), parse_sets(ONE_PROPAGATION + args.sets))
-    method = methods.create(be, settings)
-    method.set_scene(scene)
+    be, method, reference = diffusion_at_reference(args.blend, args.reference, ONE_PROPAGATION + args.sets)
     sides = method.run().images["indirect"][..., :3].astype(np.float64)
 
     grid, cells = method.grid, method.cells
