@@ -15,9 +15,9 @@ For each transfer (cone, the paper's; directional):
 
 `--alternatives`: sharper angular models than L1 tried on the same twin, carried as `directional` is
 (docs/DIFFUSION.md, "Small bright patches, and sharper angular models"): L2 with its exact face
-matrices, a positive closure of the L1 field (M1-like) and a flux limiter on L1. The ceiling's share
-from a 2 x 2 and a 10 x 10 lit patch, the point source at 4 and 8 cells, and figure 3's block (several
-minutes at 16 cells: the closure integrates per cell).
+matrices, a positive closure of the L1 field (M1-like), a flux limiter on L1, and L2 only at surfaces.
+The ceiling's share from a 2 x 2 and a 10 x 10 lit patch, the point source at 4 and 8 cells, and figure
+3's block (several minutes at 16 cells: the closure integrates per cell).
 
 Run: .venv/bin/python tools/diffusion_box.py [--cells 32] [--alternatives]  (both transfers; about a
 minute at 32 cells)
@@ -156,7 +156,7 @@ def block_shares(n: int, block, transfer, coefficients: int = 4, by_layer: bool 
         lit[1, lo:hi + 1, lo:hi + 1] = 0.0
     field = lit_field(lit, cell["normal"], coefficients)
     total = ref.flux_w(field)
-    _, plus, minus = ref.propagate(field, cell, 2 * n, transfer)
+    _, plus, minus = ref.propagate(field, cell, 2 * n, for_cells(transfer, cell))
     absorbed = plus + minus
     on_block = 0.0 if block is None else absorbed[2:top + 1, lo:hi + 1, lo:hi + 1].sum() / total
     shares = float(absorbed[n - 2, 2:-2, 2:-2].sum() / total), float(on_block)
@@ -277,9 +277,47 @@ def limited_transfer(knee: float = 2.0 / 3.0):
     return transport
 
 
+class ByCells:
+    """An angular model that depends on where the surfaces are: `make(cells)` gives the transfer for a
+    scene's cells (ref.cells)."""
+
+    def __init__(self, make):
+        self.make = make
+
+
+def for_cells(transfer, cell: dict):
+    return transfer.make(cell) if isinstance(transfer, ByCells) else transfer
+
+
+def surface_l2_transfer() -> ByCells:
+    """L2 in the cells that hold a surface or border one, `directional` (L1, the flux row) in the air
+    further off: the field carries nine coefficients, and the air's cells use and pass on the first four
+    (the L2 band dropped there). Where light meets surfaces it has L2's angular detail; in open space
+    L1's, which does not keep light to the axes."""
+    l2 = l2_transfer()
+    m1 = ref.directional_matrices()
+
+    def make(cell: dict):
+        near = cell["occupied"].copy()
+        for axis in range(3):
+            for shift in (1, -1):
+                near |= np.roll(cell["occupied"], shift, axis=axis)
+
+        def transport(field: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            raw2, shape2 = l2(field)
+            moved1 = np.einsum("dij,...j->...di", m1, field[..., :4])
+            raw1 = ref.FLUX_PER_C0 * moved1[..., 0]
+            shape1 = np.zeros(shape2.shape)
+            shape1[..., :4] = moved1 / np.where(raw1 > 0.0, raw1, 1.0)[..., None]
+            return (np.where(near[..., None], raw2, raw1),
+                    np.where(near[..., None, None], shape2, shape1))
+        return transport
+    return ByCells(make)
+
+
 def alternative_figures(n: int) -> None:
     models = (("directional", "directional", 4), ("L2", l2_transfer(), 9), ("closure", closure_transfer(), 4),
-              ("limited", limited_transfer(), 4))
+              ("limited", limited_transfer(), 4), ("L2 by surfaces", surface_l2_transfer(), 9))
     cell = ref.closed_box_cells(n)
     block = block_in_box(n)
     print(f"sharper angular models, closed box of {n} cells: per lit patch the share on the ceiling "
@@ -296,14 +334,16 @@ def alternative_figures(n: int) -> None:
     for name, transfer, coefficients in models:
         lobe = sh.cosine_lobe_l1(up) if coefficients == 4 else sh.cosine_lobe_l2(up)
         single = (lobe / np.pi).reshape(1, 1, 1, -1)
-        share = ref.face_fluxes(single, np.ones((1, 1, 1, 6)), transfer)[0, 0, 0, 4] / ref.flux_w(single)
+        lone = ref.cells(np.ones((1, 1, 1), bool), np.array([[[[0.0, 0.0, 1.0]]]]), np.zeros((1, 1, 1, 3)))
+        share = (ref.face_fluxes(single, np.ones((1, 1, 1, 6)), for_cells(transfer, lone))[0, 0, 0, 4]
+                 / ref.flux_w(single))
         row = [f"{name:12s} {share:8.3f}"]
         for half, width in ((1, 11), (5, 13)):
             lit = np.zeros((n, n, n))
             lit[1, n // 2 - half:n // 2 + half, n // 2 - half:n // 2 + half] = 1.0
             field = lit_field(lit, cell["normal"], coefficients)
             total = ref.flux_w(field)
-            _, plus, minus = ref.propagate(field, cell, 2 * n, transfer)
+            _, plus, minus = ref.propagate(field, cell, 2 * n, for_cells(transfer, cell))
             absorbed = plus + minus
             row.append(f"{absorbed[n - 2, 2:-2, 2:-2].sum() / total:{width}.3f}  "
                        f"{absorbed[1, 2:-2, 2:-2].sum() / total:{width - 2}.3f}")
@@ -312,9 +352,10 @@ def alternative_figures(n: int) -> None:
         field = np.zeros((size,) * 3 + (coefficients,))
         field[centre, centre, centre, 0] = 1.0 / ref.FLUX_PER_C0
         through = np.zeros(size)
+        in_empty = for_cells(transfer, empty)
         for _ in range(24):
-            through += ref.inflow(ref.face_fluxes(field, empty["open"], transfer))[centre, centre, :, 0]
-            field, _, _ = ref.step(field, empty, transfer)
+            through += ref.inflow(ref.face_fluxes(field, empty["open"], in_empty))[centre, centre, :, 0]
+            field, _, _ = ref.step(field, empty, in_empty)
         row.append("  ".join(f"{4 * np.pi * r**2 * through[centre + r]:.2f}" for r in (4, 8)))
         row.append("{:14.3f}  {:5.3f}".format(*block_shares(n, block, transfer, coefficients)))
         print("  ".join(row))

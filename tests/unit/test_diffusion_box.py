@@ -102,3 +102,23 @@ def test_the_limiter_sends_a_beam_through_its_own_face_only_and_keeps_the_field(
     shapes = ref.carried_shapes(fields, open_faces, out, diffusion_box.limited_transfer())
     np.testing.assert_allclose((shapes * out[..., None]).sum(-2), fields, rtol=1e-10, atol=1e-15)
 
+
+
+def test_l2_by_surfaces_is_l2_at_surfaces_and_directional_in_the_air():
+    occupied = np.zeros((5, 5, 5), bool)
+    occupied[2, 2, 2] = True  # one surface cell: it and its six neighbours are "near"
+    normal = np.zeros((5, 5, 5, 3))
+    normal[2, 2, 2] = (0.0, 0.0, 1.0)
+    cell = ref.cells(occupied, normal, np.zeros((5, 5, 5, 3)))
+    rng = np.random.default_rng(3)
+    field = rng.normal(size=(5, 5, 5, 9))
+    raw, shape = diffusion_box.surface_l2_transfer().make(cell)(field)
+    raw_l2, shape_l2 = diffusion_box.l2_transfer()(field)
+    raw_l1, shape_l1 = ref.face_transport(field[..., :4], "directional")
+    for near in ((2, 2, 2), (2, 2, 3), (1, 2, 2)):
+        np.testing.assert_array_equal(raw[near], raw_l2[near])
+        np.testing.assert_array_equal(shape[near], shape_l2[near])
+    for air in ((0, 0, 0), (2, 2, 4), (4, 4, 4)):  # two cells off, or further
+        np.testing.assert_allclose(raw[air], raw_l1[air], rtol=1e-12)
+        np.testing.assert_allclose(shape[air][..., :4], shape_l1[air], rtol=1e-12)
+        assert np.all(shape[air][..., 4:] == 0.0)  # the L2 band is dropped in the air
