@@ -34,6 +34,8 @@ sys.path.insert(0, str(ROOT / "tools"))
 
 from noise_table import build_settings, parse_sets  # noqa: E402
 
+from addon.engine import diffusion_reference  # noqa: E402
+
 DARK_RATIO = 0.1        # a pixel below this share of Cycles' value reads as unlit
 LIT_PERCENTILE = 30.0   # ... where Cycles' value is above this percentile of the covered pixels'
 RECEIVES_PLUS, RECEIVES_MINUS = 64, 128  # diffusion/cell.glsl's bits of cell_block.w - 1
@@ -49,14 +51,9 @@ def dark_mask(lum: np.ndarray, ref_lum: np.ndarray, covered: np.ndarray) -> np.n
 def best_alignment(points_m, normals, grid, block, plane) -> np.ndarray:
     """Per point, the largest |n . n_cell| over the 8 cells the lookup reads (diffusion/lookup.comp.glsl)
     that hold a surface whose side facing n receives light; 0 where none does."""
-    g = (points_m - np.asarray(grid.origin_m)) / grid.cell_size_m - 0.5
-    base = np.floor(g).astype(int)
     best = np.zeros(len(points_m))
-    dims = np.asarray(grid.dims)
-    for k in range(8):
-        c = base + np.array([k & 1, (k >> 1) & 1, k >> 2])
-        inside = np.all((c >= 0) & (c < dims), axis=1)
-        cc = np.where(inside[:, None], c, 0)
+    points_cells = (points_m - np.asarray(grid.origin_m)) / grid.cell_size_m
+    for cc, _, inside in diffusion_reference.lookup_corners(points_cells, grid.dims):
         b = block[cc[:, 2], cc[:, 1], cc[:, 0]]
         n_cell = plane[cc[:, 2], cc[:, 1], cc[:, 0], :3]
         dn = np.sum(normals * n_cell, axis=1)
@@ -97,7 +94,7 @@ def diffusion_at_reference(blend: str, reference_path: str, sets: list[str]):
 
 def main() -> int:
     args = parse_args(__doc__.splitlines()[0])
-    from addon.engine import diffusion_reference, metrics
+    from addon.engine import metrics
 
     be, method, reference = diffusion_at_reference(args.blend, args.reference, args.sets)
     ours = method.run().images["indirect"][..., :3].astype(np.float64)

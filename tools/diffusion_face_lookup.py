@@ -34,7 +34,7 @@ sys.path.insert(0, str(ROOT / "tools"))
 
 from diffusion_dark_pixels import diffusion_at_reference, parse_args  # noqa: E402
 
-from addon.engine.diffusion_reference import DIRECTIONS  # noqa: E402
+from addon.engine.diffusion_reference import DIRECTIONS, lookup_corners  # noqa: E402
 
 ONE_PROPAGATION = ["diffusion.emitter_class_passes=false", "diffusion.far_field=false"]
 
@@ -46,19 +46,12 @@ def face_lookup(points_m: np.ndarray, normals: np.ndarray, origin_m, cell_m: flo
     light travelled), `block` the cells (diffusion/cell.glsl: xyz per-axis absorbed share, w > 0
     occupied). 0 where no cell near has a face the point's surface could be lit through."""
     dims = np.array(block.shape[:3][::-1])
-    g = (points_m - np.asarray(origin_m)) / cell_m - 0.5
-    base = np.floor(g).astype(int)
-    frac = g - base
     facing = np.maximum(0.0, -(normals @ DIRECTIONS.T)) ** 2  # (n, 6)
     steps = DIRECTIONS.astype(int)
     num = np.zeros((len(points_m), 3))
     den = np.zeros(len(points_m))
-    for k in range(8):
-        o = np.array([k & 1, (k >> 1) & 1, k >> 2])
-        c = base + o
-        t = np.prod(np.where(o, frac, 1.0 - frac), axis=1) + 1e-3  # lookup.comp.glsl's weight floor
-        inside = np.all((c >= 0) & (c < dims), axis=1)
-        cc = np.clip(c, 0, dims - 1)
+    points_cells = (points_m - np.asarray(origin_m)) / cell_m
+    for cc, t, inside in lookup_corners(points_cells, dims):  # as diffusion/lookup.comp.glsl reads them
         b = block[cc[:, 2], cc[:, 1], cc[:, 0]]
         source = cc[:, None, :] - steps[None]  # (n, 6, 3): the cell light through face f came from
         source_inside = np.all((source >= 0) & (source < dims), axis=2)

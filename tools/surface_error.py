@@ -8,8 +8,8 @@ against a Cycles reference and its share of the image's squared error.
 The reference must be of the same scene, camera and size (bench's references are). bias = mean(ours) /
 mean(Cycles) over the group's pixels (luminance as the mean of r, g, b); share = the group's sum of
 squared differences over the whole image's; the line of all covered pixels also gives the image's
-rel_rmse_8 (the benchmark's error, addon/engine/metrics.py). A group below 1 % of the covered pixels is not printed.
-Prints one JSON line per group.
+rel_rmse_8 (the benchmark's error, addon/engine/metrics.py). A group below 1 % of the covered pixels is
+not printed. Prints one JSON line per group.
 """
 
 from __future__ import annotations

@@ -451,6 +451,21 @@ def _coarse_sum(fine: np.ndarray, far_shape: tuple, shift: tuple = (0, 0, 0)) ->
 
 
 # -- reconstruction ------------------------------------------------------------------------------------
+def lookup_corners(points_cells: np.ndarray, dims_xyz):
+    """The 8 cells whose centres surround each point (n, 3; grid coordinates in cells), as the lookup
+    reads them: per corner (cell (n, 3) x y z, clipped into the grid; its trilinear weight raised by
+    LOOKUP_WEIGHT_FLOOR (n); whether the unclipped cell is inside the grid (n))."""
+    p = np.asarray(points_cells, np.float64) - 0.5
+    base = np.floor(p).astype(int)
+    frac = p - base
+    dims = np.asarray(dims_xyz)
+    for k in range(8):
+        o = np.array([k & 1, (k >> 1) & 1, k >> 2])
+        c = base + o
+        t = np.prod(np.where(o, frac, 1.0 - frac), axis=1) + LOOKUP_WEIGHT_FLOOR
+        yield np.clip(c, 0, dims - 1), t, np.all((c >= 0) & (c < dims), axis=1)
+
+
 def lookup(points_cells: np.ndarray, normals: np.ndarray, cell: dict, flux_plus: np.ndarray,
            flux_minus: np.ndarray, cell_area_m2: float) -> np.ndarray:
     """Irradiance / pi (Cycles' Diffuse Indirect) at points (n, 3) in grid coordinates (cells) with unit
@@ -462,24 +477,16 @@ def lookup(points_cells: np.ndarray, normals: np.ndarray, cell: dict, flux_plus:
     where none does, 0 (no surface near: no light known). Every trilinear weight is raised by
     LOOKUP_WEIGHT_FLOOR, so a point at a cell's centre whose own cell cannot receive (a room's corner)
     still reads its neighbours."""
-    p = np.asarray(points_cells, np.float64) - 0.5
-    base = np.floor(p).astype(int)
-    frac = p - base
-    dims_zyx = np.array(cell["occupied"].shape)
-    num = np.zeros(len(p))
-    den = np.zeros(len(p))
-    num_t = np.zeros(len(p))
-    den_t = np.zeros(len(p))
-    for k in range(8):
-        o = np.array([k & 1, (k >> 1) & 1, k >> 2])
-        c = base + o
-        t = np.prod(np.where(o, frac, 1.0 - frac), axis=1) + LOOKUP_WEIGHT_FLOOR
-        inside = np.all((c >= 0) & (c < dims_zyx[::-1]), axis=1)
-        cz = np.clip(c, 0, dims_zyx[::-1] - 1)
+    count = len(points_cells)
+    num = np.zeros(count)
+    den = np.zeros(count)
+    num_t = np.zeros(count)
+    den_t = np.zeros(count)
+    for cz, t, inside in lookup_corners(points_cells, cell["occupied"].shape[::-1]):
         idx = (cz[:, 2], cz[:, 1], cz[:, 0])
         n_c = cell["normal"][idx]
         dn = np.sum(normals * n_c, axis=1)
-        occ = inside & cell["occupied"][idx] & cell["receives"][idx][np.arange(len(p)), np.where(dn >= 0.0, 0, 1)]
+        occ = inside & cell["occupied"][idx] & cell["receives"][idx][np.arange(count), np.where(dn >= 0.0, 0, 1)]
         area = np.maximum(cell["area"][idx], 1e-6) * cell_area_m2
         e = np.where(dn >= 0.0, flux_plus[idx], flux_minus[idx]) / area
         w = np.where(occ, t * np.abs(dn), 0.0)
