@@ -122,3 +122,21 @@ def test_l2_by_surfaces_is_l2_at_surfaces_and_directional_in_the_air():
         np.testing.assert_allclose(raw[air], raw_l1[air], rtol=1e-12)
         np.testing.assert_allclose(shape[air][..., :4], shape_l1[air], rtol=1e-12)
         assert np.all(shape[air][..., 4:] == 0.0)  # the L2 band is dropped in the air
+
+
+def test_the_sharper_row_is_directional_at_one_and_sends_its_scaled_share_up():
+    fields = realizable_fields(20)
+    open_faces = np.ones((20, 1, 1, 6))
+    np.testing.assert_allclose(ref.face_fluxes(fields, open_faces, diffusion_box.sharper_row_transfer(1.0)),
+                               ref.face_fluxes(fields, open_faces, "directional"), rtol=1e-12)
+    # An upward Lambertian lobe, per W: each side's raw flux is 1/6, the top's 1/6 + r (its down face
+    # clamps), so the top's share is (1/6 + r) / (5/6 + r), the exact share s at scale 1; scaling the
+    # row scales r: (1/6 + 1.3 r) / (5/6 + 1.3 r) = 0.49655.
+    s = LAMBERTIAN_UP_SHARE
+    r = (5.0 * s / 6.0 - 1.0 / 6.0) / (1.0 - s)
+    field = (sh.cosine_lobe_l1(np.array([0.0, 0.0, 1.0])) / np.pi).reshape(1, 1, 1, 4)
+    shares = (ref.face_fluxes(field, np.ones((1, 1, 1, 6)), diffusion_box.sharper_row_transfer(1.3))[0, 0, 0]
+              / ref.flux_w(field))
+    # LAMBERTIAN_UP_SHARE is given to 5 digits, so r and the share to about 1e-5.
+    assert abs(shares[4] - (1.0 / 6.0 + 1.3 * r) / (5.0 / 6.0 + 1.3 * r)) < 3e-5
+    assert abs(shares.sum() - 1.0) < 1e-12 and shares[5] == 0.0
