@@ -3,9 +3,10 @@ their normal (a room's floor, ceiling and walls), optionally split into height b
 against a Cycles reference and its share of the image's squared error.
 
     .venv/bin/python tools/surface_error.py BLEND --reference REF/indirect.exr --method diffusion \
-        [--res 128] [--bands 4] [--set diffusion.grid_cells=16 ...]
+        [--bands 4] [--set diffusion.grid_cells=16 ...]
 
-The reference must be of the same scene, camera and size (bench's references are). bias = mean(ours) /
+The reference must be of the same scene and camera (bench's references are); the image is rendered at the
+reference's size. bias = mean(ours) /
 mean(Cycles) over the group's pixels (luminance as the mean of r, g, b); share = the group's sum of
 squared differences over the whole image's; the line of all covered pixels also gives the image's
 rel_rmse_8 (the benchmark's error, addon/engine/metrics.py). A group below 1 % of the covered pixels is
@@ -55,7 +56,6 @@ def main() -> int:
     parser.add_argument("blend")
     parser.add_argument("--reference", required=True)
     parser.add_argument("--method", required=True)
-    parser.add_argument("--res", type=int, default=128)
     parser.add_argument("--bands", type=int, default=1)
     parser.add_argument("--set", dest="sets", action="append", default=[], help="group.name=value")
     args = parser.parse_args()
@@ -65,13 +65,14 @@ def main() -> int:
     from addon.bridge.capture import SceneCache
     from addon.engine import methods, metrics
 
+    reference_rgb = images.read_exr(args.reference)[..., :3].astype(np.float64)
+    height, width = reference_rgb.shape[:2]
     bpy.ops.wm.open_mainfile(filepath=str(Path(args.blend).resolve()))
-    scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), args.res, args.res)
+    scene = SceneCache().update(bpy.context.evaluated_depsgraph_get(), width, height)
     be = pipeline.backend()
-    method = methods.create(be, build_settings(args.method, args.res, parse_sets(args.sets)))
+    method = methods.create(be, build_settings(args.method, max(width, height), parse_sets(args.sets)))
     method.set_scene(scene)
     ours_rgb = method.run().images["indirect"][..., :3].astype(np.float64)
-    reference_rgb = images.read_exr(args.reference)[..., :3].astype(np.float64)
     ours, reference = ours_rgb.mean(axis=-1), reference_rgb.mean(axis=-1)
     # The G-buffer is read with GL's row 0 at the bottom; the method's image has row 0 at the top.
     position, normal = (be.read(method.gbuf[k])[::-1] for k in ("position", "normal"))

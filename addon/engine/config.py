@@ -309,6 +309,14 @@ class DiffusionConfig(_Validated):
     # cornell-area 0.262 -> 0.279 worse. Six propagations: a lights update 3-5x slower on llvmpipe.
     emitter_class_passes: bool = field(default=True, metadata={
         "doc": "a side takes in no light from sides facing its way (six propagations per bounce)"})
+    # On: the light heading through each cube face (the directions whose dominant signed axis is the
+    # face's) is a field of its own, propagated apart (six propagations per bounce, times six with the
+    # emitter classes) and never mixed with the others' in open space, so light rising past a wall is
+    # not turned into it (cone_fields.py; docs/DIFFUSION.md, "Cone fields"). The transfer is then the
+    # directional partition within each cone (`transfer` unused) and one grid carries it (`far_field`
+    # unused).
+    cone_fields: bool = field(default=False, metadata={
+        "doc": "propagate the light heading through each cube face as its own field (six per bounce)"})
     # On: the grid runs only its first near_steps and hands the light still in flight to a grid of twice
     # the cell (its own voxels and cells, aligned to the fine voxels) for the rest of the bounce
     # (docs/DIFFUSION.md, "Far field"). grid_cells >= 32: a coarser far grid resolves too little of a

@@ -8,6 +8,15 @@
 // Absorbed flux (W) goes to acc_plus / acc_minus, per side of the plane (first_step: written, else
 // added); FACES (the far field's grid): to acc_0..4, per face it came through, whose direction the fine
 // grid's planes then sort onto their own sides (diffusion/far_field_add.comp.glsl).
+// CONES (cone_fields.py): the field is one face cone's (light heading through that cube face), four
+// coefficients of the L1 basis restricted to the cone; its face fluxes are cone_raw[f] . c, its flux
+// cone_flux . c, and face f carries cone_moved[f] c (the cone's constants, compiled in): the
+// directional partition, with the light kept in its cone.
+#ifdef CONES
+const mat4 cone_moved[6] = CONE_MOVED;
+const vec4 cone_raw[6] = CONE_RAW;
+const vec4 cone_flux = CONE_FLUX;
+#endif
 #include "diffusion/cell.glsl"
 #ifdef FACES
 #include "diffusion/faces.glsl"
@@ -43,17 +52,30 @@ vec4 directional(vec4 c, int f) {
 // times the flux; DIRECTIONAL: M_d c x scale plus the face's share of the residual, below).
 float channel_outflow(vec4 c, vec3 open_plus, vec3 open_minus, int face, out vec4 carried) {
     vec3 along = c.wyz;  // the coefficients of x, y, z
+#ifdef CONES
+    vec3 raw_plus = vec3(dot(cone_raw[0], c), dot(cone_raw[2], c), dot(cone_raw[4], c));
+    vec3 raw_minus = vec3(dot(cone_raw[1], c), dot(cone_raw[3], c), dot(cone_raw[5], c));
+    float total = max(dot(cone_flux, c), 0.0);
+#else
     vec3 raw_plus = RAW_K0 * c.x + RAW_K1 * along;
     vec3 raw_minus = RAW_K0 * c.x - RAW_K1 * along;
+    float total = max(DIFFUSION_FLUX_PER_C0 * c.x, 0.0);
+#endif
     vec3 plus = max(raw_plus, vec3(0.0)) * open_plus;
     vec3 minus = max(raw_minus, vec3(0.0)) * open_minus;
     float sum = dot(plus + minus, vec3(1.0));
     int axis = face >> 1;
     bool positive = (face & 1) == 0;
     float through = positive ? plus[axis] : minus[axis];
-    float total = max(DIFFUSION_FLUX_PER_C0 * c.x, 0.0);
     float scale = sum > 0.0 ? total / sum : 0.0;
-#ifdef DIRECTIONAL
+#ifdef CONES
+    // As DIRECTIONAL's below, with the cone's matrices: the faces together carry c.
+    vec3 kp = vec3(greaterThan(plus, vec3(0.0)));
+    vec3 km = vec3(greaterThan(minus, vec3(0.0)));
+    vec4 residual = c - (kp.x * (cone_moved[0] * c) + km.x * (cone_moved[1] * c) + kp.y * (cone_moved[2] * c)
+                         + km.y * (cone_moved[3] * c) + kp.z * (cone_moved[4] * c) + km.z * (cone_moved[5] * c));
+    carried = through > 0.0 && total > 0.0 ? cone_moved[face] * c + (through / sum) * residual : vec4(0.0);
+#elif defined(DIRECTIONAL)
     // A face that carries light (raw > 0, open) carries M_f c, plus its share (by flux) of the residual
     // c - sum over carrying faces of M_f c: what the clamped and closed faces' M_f c held (their lobes
     // have flux <= 0 but still direction). So the faces together carry c itself and the light keeps its

@@ -55,3 +55,41 @@ def test_a_new_moderngl_backend_leaves_blenders_context_current(blender_backend)
     ModernGLBackend()
     tex = blender_backend.texture((4, 4), data=np.ones((4, 4, 4), np.float32))
     np.testing.assert_array_equal(blender_backend.read(tex), 1.0)
+
+
+@pytest.mark.parametrize("cone", [1, 4])
+def test_cone_field_passes_agree(gl, blender_backend, cone):
+    # The cone fields' emitters and step (diffusion/emit.comp.glsl, propagate.comp.glsl with CONES),
+    # whose matrices come in as long #defines of GLSL constructors: the same numbers on both backends.
+    from addon.engine.grid import Grid
+    from addon.engine.passes import diffusion_cells, diffusion_inject, diffusion_propagate
+
+    grid = Grid(np.zeros(3), 0.5, (5, 4, 3))
+    rng = np.random.default_rng(7)
+    shape = (3, 4, 5)
+    occupied = rng.random(shape) < 0.4
+    normal = rng.normal(size=(*shape, 3))
+    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+    voxels = {"vox_albedo": np.where(occupied[..., None], 0.6, 0.0) * np.ones(4),
+              "vox_normal": np.concatenate([normal * occupied[..., None], np.ones((*shape, 1))], -1),
+              "vox_projected": np.where(occupied[..., None], rng.uniform(0.2, 1.2, (*shape, 4)), 0.0)}
+    flux = {k: rng.uniform(0.0, 2.0, (*shape, 4)).astype(np.float32) for k in ("flux_plus", "flux_minus")}
+    out = []
+    for be in (gl, blender_backend):
+        textures = {k: be.texture(grid.dims, "RGBA32F", v.astype(np.float32)) for k, v in voxels.items()}
+        cells = diffusion_cells.textures(be, grid)
+        diffusion_cells.run(be, textures, cells, grid)
+        sets = [{f"sh_{c}": be.texture(grid.dims) for c in "rgb"} for _ in range(2)]
+        diffusion_inject.emit(be, {k: be.texture(grid.dims, "RGBA32F", v) for k, v in flux.items()}, cells, sets[0],
+                              grid, vox_albedo=textures["vox_albedo"], cone=cone)
+        absorbed = diffusion_propagate.sides(be, grid)
+        for i in range(3):  # light leaves its occupied cells, then meets others
+            diffusion_propagate.run(be, sets[i % 2], sets[(i + 1) % 2], absorbed, cells, grid, first_step=i == 0,
+                                    cone=cone)
+        out.append([be.read(sets[i][f"sh_{c}"]) for i in range(2) for c in "rgb"]
+                   + [be.read(absorbed[k]) for k in ("flux_plus", "flux_minus")])
+    assert np.abs(out[0][3]).max() > 0 and np.abs(out[0][6] + out[0][7]).max() > 0  # moved, and absorbed
+    for a, b in zip(*out, strict=True):
+        # fp32 on both: the emitters' gram^-1 (condition number 319) amplifies rounding to 3e-5 relative
+        # (tests/gpu/test_diffusion.py), and one step adds a few ulp.
+        np.testing.assert_allclose(b, a, rtol=0, atol=1e-4 * np.abs(a).max())

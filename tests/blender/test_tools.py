@@ -167,7 +167,7 @@ def test_surface_error_prints_each_surface_of_a_room(cornell, tmp_path):
     tool("-m", "addon", "render", str(cornell), "--method", "rsm", "--resolution", "32", "--out",
          str(tmp_path / "rsm"), "--quiet")
     out = tool("tools/surface_error.py", str(cornell), "--reference", str(tmp_path / "rsm" / "indirect.exr"),
-               "--method", "lpv", "--res", "32")
+               "--method", "lpv")
     rows = {r["group"]: r for r in map(json.loads, (line for line in out.splitlines() if line.startswith("{")))}
     assert rows["all"]["pixels"] == 32 * 32
     assert {"+x", "-x", "-y", "+z", "-z"} <= set(rows)

@@ -10,8 +10,8 @@ Volumes read back as (z, y, x, 4) arrays.
 import numpy as np
 import pytest
 
+from addon.engine import cone_fields, sh
 from addon.engine import diffusion_reference as ref
-from addon.engine import sh
 from addon.engine.grid import Grid
 from addon.engine.passes import atlas as atlas_pass
 from addon.engine.passes import (
@@ -382,3 +382,79 @@ def test_lookup_is_the_twins(gl):
         want[:3] = 0.0
         np.testing.assert_allclose(got[:, ch], want, rtol=0, atol=RTOL * want.max())
     assert (got[3:, 0] == 0).any() and (got[3:, 0] > 0).any()  # both the fallback and the lookup ran
+
+
+def random_cone_fields(rng, grid, cone, emitters=10):
+    """Per channel, cone `cone`'s fields of Lambertian emitters and isotropic light in random cells
+    (cone_fields.emit's, as the method's are)."""
+    out = []
+    for _ in range(3):
+        fp, fm = np.zeros(zyx(grid, 0)[:3]), np.zeros(zyx(grid, 0)[:3])
+        for _ in range(emitters):
+            z, y, x = (rng.integers(0, n) for n in zyx(grid, 0)[:3])
+            fp[z, y, x] += rng.uniform(0.1, 2.0)
+            fm[z, y, x] += rng.uniform(0.0, 0.5)
+        normal = rng.normal(size=zyx(grid, 3))
+        normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+        occupied = rng.random(fp.shape) < 0.7
+        out.append(cone_fields.emit(fp, fm, normal, occupied, cone).astype(np.float32))
+    return out
+
+
+@pytest.mark.parametrize("cone", [0, 3, 4])
+def test_cone_field_steps_are_the_twins(gl, cone):
+    # As test_propagation_steps_are_the_twins, for one cone field (cone_fields.step): its matrices are
+    # compiled into the step, the clamp, the open faces and the residual as directional's.
+    rng = np.random.default_rng(5 + cone)
+    voxels = random_voxels(rng, GRID)
+    _, cells = gpu_cells(gl, voxels)
+    fields = random_cone_fields(rng, GRID, cone)
+    sets = [sh_volumes(gl, GRID, fields), sh_volumes(gl, GRID)]
+    absorbed = diffusion_propagate.sides(gl, GRID)
+    cell = ref_cells(voxels)
+    want = [np.asarray(f, np.float64) for f in fields]
+    plus, minus = np.zeros((3, *zyx(GRID, 0)[:3])), np.zeros((3, *zyx(GRID, 0)[:3]))
+    for i in range(2):
+        diffusion_propagate.run(gl, sets[i % 2], sets[(i + 1) % 2], absorbed, cells, GRID, first_step=i == 0,
+                                cone=cone)
+        for ch in range(3):
+            want[ch], p, m = cone_fields.step(want[ch], cell, cone)
+            plus[ch] += p
+            minus[ch] += m
+        for ch, c in enumerate("rgb"):
+            got = gl.read(sets[(i + 1) % 2][f"sh_{c}"])
+            np.testing.assert_allclose(got, want[ch], rtol=0, atol=RTOL * np.abs(want[ch]).max())
+    assert plus.sum() > 0 and minus.sum() > 0
+    for ch in range(3):
+        np.testing.assert_allclose(gl.read(absorbed["flux_plus"])[..., ch], plus[ch], rtol=0, atol=RTOL * plus.max())
+        np.testing.assert_allclose(gl.read(absorbed["flux_minus"])[..., ch], minus[ch], rtol=0,
+                                   atol=RTOL * minus.max())
+
+
+@pytest.mark.parametrize("cone, emitter_class", [(0, ref.EVERY_CLASS), (5, ref.EVERY_CLASS), (2, 4)])
+def test_cone_field_emitters_are_the_twins(gl, cone, emitter_class):
+    # Each lobe's part in the cone by the same 8 x 8 points per cube face as cone_fields.lobe_parts, an
+    # empty cell's light times the cone's isotropic part, from the atlas and from albedo volumes. The
+    # part is gram^-1 times the lobe's projection, and a cone's Gram matrix has condition number 319
+    # (the L1 basis is nearly dependent over a sixth of the sphere): fp32's rounding of the projection
+    # (1e-7 relative) grows to 3e-5 at most, so 1e-4 here.
+    rng = np.random.default_rng(6)
+    voxels = random_voxels(rng, GRID)
+    textures, cells = gpu_cells(gl, voxels)
+    cell = ref_cells(voxels)
+    fp, fm = (rng.uniform(0.0, 2.0, zyx(GRID)).astype(np.float32) for _ in range(2))
+    atlas, _, _ = diffusion_inject.atlas_target(gl, GRID)
+    tiles = {"flux_plus": atlas_of(gl, atlas, GRID, fp), "flux_minus": atlas_of(gl, atlas, GRID, fm)}
+    volumes = {"flux_plus": gl.texture(GRID.dims, "RGBA32F", fp), "flux_minus": gl.texture(GRID.dims, "RGBA32F", fm)}
+    for source, albedo in ((tiles, None), (volumes, voxels["vox_albedo"])):
+        out = sh_volumes(gl, GRID, [np.full(zyx(GRID), 9.0, np.float32)] * 3)
+        if albedo is None:
+            diffusion_inject.emit(gl, source, cells, out, GRID, atlas=atlas, emitter_class=emitter_class, cone=cone)
+        else:
+            diffusion_inject.emit(gl, source, cells, out, GRID, vox_albedo=textures["vox_albedo"],
+                                  emitter_class=emitter_class, cone=cone)
+        for ch, c in enumerate("rgb"):
+            a = 1.0 if albedo is None else albedo[..., ch]
+            want = cone_fields.emit(fp[..., ch], fm[..., ch], cell["normal"], cell["occupied"], cone, a,
+                                    emitter_class)
+            np.testing.assert_allclose(gl.read(out[f"sh_{c}"]), want, rtol=0, atol=1e-4 * np.abs(want).max())

@@ -3,12 +3,15 @@
 Passes: those of `direct` (G-buffer, per light face: rsm, direct_light); once per geometry change the
 shared voxelizer (voxelize) and diffusion_cells (each cell's plane, absorption and open faces); per RSM
 face diffusion_inject (its VPLs' flux onto the sides of their cells' planes); once per update, for each
-bounce and emitter class (six with DiffusionConfig.emitter_class_passes, else one): diffusion_emit (the
+bounce, emitter class (six with DiffusionConfig.emitter_class_passes, else one) and cone field (six with
+DiffusionConfig.cone_fields, cone_fields.py: the light heading through each cube face apart, else one
+field of all directions): diffusion_emit (the
 sides' flux as Lambertian L1 SH lobes about their normals: the injected direct light, then each bounce's
 absorbed flux times albedo), steps x diffusion_propagate (gather form, ping-pong, absorbed flux
 accumulated per side), the class's light added to the bounce's at every side of another class, and the
 bounce added to the light field (diffusion_propagate.add); with DiffusionConfig.far_field (grids of
-diffusion_far_field.MIN_GRID_CELLS and more) the grid runs only its near steps, and the light still in
+diffusion_far_field.MIN_GRID_CELLS and more, without cone fields) the grid runs only its near steps, and
+the light still in
 flight is handed to a grid of twice the cell (its own voxelizer and cells) for the rest of the bounce,
 whose absorbed flux is shared back onto the fine sides (diffusion_far_field); the gather: diffusion_lookup -> `indirect`
 (Cycles' Diffuse Indirect). The light field does not depend on the camera: a camera move re-runs only
@@ -20,7 +23,7 @@ Products: direct, indirect, albedo.
 
 from __future__ import annotations
 
-from .. import registry
+from .. import cone_fields, registry
 from ..config import DiffusionConfig
 from ..grid import Grid
 from ..passes import (
@@ -90,15 +93,17 @@ class DiffusionMethod(OneBounceMethod):
             self.atlas, self.injected, self._inject_target = diffusion_inject.atlas_target(be, grid)
             self.snapshots = [{f"sh_{c}": be.texture(grid.dims) for c in "rgb"} for _ in range(2)]
             self.absorbed = diffusion_propagate.sides(be, grid)  # one propagation's
-            # One bounce's flux, every class's but each side's own (the last bounce's emits the next), or
-            # the propagation's itself when there is one class.
+            # One bounce's flux, every class's (but each side's own) and cone field's (the last bounce's
+            # emits the next), or the propagation's itself when there is one.
+            several = self.diffusion_config.emitter_class_passes or self.diffusion_config.cone_fields
             self.bounce_flux = ([diffusion_propagate.sides(be, grid) for _ in range(min(2, self.gi.bounces))]
-                                if self.diffusion_config.emitter_class_passes else [self.absorbed])
+                                if several else [self.absorbed])
             self.accumulated = diffusion_propagate.sides(be, grid) if self.gi.bounces > 1 else self.bounce_flux[0]
             self.far = None
         self.voxels = self.voxelizer.run()
         diffusion_cells.run(be, self.voxels, self.cells, self.grid)
-        if self.diffusion_config.far_field and max(grid.dims) >= diffusion_far_field.MIN_GRID_CELLS:
+        config = self.diffusion_config
+        if config.far_field and not config.cone_fields and max(grid.dims) >= diffusion_far_field.MIN_GRID_CELLS:
             self._set_far_field()
 
     def _set_far_field(self) -> None:
@@ -135,27 +140,29 @@ class DiffusionMethod(OneBounceMethod):
         transfer = self.diffusion_config.transfer
         classes = (diffusion_inject.EMITTER_CLASSES if self.diffusion_config.emitter_class_passes
                    else (diffusion_inject.EVERY_CLASS,))
+        cones = cone_fields.CONES if self.diffusion_config.cone_fields else (None,)
+        propagations = [(k, cone) for k in classes for cone in cones]
         previous = None  # the last bounce's flux, which the next one re-emits
         for bounce in range(1, self.gi.bounces + 1):
             flux = self.bounce_flux[bounce % len(self.bounce_flux)]
-            for k in classes:
+            for k, cone in propagations:
                 with self.step(timings, diffusion_inject.EMIT_DECL):
                     if previous is None:
                         diffusion_inject.emit(be, self.injected, cells, self.snapshots[0], grid, atlas=self.atlas,
-                                              emitter_class=k)
+                                              emitter_class=k, cone=cone)
                     else:
                         diffusion_inject.emit(be, previous, cells, self.snapshots[0], grid,
-                                              vox_albedo=self.voxels["vox_albedo"], emitter_class=k)
+                                              vox_albedo=self.voxels["vox_albedo"], emitter_class=k, cone=cone)
                 with self.step(timings, diffusion_propagate.DECL):
                     for i in range(near):
                         diffusion_propagate.run(be, self.snapshots[i % 2], self.snapshots[(i + 1) % 2], self.absorbed,
-                                                cells, grid, first_step=i == 0, transfer=transfer)
+                                                cells, grid, first_step=i == 0, transfer=transfer, cone=cone)
                 if far is not None:
                     with self.step(timings, diffusion_far_field.DECL):
                         self._propagate_far(self.snapshots[near % 2], steps - near, transfer)
                 if flux is not self.absorbed:
                     with self.step(timings, diffusion_propagate.DECL):
-                        diffusion_propagate.add(be, self.absorbed, flux, grid, first=k == classes[0],
+                        diffusion_propagate.add(be, self.absorbed, flux, grid, first=(k, cone) == propagations[0],
                                                 cell_normal=cells["cell_normal"], skip_class=k)
             if self.accumulated is not flux:
                 with self.step(timings, diffusion_propagate.DECL):

@@ -13,11 +13,14 @@ emitter class, docs/DIFFUSION.md "Emitter classes"). Twin: diffusion_reference.i
 
 from __future__ import annotations
 
+import functools
+
 from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_count
 from ..grid import Grid
 from .atlas import Atlas, splat, splat_spec
 from .declare import RSM, VOX_ALBEDO, PassDecl, Port
 from .diffusion_cells import CELL_BLOCK, CELL_NORMAL
+from .diffusion_cone_defines import cone_defines
 
 INJECTED = Port("diffusion", "injected", "RGBA32F", "atlas",
                 "VPL flux (W) on each side of a cell's plane, by layer tile")
@@ -36,7 +39,11 @@ DECL = PassDecl("diffusion_inject", "solve", (*RSM, CELL_NORMAL), (INJECTED,),
                 "each face's VPLs splatted by side of their cell's plane")
 
 
-def _emit_spec(atlas: bool) -> ShaderSpec:
+@functools.cache
+def emit_spec(atlas: bool, cone: int | None = None) -> ShaderSpec:
+    """From the injection atlases (the first bounce: VPL flux is reflected light already), or from a
+    bounce's absorbed flux times the voxels' albedo (the next bounce); with a `cone`, that cone field's
+    part of the emitters (cone_fields.py)."""
     dim = "2D" if atlas else "3D"
     samplers = (Sampler("flux_plus", dim), Sampler("flux_minus", dim), Sampler("cell_normal", "3D"),
                 Sampler("cell_block", "3D"))
@@ -45,15 +52,14 @@ def _emit_spec(atlas: bool) -> ShaderSpec:
         uniforms += (Var("tiles_x", "int"),)
     else:
         samplers += (Sampler("vox_albedo", "3D"),)
-    return ShaderSpec(name="diffusion_emit" + ("_atlas" if atlas else "_albedo"), compute="diffusion/emit.comp.glsl",
+    name = "diffusion_emit" + ("_atlas" if atlas else "_albedo") + ("" if cone is None else f"_cone_field_{cone}")
+    return ShaderSpec(name=name, compute="diffusion/emit.comp.glsl",
                       local_size=(4, 4, 4), samplers=samplers,
                       images=tuple(Image(f"sh_{c}", "3D", "RGBA32F", "write") for c in "rgb"), uniforms=uniforms,
-                      defines=(("ATLAS", "1"),) if atlas else (("ALBEDO", "1"),))
+                      defines=((("ATLAS", "1"),) if atlas else (("ALBEDO", "1"),))
+                      + (cone_defines(cone) if cone is not None else ()))
 
 
-# From the injection atlases (the first bounce: VPL flux is reflected light already), or from a bounce's
-# absorbed flux times the voxels' albedo (the next bounce).
-EMIT_SPECS = {True: _emit_spec(True), False: _emit_spec(False)}
 EMIT_DECL = PassDecl("diffusion_emit", "solve", (INJECTED, CELL_NORMAL, CELL_BLOCK, VOX_ALBEDO), (SNAPSHOT,),
                      "each side's flux as a Lambertian lobe about its normal (x albedo for later bounces)")
 
@@ -71,12 +77,12 @@ def run(backend: Backend, target, points, rsm: dict, grid: Grid, atlas: Atlas, c
 
 
 def emit(backend: Backend, flux: dict, cells: dict, snapshot: dict, grid: Grid, atlas: Atlas | None = None,
-         vox_albedo=None, emitter_class: int = EVERY_CLASS) -> None:
+         vox_albedo=None, emitter_class: int = EVERY_CLASS, cone: int | None = None) -> None:
     """snapshot (sh_r/g/b) := the emitters of `flux` (flux_plus / flux_minus): the injection atlases
     (`atlas` given), or volumes of absorbed flux re-emitted times `vox_albedo`; of the sides of
     `emitter_class` alone (0..5: the dominant signed axis of the side's normal, as the faces +x -x +y -y
     +z -z) unless it is EVERY_CLASS. Every cell written."""
-    spec = EMIT_SPECS[atlas is not None]
+    spec = emit_spec(atlas is not None, cone)
     samplers = {"flux_plus": flux["flux_plus"], "flux_minus": flux["flux_minus"], **cells}
     uniforms = {"dims": grid.dims, "emitting_class": emitter_class}
     if atlas is not None:

@@ -21,6 +21,7 @@ from ..backends.base import Backend, Image, Sampler, ShaderSpec, Var, group_coun
 from ..grid import Grid
 from .declare import PassDecl, Port
 from .diffusion_cells import CELL_BLOCK, CELL_NORMAL
+from .diffusion_cone_defines import cone_defines
 from .diffusion_inject import EVERY_CLASS, SNAPSHOT
 from .lpv_propagate import improved_constants
 
@@ -28,13 +29,17 @@ ABSORBED = Port("diffusion", "absorbed", "RGBA32F", "grid", "one bounce's flux (
 ACCUMULATED = Port("diffusion", "accumulated", "RGBA32F", "grid",
                    "every bounce's flux (W) absorbed on each side of a plane: the light field")
 
-def _spec(transfer: str, faces: bool) -> ShaderSpec:
-    directional = transfer == "directional"
+@functools.cache
+def spec(transfer: str, faces: bool, cone: int | None = None) -> ShaderSpec:
+    """The step's program: `transfer`'s, or with a `cone` (0..5) that cone field's (cone_fields.py),
+    whose matrices are compiled in; `faces`: absorbed flux kept by face (the far field's grid)."""
+    directional = transfer == "directional" and cone is None
     accumulators = (tuple(Image(f"acc_{i}", "3D", "RGBA32F", "read_write") for i in range(FACE_TEXELS)) if faces
                     else (Image("acc_plus", "3D", "RGBA32F", "read_write"),
                           Image("acc_minus", "3D", "RGBA32F", "read_write")))
+    name = f"diffusion_propagate_{transfer}" if cone is None else f"diffusion_propagate_cone_field_{cone}"
     return ShaderSpec(
-        name=f"diffusion_propagate_{transfer}" + ("_faces" if faces else ""),
+        name=name + ("_faces" if faces else ""),
         compute="diffusion/propagate.comp.glsl",
         local_size=(4, 4, 4),
         samplers=(*(Sampler(f"src_{c}", "3D") for c in "rgb"), *(() if faces else (Sampler("cell_normal", "3D"),)),
@@ -43,15 +48,13 @@ def _spec(transfer: str, faces: bool) -> ShaderSpec:
         uniforms=(Var("dims", "ivec3"), Var("first_step", "int"))
         + ((Var("m_cross", "float"), Var("m_along", "float"), Var("m_side", "float"), Var("flux_cross", "float"))
            if directional else ()),
-        defines=(("DIRECTIONAL", "1"),) * directional + (("FACES", "1"),) * faces,
+        defines=(("DIRECTIONAL", "1"),) * directional + (("FACES", "1"),) * faces
+        + (cone_defines(cone) if cone is not None else ()),
     )
 
 
 # The flux per face of a cell, 6 faces x rgb, packed into this many RGBA volumes (diffusion/faces.glsl).
 FACE_TEXELS = 5
-# cone: the paper's face-cone transfer, normalised; directional: LPV's improved transfer (docs/DIFFUSION.md).
-# faces: the absorbed flux kept by the face it came through (the far field's grid, diffusion_far_field).
-SPECS = {(t, faces): _spec(t, faces) for t in ("cone", "directional") for faces in (False, True)}
 
 ADD = ShaderSpec(
     name="diffusion_add",
@@ -102,19 +105,20 @@ def faces(backend: Backend, grid: Grid) -> dict:
 
 
 def run(backend: Backend, src: dict, dst: dict, absorbed: dict, cells: dict, grid: Grid, first_step: bool,
-        transfer: str = "cone") -> None:
+        transfer: str = "cone", cone: int | None = None) -> None:
     """One step: src (sh_r/g/b) -> dst, the flux absorbed written (first_step) or added into `absorbed`:
     per side (flux_plus / flux_minus, from `sides`) or per face it came through (acc_0 .. acc_4, from
-    `faces`: the far field's grid)."""
+    `faces`: the far field's grid). cone: the fields are that cone field's (cone_fields.py; `transfer`
+    is then unused)."""
     by_face = "acc_0" in absorbed
-    spec = SPECS[transfer, by_face]
+    spec_ = spec(transfer, by_face, cone)
     uniforms = {"dims": grid.dims, "first_step": int(first_step)}
-    if transfer == "directional":
+    if transfer == "directional" and cone is None:
         c = improved_constants()
         uniforms.update(m_cross=c["m_cross"], m_along=c["m_along"], m_side=c["m_side"], flux_cross=flux_cross())
     images = (dict(absorbed) if by_face
               else {"acc_plus": absorbed["flux_plus"], "acc_minus": absorbed["flux_minus"]})
-    backend.dispatch(backend.program(spec), group_count(grid.dims, spec.local_size), uniforms=uniforms,
+    backend.dispatch(backend.program(spec_), group_count(grid.dims, spec_.local_size), uniforms=uniforms,
                      samplers={**{f"src_{c}": src[f"sh_{c}"] for c in "rgb"}, **cells},
                      images={**{f"dst_{c}": dst[f"sh_{c}"] for c in "rgb"}, **images})
 
