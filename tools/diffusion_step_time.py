@@ -1,5 +1,5 @@
-"""One `diffusion` propagation step (both transfers) against one `lpv` step (improved, geometry volume: its
-defaults), on
+"""One `diffusion` propagation step (both transfers, and one cone field's: DiffusionConfig.cone_fields) against
+one `lpv` step (improved, geometry volume: its defaults), on
 the same backend in the same run, on a grid of N^3 cells a third of which hold surfaces (docs/DIFFUSION.md,
 "Speed"). Each figure: the median over the rounds of (32 steps, finish()) / 32, alternating the methods so
 all see the same load; wall-clock ms and the process's CPU ms (llvmpipe runs the shaders on this
@@ -71,11 +71,11 @@ def main() -> None:
         with stamps.timed({}, "step"):
             step()
 
-    def diffusion(transfer):
+    def diffusion(transfer, cone=None):
         def steps():
             for i in range(STEPS):
                 stamped(lambda i=i: diffusion_propagate.run(be, sets[i % 2], sets[(i + 1) % 2], absorbed, cells, grid,
-                                                            i == 0, transfer))
+                                                            i == 0, transfer, cone))
         return steps
 
     def lpv():
@@ -83,7 +83,8 @@ def main() -> None:
             stamped(lambda i=i: lpv_propagate.run(be, sets[i % 2], sets[(i + 1) % 2], acc, grid, "improved", i == 0,
                                                   blocking))
 
-    runs = {"diffusion (cone)": diffusion("cone"), "diffusion (directional)": diffusion("directional"), "lpv": lpv}
+    runs = {"diffusion (cone)": diffusion("cone"), "diffusion (directional)": diffusion("directional"),
+            "diffusion (a cone field's)": diffusion("directional", cone=4), "lpv": lpv}
     wall = {name: [] for name in runs}
     cpu = {name: [] for name in runs}
     gpu = {name: [] for name in runs}

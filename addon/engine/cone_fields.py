@@ -83,8 +83,12 @@ def constants() -> dict[str, np.ndarray]:
         moved.append(np.einsum("il,k,kf,kl,kj->fij", g_inv, dw, p, y, y))
         iso.append(g_inv @ flux[-1] / sphere_sr)
     gram = np.array(gram)
-    return {"gram": gram, "gram_inv": np.linalg.inv(gram), "flux": np.array(flux), "raw": np.array(raw),
-            "moved": np.array(moved), "iso": np.array(iso)}
+    out = {"gram": gram, "gram_inv": np.linalg.inv(gram), "flux": np.array(flux), "raw": np.array(raw),
+           "moved": np.array(moved), "iso": np.array(iso)}
+    # The cone's symmetry makes many entries exactly 0 (a cone's light never crosses its back face; its
+    # basis functions odd across a mirror plane of the cone do not couple), which the quadrature leaves at
+    # rounding (1e-15): set them to 0, so the shader's compiler drops those products.
+    return {k: np.where(np.abs(v) < 1e-12 * np.abs(v).max(), 0.0, v) for k, v in out.items()}
 
 
 def lobe_parts(normals: np.ndarray, cone: int) -> np.ndarray:

@@ -313,8 +313,7 @@ class DiffusionConfig(_Validated):
     # face's) is a field of its own, propagated apart (six propagations per bounce, times six with the
     # emitter classes) and never mixed with the others' in open space, so light rising past a wall is
     # not turned into it (cone_fields.py; docs/DIFFUSION.md, "Cone fields"). The transfer is then the
-    # directional partition within each cone (`transfer` unused) and one grid carries it (`far_field`
-    # unused).
+    # directional partition within each cone (`transfer` unused).
     cone_fields: bool = field(default=False, metadata={
         "doc": "propagate the light heading through each cube face as its own field (six per bounce)"})
     # On: the grid runs only its first near_steps and hands the light still in flight to a grid of twice

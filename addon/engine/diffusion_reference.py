@@ -338,17 +338,18 @@ def _enclosed(cell: dict) -> np.ndarray:
     return cell["occupied"] & ~cell["open"].any(-1)
 
 
-def far_move_enclosed(fields: np.ndarray, far_cell: dict) -> np.ndarray:
+def far_move_enclosed(fields: np.ndarray, far_cell: dict, cone: int | None = None) -> np.ndarray:
     """The far grid's emitters (3, z, y, x, 4: rgb fields summed from the fine grid's) with the light of
     each enclosed cell (occupied, no open face) moved to its face and edge neighbours that are not
     enclosed, in proportion to 1e-3 + max(0, u.w): u the unit offset, w the mean direction of the cell's
-    light (band 1 of its channels' sum, (y, z, x) in SH order). It stays where no neighbour takes it."""
+    light (band 1 of its channels' sum, (y, z, x) in SH order; a cone field's (`cone`, cone_fields.py):
+    its cone's axis). It stays where no neighbour takes it."""
     enclosed = _enclosed(far_cell)
     out = np.array(fields, np.float64)
     shape = enclosed.shape
     for z, y, x in zip(*np.nonzero(enclosed), strict=True):
         band1 = fields[:, z, y, x, 1:].sum(axis=0)  # y, z, x
-        w = np.array([band1[2], band1[0], band1[1]])
+        w = np.array([band1[2], band1[0], band1[1]]) if cone is None else DIRECTIONS[cone]
         w = w / np.linalg.norm(w) if np.linalg.norm(w) > 0 else w
         takers, weights = [], []
         for oz, oy, ox in _NEIGHBOURS_18:

@@ -31,8 +31,12 @@ float move_weight(ivec3 o, vec3 w) {
     return 1e-3 + max(0.0, dot(normalize(vec3(o)), w));
 }
 
-// The mean direction of the light in cell c (unit, or 0): band 1 (y, z, x) of its channels' sum.
+// The mean direction of the light in cell c (unit, or 0): band 1 (y, z, x) of its channels' sum; a cone
+// field's (CONE, cone_fields.py), whose coefficients are of the cone's own basis: the cone's axis.
 vec3 light_direction(ivec3 c) {
+#ifdef CONE
+    return diffusion_direction(CONE);
+#endif
     vec4 s = texelFetch(src_r, c, 0) + texelFetch(src_g, c, 0) + texelFetch(src_b, c, 0);
     vec3 w = s.wyz;
     float l = length(w);

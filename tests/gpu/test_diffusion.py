@@ -325,9 +325,11 @@ def test_far_field_weights_and_add_are_the_twins(gl, shift):
         np.testing.assert_allclose(plus.sum() + minus.sum(), shared, rtol=1e-12)
 
 
-def test_far_field_hand_over_frees_enclosed_cells(gl):
+@pytest.mark.parametrize("cone", [None, 2])
+def test_far_field_hand_over_frees_enclosed_cells(gl, cone):
     # The fine light in flight summed per far cell, the light of cells with no open face moved to the face
-    # and edge neighbours that have one, mostly along the light's direction; no light made or lost.
+    # and edge neighbours that have one, mostly along the light's direction (a cone field's: its cone's
+    # axis); no light made or lost.
     # A far grid of 5 x 5 x 5 starting a fine cell before the fine grid on y (faces out of the grid count
     # as open, so a small grid has no enclosed cell), 85 % occupied: enclosed cells with and without a
     # neighbour to take their light.
@@ -343,10 +345,10 @@ def test_far_field_hand_over_frees_enclosed_cells(gl):
     assert enclosed.sum() > 5 and (~enclosed).any()
     fields = random_fields(rng, fine, emitters=200)
     snapshots = [sh_volumes(gl, far_grid), sh_volumes(gl, far_grid)]
-    diffusion_far_field.hand_over(gl, sh_volumes(gl, fine, fields), fine, snapshots, far_cells, far)
+    diffusion_far_field.hand_over(gl, sh_volumes(gl, fine, fields), fine, snapshots, far_cells, far, cone)
     summed = np.stack([ref._coarse_sum_field(np.asarray(f, np.float64), zyx(far_grid, 0)[:3], far.shift)
                        for f in fields])
-    want = ref.far_move_enclosed(summed, far_cell)
+    want = ref.far_move_enclosed(summed, far_cell, cone)
     assert not np.allclose(want, summed)  # some light moved
     for ch, c in enumerate("rgb"):
         np.testing.assert_allclose(gl.read(snapshots[0][f"sh_{c}"]), want[ch], rtol=0,

@@ -10,8 +10,7 @@ sides' flux as Lambertian L1 SH lobes about their normals: the injected direct l
 absorbed flux times albedo), steps x diffusion_propagate (gather form, ping-pong, absorbed flux
 accumulated per side), the class's light added to the bounce's at every side of another class, and the
 bounce added to the light field (diffusion_propagate.add); with DiffusionConfig.far_field (grids of
-diffusion_far_field.MIN_GRID_CELLS and more, without cone fields) the grid runs only its near steps, and
-the light still in
+diffusion_far_field.MIN_GRID_CELLS and more) the grid runs only its near steps, and the light still in
 flight is handed to a grid of twice the cell (its own voxelizer and cells) for the rest of the bounce,
 whose absorbed flux is shared back onto the fine sides (diffusion_far_field); the gather: diffusion_lookup -> `indirect`
 (Cycles' Diffuse Indirect). The light field does not depend on the camera: a camera move re-runs only
@@ -103,7 +102,7 @@ class DiffusionMethod(OneBounceMethod):
         self.voxels = self.voxelizer.run()
         diffusion_cells.run(be, self.voxels, self.cells, self.grid)
         config = self.diffusion_config
-        if config.far_field and not config.cone_fields and max(grid.dims) >= diffusion_far_field.MIN_GRID_CELLS:
+        if config.far_field and max(grid.dims) >= diffusion_far_field.MIN_GRID_CELLS:
             self._set_far_field()
 
     def _set_far_field(self) -> None:
@@ -159,7 +158,7 @@ class DiffusionMethod(OneBounceMethod):
                                                 cells, grid, first_step=i == 0, transfer=transfer, cone=cone)
                 if far is not None:
                     with self.step(timings, diffusion_far_field.DECL):
-                        self._propagate_far(self.snapshots[near % 2], steps - near, transfer)
+                        self._propagate_far(self.snapshots[near % 2], steps - near, transfer, cone)
                 if flux is not self.absorbed:
                     with self.step(timings, diffusion_propagate.DECL):
                         diffusion_propagate.add(be, self.absorbed, flux, grid, first=(k, cone) == propagations[0],
@@ -170,16 +169,16 @@ class DiffusionMethod(OneBounceMethod):
                                             cell_normal=cells["cell_normal"])
             previous = flux
 
-    def _propagate_far(self, in_flight: dict, fine_steps_left: int, transfer: str) -> None:
+    def _propagate_far(self, in_flight: dict, fine_steps_left: int, transfer: str, cone: int | None) -> None:
         """The light still in flight after the near steps, summed into the far grid, propagated there for
         as many steps as the bounce had left, and what its surfaces absorb added to the fine `absorbed`.
         A far step moves light two fine cells, but light scatters at every cell and wanders: in a closed
         white box half as many steps left 8 % of the light handed over in flight, as many 0.4 %."""
         be, f = self.backend, self.far
-        diffusion_far_field.hand_over(be, in_flight, self.grid, f.snapshots, f.cells, f.far)
+        diffusion_far_field.hand_over(be, in_flight, self.grid, f.snapshots, f.cells, f.far, cone)
         for i in range(max(1, fine_steps_left)):
             diffusion_propagate.run(be, f.snapshots[i % 2], f.snapshots[(i + 1) % 2], f.absorbed, f.cells,
-                                    f.far.grid, first_step=i == 0, transfer=transfer)
+                                    f.far.grid, first_step=i == 0, transfer=transfer, cone=cone)
         diffusion_far_field.add(be, f.absorbed, f.weights, f.far, self.absorbed, self.cells, self.grid)
 
     def gather_pixels(self, timings: dict[str, float]) -> None:

@@ -24,6 +24,7 @@ Twins: diffusion_reference.far_move_enclosed, step_by_face, far_weights, far_add
 
 from __future__ import annotations
 
+import functools
 from typing import NamedTuple
 
 import numpy as np
@@ -40,14 +41,18 @@ from .diffusion_propagate import ABSORBED, FACE_TEXELS
 # resolves a room (one 16-cell grid: window-room rel_rmse_8 1.160 against 0.366 at 32, docs/DIFFUSION.md).
 MIN_GRID_CELLS = 32
 
-MOVE = ShaderSpec(
-    name="diffusion_far_field_move",
-    compute="diffusion/far_field_move.comp.glsl",
-    local_size=(4, 4, 4),
-    samplers=(*(Sampler(f"src_{c}", "3D") for c in "rgb"), Sampler("cell_block", "3D")),
-    images=tuple(Image(f"sh_{c}", "3D", "RGBA32F", "write") for c in "rgb"),
-    uniforms=(Var("dims", "ivec3"),),
-)
+@functools.cache
+def move_spec(cone: int | None) -> ShaderSpec:
+    """The enclosed cells' move; a cone field's (`cone`) moves its light along the cone's axis."""
+    return ShaderSpec(
+        name="diffusion_far_field_move" + ("" if cone is None else f"_cone_field_{cone}"),
+        compute="diffusion/far_field_move.comp.glsl",
+        local_size=(4, 4, 4),
+        samplers=(*(Sampler(f"src_{c}", "3D") for c in "rgb"), Sampler("cell_block", "3D")),
+        images=tuple(Image(f"sh_{c}", "3D", "RGBA32F", "write") for c in "rgb"),
+        uniforms=(Var("dims", "ivec3"),),
+        defines=() if cone is None else (("CONE", str(cone)),),
+    )
 
 WEIGHTS = ShaderSpec(
     name="diffusion_far_field_weights",
@@ -113,12 +118,14 @@ def near_steps(configured: int, steps: int) -> int:
     return max(1, min(configured or steps // 2, steps))
 
 
-def hand_over(backend: Backend, snapshot: dict, fine: Grid, far_snapshots: list, far_cells: dict, far: FarGrid) -> None:
+def hand_over(backend: Backend, snapshot: dict, fine: Grid, far_snapshots: list, far_cells: dict, far: FarGrid,
+              cone: int | None = None) -> None:
     """far_snapshots[0] (sh_r/g/b) := the far grid's starting light: the fine `snapshot` (the light in
-    flight) summed per far cell (lpv_far_field.source, into far_snapshots[1]), the light of enclosed far
-    cells moved to their neighbours (far_field_move.comp.glsl)."""
+    flight; `cone`: that cone field's) summed per far cell (lpv_far_field.source, into far_snapshots[1]),
+    the light of enclosed far cells moved to their neighbours (far_field_move.comp.glsl)."""
     lpv_far_field.source(backend, snapshot, fine, far_snapshots[1], far.grid, far.shift)
-    backend.dispatch(backend.program(MOVE), group_count(far.grid.dims, MOVE.local_size),
+    move = move_spec(cone)
+    backend.dispatch(backend.program(move), group_count(far.grid.dims, move.local_size),
                      uniforms={"dims": far.grid.dims},
                      samplers={**{f"src_{c}": far_snapshots[1][f"sh_{c}"] for c in "rgb"},
                                "cell_block": far_cells["cell_block"]},
