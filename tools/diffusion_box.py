@@ -33,8 +33,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from addon.engine import cone_fields, sh  # noqa: E402
 from addon.engine import diffusion_reference as ref  # noqa: E402
-from addon.engine import sh  # noqa: E402
 
 
 def _cosine_directions(rng, count: int) -> np.ndarray:
@@ -374,6 +374,54 @@ def alternative_figures(n: int) -> None:
         row.append("  ".join(f"{4 * np.pi * r**2 * through[centre + r]:.2f}" for r in (4, 8)))
         row.append("{:14.3f}  {:5.3f}".format(*block_shares(n, block, transfer, coefficients)))
         print("  ".join(row))
+    print(cone_field_row(n))
+
+
+def cone_field_row(n: int) -> str:
+    """alternative_figures' measurements for the cone fields (cone_fields.py): every emitter's light split
+    into the six face cones' fields, each propagated apart (the method's DiffusionConfig.cone_fields)."""
+    k = cone_fields.constants()
+    up = np.array([0.0, 0.0, 1.0])
+    lone = np.ones((1, 1, 1, 6))
+    share = sum(float(cone_fields.face_fluxes(cone_fields.lobe_parts(up, b).reshape(1, 1, 1, 4), lone, b)[1]
+                      [0, 0, 0, 4]) for b in cone_fields.CONES)
+
+    def absorbed_of(lit: np.ndarray, cell: dict) -> np.ndarray:
+        total = np.zeros(lit.shape)
+        for b in cone_fields.CONES:
+            field = cone_fields.emit(lit, np.zeros_like(lit), cell["normal"], cell["occupied"], b)
+            for _ in range(2 * n):
+                field, plus, minus = cone_fields.step(field, cell, b)
+                total += plus + minus
+        return total
+
+    row = [f"{'cone fields':12s} {share:8.3f}"]
+    cell = ref.closed_box_cells(n)
+    for half, width in ((1, 11), (5, 13)):
+        lit = np.zeros((n, n, n))
+        lit[1, n // 2 - half:n // 2 + half, n // 2 - half:n // 2 + half] = 1.0
+        absorbed = absorbed_of(lit, cell)
+        row.append(f"{absorbed[n - 2, 2:-2, 2:-2].sum() / lit.sum():{width}.3f}  "
+                   f"{absorbed[1, 2:-2, 2:-2].sum() / lit.sum():{width - 2}.3f}")
+    size, centre = 21, 10
+    empty = ref.cells(np.zeros((size,) * 3, bool), np.zeros((size,) * 3 + (3,)), np.zeros((size,) * 3 + (3,)))
+    through = np.zeros(size)
+    for b in cone_fields.CONES:
+        field = np.zeros((size,) * 3 + (4,))
+        field[centre, centre, centre] = k["iso"][b]
+        for _ in range(24):
+            through += ref.inflow(cone_fields.face_fluxes(field, empty["open"], b)[1])[centre, centre, :, 0]
+            field, _ = cone_fields.step_by_face(field, empty, b)
+    row.append("  ".join(f"{4 * np.pi * r**2 * through[centre + r]:.2f}" for r in (4, 8)))
+    lo, hi, top = block = block_in_box(n)
+    cell = ref.closed_box_cells(n, block)
+    lit = np.zeros((n, n, n))
+    lit[1, 2:n - 2, 2:n - 2] = 1.0
+    lit[1, lo:hi + 1, lo:hi + 1] = 0.0
+    absorbed = absorbed_of(lit, cell)
+    row.append(f"{absorbed[n - 2, 2:-2, 2:-2].sum() / lit.sum():14.3f}  "
+               f"{absorbed[2:top + 1, lo:hi + 1, lo:hi + 1].sum() / lit.sum():5.3f}")
+    return "  ".join(row)
 
 
 def main() -> None:
