@@ -1,7 +1,7 @@
 """The Bake operator with the scene's settings, overlay off, for each method; save the file.
 -- OUT.blend RESULT.json   (run with the scene .blend opened)
 
-Each method bakes the Floor and BackWall into packed images at 32 x 32 texels (indirect light; `direct`
+Each method (and diffusion with its cone fields) bakes the Floor and BackWall into packed images at 32 x 32 texels (indirect light; `direct`
 bakes its direct light) and the Floor into vertex colours; the last method's images stay in the file."""
 
 import os
@@ -30,8 +30,13 @@ def run(result):
     settings.lpv.grid_cells, settings.vct.voxel_cells, settings.vct.diffuse_cones = 16, 16, 6
     bake = _common.bounce("addon.bridge.bake")
     methods = {}
-    for method in _common.bounce("addon.engine.registry").NAMES:
+    # Diffusion's cone fields first (their own shader programs, whose matrices come in as long
+    # #defines), so the last bake is the registry's last method's, whose images stay in the file.
+    runs = [("diffusion-cone-fields", "diffusion", True)]
+    runs += [(method, method, False) for method in _common.bounce("addon.engine.registry").NAMES]
+    for key, method, cone_fields in runs:
         settings.gi.method = method
+        settings.diffusion.cone_fields = cone_fields
         pass_name = "direct" if method == "direct" else "indirect"
         select(OBJECTS)
         status = bpy.ops.bounce.bake(size=32, pass_name=pass_name, target="image")
@@ -41,8 +46,8 @@ def run(result):
         attr = bpy.data.objects["Floor"].data.color_attributes[bake.attribute_name(pass_name)]
         colors = np.empty(len(attr.data) * 4, np.float32)
         attr.data.foreach_get("color", colors)
-        methods[method] = {"status": sorted(status), "images": images, "vertex_colors_status": sorted(vc_status),
-                           "vertex_colors_max": float(colors.reshape(-1, 4)[:, :3].max())}
+        methods[key] = {"status": sorted(status), "images": images, "vertex_colors_status": sorted(vc_status),
+                        "vertex_colors_max": float(colors.reshape(-1, 4)[:, :3].max())}
     result["methods"] = methods
     result["openimageio_imported"] = "OpenImageIO" in sys.modules
     bpy.ops.wm.save_as_mainfile(filepath=out)
