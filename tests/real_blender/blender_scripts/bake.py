@@ -1,8 +1,9 @@
 """The Bake operator with the scene's settings, overlay off, for each method; save the file.
 -- OUT.blend RESULT.json   (run with the scene .blend opened)
 
-Each method (and diffusion with its cone fields) bakes the Floor and BackWall into packed images at 32 x 32 texels (indirect light; `direct`
-bakes its direct light) and the Floor into vertex colours; the last method's images stay in the file."""
+Each method (and diffusion with its cone fields) bakes the Floor and BackWall into packed images at
+32 x 32 texels (indirect light; `direct` bakes its direct light) and the Floor into vertex colours; the
+last method's images stay in the file."""
 
 import os
 import sys
