@@ -115,11 +115,12 @@ METHODS: tuple[MethodSpec, ...] = (
         module="diffusion", class_name="DiffusionMethod", products=("direct", "indirect", "albedo"), max_bounces=8,
         reads=(*_IMAGE, "gi.bounces", *_LIGHT_VIEWS, "diffusion.*"),
         # Three grids at the defaults (directional transfer, two spans of steps per bounce, emitter classes),
-        # one propagation for all sides, and the paper's transfer at 32 cells with the default steps and with
-        # its own rule of one span (docs/DIFFUSION.md).
+        # one propagation for all sides, the paper's transfer at 32 cells with the default steps and with
+        # its own rule of one span, and the cone fields in place of the emitter classes (docs/DIFFUSION.md).
         bench=({"diffusion.grid_cells": 16}, {}, {"diffusion.grid_cells": 64},
                {"diffusion.emitter_class_passes": False}, {"diffusion.transfer": "cone"},
-               {"diffusion.transfer": "cone", "diffusion.span_multiple": 1.0})),
+               {"diffusion.transfer": "cone", "diffusion.span_multiple": 1.0},
+               {"diffusion.cone_fields": True, "diffusion.emitter_class_passes": False})),
     MethodSpec(
         name="gather", summary="distance-corrected final gather of the probes' cube maps as quad lights (paper 001)",
         module="gather", class_name="GatherMethod", products=("direct", "indirect", "albedo"), max_bounces=8,
