@@ -177,5 +177,5 @@ def test_surface_error_prints_each_surface_of_a_room(cornell, tmp_path):
 def test_diffusion_step_time_prints_each_method():
     out = tool("tools/diffusion_step_time.py", "--cells", "8", "--rounds", "2")
     lines = [line for line in out.splitlines() if "ms per step at 8^3" in line]
-    assert len(lines) == 3 and "renderer:" in out
+    assert len(lines) == 4 and "renderer:" in out  # cone, directional, a cone field's, lpv
     assert "(1.00x lpv)" in lines[-1] and "CPU ms" in lines[-1]  # lpv against itself, both clocks
