@@ -37,7 +37,16 @@ import functools
 import numpy as np
 
 from . import sh
-from .diffusion_reference import AXES, DIRECTIONS, EVERY_CLASS, emitter_class, inflow, side_weights
+from .diffusion_reference import (
+    AXES,
+    DIRECTIONS,
+    EVERY_CLASS,
+    emitter_class,
+    gather,
+    outflow,
+    shared_residual,
+    side_weights,
+)
 
 CONES = tuple(range(6))   # numbered as the faces: +x -x +y -y +z -z
 QUADRATURE = 64           # midpoints per cube-face side for the constants
@@ -135,10 +144,7 @@ def face_fluxes(field: np.ndarray, open_faces: np.ndarray, cone: int) -> tuple[n
     raw fluxes clamped at 0, kept on open faces and scaled to the field's flux."""
     k = constants()
     raw = field @ k["raw"][cone].T
-    total = np.maximum(field @ k["flux"][cone], 0.0)
-    clamped = np.maximum(raw, 0.0) * open_faces
-    s = clamped.sum(-1, keepdims=True)
-    return raw, np.where(s > 0.0, clamped * (total[..., None] / np.where(s > 0.0, s, 1.0)), 0.0)
+    return raw, outflow(raw, open_faces, np.maximum(field @ k["flux"][cone], 0.0))
 
 
 def step_by_face(field: np.ndarray, cell: dict, cone: int) -> tuple[np.ndarray, np.ndarray]:
@@ -146,18 +152,7 @@ def step_by_face(field: np.ndarray, cell: dict, cone: int) -> tuple[np.ndarray, 
     (the next field, the flux absorbed by the face it came through (z, y, x, 6), W)."""
     raw, out = face_fluxes(field, cell["open"], cone)
     moved = np.einsum("fij,...j->...fi", constants()["moved"][cone], field)  # (z, y, x, 6, 4)
-    carrying = out > 0.0
-    kept = np.where(carrying[..., None], moved, 0.0)
-    raw_kept = np.where(carrying, raw, 0.0)
-    kept_sum = raw_kept.sum(-1, keepdims=True)
-    share = raw_kept / np.where(kept_sum > 0.0, kept_sum, 1.0)
-    residual = field - kept.sum(-2)
-    carried = (kept + share[..., None] * residual[..., None, :]) / np.where(carrying, out, 1.0)[..., None]
-    a = inflow(out)
-    shape = inflow(np.ascontiguousarray(carried))
-    axis_of_face = np.array([axis for axis, _ in AXES])
-    absorbed = a * cell["block"][..., axis_of_face]
-    return np.einsum("...d,...dk->...k", a - absorbed, shape), absorbed
+    return gather(out, shared_residual(field, raw, moved, out), cell)
 
 
 def step(field: np.ndarray, cell: dict, cone: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

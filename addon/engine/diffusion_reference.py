@@ -237,13 +237,17 @@ def face_transport(field: np.ndarray, transfer: str | Callable) -> tuple[np.ndar
 
 def face_fluxes(field: np.ndarray, open_faces: np.ndarray, transfer: str = "cone") -> np.ndarray:
     """(z, y, x, 6) W leaving each cell through each face: the transfer's raw face flux (exact for the L1
-    intensity), clamped at 0 and kept only on open faces, then scaled so the faces carry the cell's whole
-    flux, max(0, 2 sqrt(pi) c0): the L1 lobe is negative behind itself, and a clamp alone would add
-    light; the scale moves it to the faces it can leave by."""
-    raw = np.maximum(face_transport(field, transfer)[0], 0.0) * open_faces
-    total = np.maximum(FLUX_PER_C0 * field[..., 0], 0.0)
-    s = raw.sum(axis=-1, keepdims=True)
-    return np.where(s > 0.0, raw * (total[..., None] / np.where(s > 0.0, s, 1.0)), 0.0)
+    intensity) through `outflow`, to the cell's flux max(0, 2 sqrt(pi) c0)."""
+    return outflow(face_transport(field, transfer)[0], open_faces, np.maximum(FLUX_PER_C0 * field[..., 0], 0.0))
+
+
+def outflow(raw: np.ndarray, open_faces: np.ndarray, total: np.ndarray) -> np.ndarray:
+    """(z, y, x, 6) W: the raw face fluxes clamped at 0 and kept only on open faces, then scaled so the
+    faces carry the cell's whole flux `total` (z, y, x): a field's lobe is negative behind itself, and a
+    clamp alone would add light; the scale moves it to the faces it can leave by."""
+    kept = np.maximum(raw, 0.0) * open_faces
+    s = kept.sum(axis=-1, keepdims=True)
+    return np.where(s > 0.0, kept * (total[..., None] / np.where(s > 0.0, s, 1.0)), 0.0)
 
 
 def carried_shapes(field: np.ndarray, open_faces: np.ndarray, out: np.ndarray, transfer: str) -> np.ndarray:
@@ -257,7 +261,13 @@ def carried_shapes(field: np.ndarray, open_faces: np.ndarray, out: np.ndarray, t
     raw, shape = face_transport(field, transfer)
     if transfer == "cone":
         return shape
-    moved = shape * raw[..., None]  # M_d L
+    return shared_residual(field, raw, shape * raw[..., None], out)
+
+
+def shared_residual(field: np.ndarray, raw: np.ndarray, moved: np.ndarray, out: np.ndarray) -> np.ndarray:
+    """(z, y, x, 6, K) per W of `out`: each carrying face's (out > 0) field `moved` (z, y, x, 6, K; the
+    part of `field` it takes, raw flux `raw`) plus its share by raw flux of the residual, `field` less the
+    carrying faces' parts: the faces together carry `field` itself."""
     carrying = out > 0.0
     kept = np.where(carrying[..., None], moved, 0.0)
     raw_kept = np.where(carrying, raw, 0.0)
@@ -308,12 +318,18 @@ def step_by_face(field: np.ndarray, cell: dict, transfer: str = "cone") -> tuple
     """One gather step (`step`): (next field, flux absorbed by the face it came through (z, y, x, 6), W),
     as the far field's grid keeps it (diffusion_far_field)."""
     out = face_fluxes(field, cell["open"], transfer)
+    return gather(out, carried_shapes(field, cell["open"], out, transfer), cell)
+
+
+def gather(out: np.ndarray, carried: np.ndarray, cell: dict) -> tuple[np.ndarray, np.ndarray]:
+    """(next field, flux absorbed by the face it came through (z, y, x, 6), W) from each cell's face
+    fluxes `out` (z, y, x, 6) and the field each arrives as per W (z, y, x, 6, K): a cell's surface absorbs
+    block[axis(d)] of the inflow through face d, the rest is carried on."""
     a = inflow(out)
-    shape = inflow(np.ascontiguousarray(carried_shapes(field, cell["open"], out, transfer)))
+    shape = inflow(np.ascontiguousarray(carried))
     axis_of_face = np.array([axis for axis, _ in AXES])
     absorbed = a * cell["block"][..., axis_of_face]
-    nxt = np.einsum("...d,...dk->...k", a - absorbed, shape)
-    return nxt, absorbed
+    return np.einsum("...d,...dk->...k", a - absorbed, shape), absorbed
 
 
 def propagate(field: np.ndarray, cell: dict, steps: int,

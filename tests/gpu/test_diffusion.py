@@ -102,14 +102,16 @@ def sh_volumes(gl, grid, data=None):
     return {f"sh_{c}": gl.texture(grid.dims, "RGBA32F", x) for c, x in zip("rgb", d, strict=True)}
 
 
-@pytest.mark.parametrize("transfer", ref.TRANSFERS)
-def test_propagation_steps_are_the_twins(gl, transfer):
+@pytest.mark.parametrize("transfer, cone", [(t, None) for t in ref.TRANSFERS] + [("directional", b) for b in (0, 3, 4)])
+def test_propagation_steps_are_the_twins(gl, transfer, cone):
     # Two steps through random cells: the next fields, and the absorbed flux written by the first step
-    # and added by the second (stale contents in the accumulation are overwritten by the first).
+    # and added by the second (stale contents in the accumulation are overwritten by the first). With a
+    # cone, that cone field's (cone_fields.step): its matrices compiled into the step, the clamp, the
+    # open faces and the residual as directional's.
     rng = np.random.default_rng(2)
     voxels = random_voxels(rng, GRID)
     _, cells = gpu_cells(gl, voxels)
-    fields = random_fields(rng, GRID)
+    fields = random_fields(rng, GRID) if cone is None else random_cone_fields(rng, GRID, cone)
     sets = [sh_volumes(gl, GRID, fields), sh_volumes(gl, GRID)]
     stale = np.full(zyx(GRID), 5.0, np.float32)
     absorbed = {k: gl.texture(GRID.dims, "RGBA32F", stale) for k in ("flux_plus", "flux_minus")}
@@ -118,9 +120,10 @@ def test_propagation_steps_are_the_twins(gl, transfer):
     plus, minus = np.zeros((3, *zyx(GRID, 0)[:3])), np.zeros((3, *zyx(GRID, 0)[:3]))
     for i in range(2):
         diffusion_propagate.run(gl, sets[i % 2], sets[(i + 1) % 2], absorbed, cells, GRID, first_step=i == 0,
-                                transfer=transfer)
+                                transfer=transfer, cone=cone)
         for ch in range(3):
-            want[ch], p, m = ref.step(want[ch], cell, transfer)
+            want[ch], p, m = ref.step(want[ch], cell, transfer) if cone is None else \
+                cone_fields.step(want[ch], cell, cone)
             plus[ch] += p
             minus[ch] += m
         got = [gl.read(sets[(i + 1) % 2][f"sh_{c}"]) for c in "rgb"]
@@ -143,11 +146,18 @@ def atlas_of(gl, atlas, grid, volume):
     return gl.texture(atlas.size, "RGBA32F", a)
 
 
-@pytest.mark.parametrize("emitter_class", [ref.EVERY_CLASS, 0, 5])
-def test_emitters_are_the_twins(gl, emitter_class):
+@pytest.mark.parametrize("emitter_class, cone", [(ref.EVERY_CLASS, None), (0, None), (5, None),
+                                                  (ref.EVERY_CLASS, 0), (ref.EVERY_CLASS, 5), (4, 2)])
+def test_emitters_are_the_twins(gl, emitter_class, cone):
     # From the injection atlas (no albedo: the VPLs' flux is reflected light already) and from absorbed
     # flux volumes times the voxels' albedo; empty cells emit isotropically; every cell is written. One
     # emitter class's emitters: the sides of that class alone, and 1/5 of an empty cell's light.
+    # A cone field's (cone_fields.emit): each lobe's part in the cone by the same 8 x 8 points per cube
+    # face, an empty cell's light times the cone's isotropic part. That part is gram^-1 times the lobe's
+    # projection, and a cone's Gram matrix has condition number 319 (the L1 basis is nearly dependent
+    # over a sixth of the sphere): fp32's rounding of the projection (1e-7 relative) grows to 3e-5 at
+    # most, so 1e-4 there.
+    tolerance = RTOL if cone is None else 1e-4
     rng = np.random.default_rng(3)
     voxels = random_voxels(rng, GRID)
     textures, cells = gpu_cells(gl, voxels)
@@ -160,14 +170,16 @@ def test_emitters_are_the_twins(gl, emitter_class):
     for source, albedo in ((tiles, None), (volumes, voxels["vox_albedo"])):
         out = sh_volumes(gl, GRID, [np.full(zyx(GRID), 9.0, np.float32)] * 3)
         if albedo is None:
-            diffusion_inject.emit(gl, source, cells, out, GRID, atlas=atlas, emitter_class=emitter_class)
+            diffusion_inject.emit(gl, source, cells, out, GRID, atlas=atlas, emitter_class=emitter_class, cone=cone)
         else:
             diffusion_inject.emit(gl, source, cells, out, GRID, vox_albedo=textures["vox_albedo"],
-                                  emitter_class=emitter_class)
+                                  emitter_class=emitter_class, cone=cone)
         for ch, c in enumerate("rgb"):
             a = 1.0 if albedo is None else albedo[..., ch]
-            want = ref.emit(fp[..., ch], fm[..., ch], cell["normal"], cell["occupied"], a, emitter_class)
-            np.testing.assert_allclose(gl.read(out[f"sh_{c}"]), want, rtol=0, atol=RTOL * np.abs(want).max())
+            args = (fp[..., ch], fm[..., ch], cell["normal"], cell["occupied"])
+            want = (ref.emit(*args, a, emitter_class) if cone is None
+                    else cone_fields.emit(*args, cone, a, emitter_class))
+            np.testing.assert_allclose(gl.read(out[f"sh_{c}"]), want, rtol=0, atol=tolerance * np.abs(want).max())
 
 
 def test_injection_is_the_twins(gl):
@@ -401,62 +413,3 @@ def random_cone_fields(rng, grid, cone, emitters=10):
         occupied = rng.random(fp.shape) < 0.7
         out.append(cone_fields.emit(fp, fm, normal, occupied, cone).astype(np.float32))
     return out
-
-
-@pytest.mark.parametrize("cone", [0, 3, 4])
-def test_cone_field_steps_are_the_twins(gl, cone):
-    # As test_propagation_steps_are_the_twins, for one cone field (cone_fields.step): its matrices are
-    # compiled into the step, the clamp, the open faces and the residual as directional's.
-    rng = np.random.default_rng(5 + cone)
-    voxels = random_voxels(rng, GRID)
-    _, cells = gpu_cells(gl, voxels)
-    fields = random_cone_fields(rng, GRID, cone)
-    sets = [sh_volumes(gl, GRID, fields), sh_volumes(gl, GRID)]
-    absorbed = diffusion_propagate.sides(gl, GRID)
-    cell = ref_cells(voxels)
-    want = [np.asarray(f, np.float64) for f in fields]
-    plus, minus = np.zeros((3, *zyx(GRID, 0)[:3])), np.zeros((3, *zyx(GRID, 0)[:3]))
-    for i in range(2):
-        diffusion_propagate.run(gl, sets[i % 2], sets[(i + 1) % 2], absorbed, cells, GRID, first_step=i == 0,
-                                cone=cone)
-        for ch in range(3):
-            want[ch], p, m = cone_fields.step(want[ch], cell, cone)
-            plus[ch] += p
-            minus[ch] += m
-        for ch, c in enumerate("rgb"):
-            got = gl.read(sets[(i + 1) % 2][f"sh_{c}"])
-            np.testing.assert_allclose(got, want[ch], rtol=0, atol=RTOL * np.abs(want[ch]).max())
-    assert plus.sum() > 0 and minus.sum() > 0
-    for ch in range(3):
-        np.testing.assert_allclose(gl.read(absorbed["flux_plus"])[..., ch], plus[ch], rtol=0, atol=RTOL * plus.max())
-        np.testing.assert_allclose(gl.read(absorbed["flux_minus"])[..., ch], minus[ch], rtol=0,
-                                   atol=RTOL * minus.max())
-
-
-@pytest.mark.parametrize("cone, emitter_class", [(0, ref.EVERY_CLASS), (5, ref.EVERY_CLASS), (2, 4)])
-def test_cone_field_emitters_are_the_twins(gl, cone, emitter_class):
-    # Each lobe's part in the cone by the same 8 x 8 points per cube face as cone_fields.lobe_parts, an
-    # empty cell's light times the cone's isotropic part, from the atlas and from albedo volumes. The
-    # part is gram^-1 times the lobe's projection, and a cone's Gram matrix has condition number 319
-    # (the L1 basis is nearly dependent over a sixth of the sphere): fp32's rounding of the projection
-    # (1e-7 relative) grows to 3e-5 at most, so 1e-4 here.
-    rng = np.random.default_rng(6)
-    voxels = random_voxels(rng, GRID)
-    textures, cells = gpu_cells(gl, voxels)
-    cell = ref_cells(voxels)
-    fp, fm = (rng.uniform(0.0, 2.0, zyx(GRID)).astype(np.float32) for _ in range(2))
-    atlas, _, _ = diffusion_inject.atlas_target(gl, GRID)
-    tiles = {"flux_plus": atlas_of(gl, atlas, GRID, fp), "flux_minus": atlas_of(gl, atlas, GRID, fm)}
-    volumes = {"flux_plus": gl.texture(GRID.dims, "RGBA32F", fp), "flux_minus": gl.texture(GRID.dims, "RGBA32F", fm)}
-    for source, albedo in ((tiles, None), (volumes, voxels["vox_albedo"])):
-        out = sh_volumes(gl, GRID, [np.full(zyx(GRID), 9.0, np.float32)] * 3)
-        if albedo is None:
-            diffusion_inject.emit(gl, source, cells, out, GRID, atlas=atlas, emitter_class=emitter_class, cone=cone)
-        else:
-            diffusion_inject.emit(gl, source, cells, out, GRID, vox_albedo=textures["vox_albedo"],
-                                  emitter_class=emitter_class, cone=cone)
-        for ch, c in enumerate("rgb"):
-            a = 1.0 if albedo is None else albedo[..., ch]
-            want = cone_fields.emit(fp[..., ch], fm[..., ch], cell["normal"], cell["occupied"], cone, a,
-                                    emitter_class)
-            np.testing.assert_allclose(gl.read(out[f"sh_{c}"]), want, rtol=0, atol=1e-4 * np.abs(want).max())
