@@ -11,7 +11,8 @@
 // CONES (cone_fields.py): the field is one face cone's (light heading through that cube face), four
 // coefficients of the L1 basis restricted to the cone; its face fluxes are cone_raw[f] . c, its flux
 // cone_flux . c, and face f carries cone_moved[f] c (the cone's constants, compiled in): the
-// directional partition, with the light kept in its cone.
+// partition of its directions over the faces (cone_fields.PARTITION_EXPONENT), the light kept in its
+// cone.
 #ifdef CONES
 const mat4 cone_moved[6] = CONE_MOVED;
 const vec4 cone_raw[6] = CONE_RAW;

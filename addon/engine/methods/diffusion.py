@@ -5,16 +5,15 @@ shared voxelizer (voxelize) and diffusion_cells (each cell's plane, absorption a
 face diffusion_inject (its VPLs' flux onto the sides of their cells' planes); once per update, for each
 bounce, emitter class (six with DiffusionConfig.emitter_class_passes, else one) and cone field (six with
 DiffusionConfig.cone_fields, cone_fields.py: the light heading through each cube face apart, else one
-field of all directions): diffusion_emit (the
-sides' flux as Lambertian L1 SH lobes about their normals: the injected direct light, then each bounce's
-absorbed flux times albedo), steps x diffusion_propagate (gather form, ping-pong, absorbed flux
-accumulated per side), the class's light added to the bounce's at every side of another class, and the
-bounce added to the light field (diffusion_propagate.add); with DiffusionConfig.far_field (grids of
-diffusion_far_field.MIN_GRID_CELLS and more) the grid runs only its near steps, and the light still in
-flight is handed to a grid of twice the cell (its own voxelizer and cells) for the rest of the bounce,
-whose absorbed flux is shared back onto the fine sides (diffusion_far_field); the gather: diffusion_lookup -> `indirect`
-(Cycles' Diffuse Indirect). The light field does not depend on the camera: a camera move re-runs only
-the lookup.
+field of all directions): diffusion_emit (the sides' flux as Lambertian L1 SH lobes about their normals:
+the injected direct light, then each bounce's absorbed flux times albedo), steps x diffusion_propagate
+(gather form, ping-pong, absorbed flux accumulated per side), the class's light added to the bounce's at
+every side of another class, and the bounce added to the light field (diffusion_propagate.add); with
+DiffusionConfig.far_field (grids of diffusion_far_field.MIN_GRID_CELLS and more) the grid runs only its
+near steps, and the light still in flight is handed to a grid of twice the cell (its own voxelizer and
+cells) for the rest of the bounce, whose absorbed flux is shared back onto the fine sides
+(diffusion_far_field); the gather: diffusion_lookup -> `indirect` (Cycles' Diffuse Indirect). The light
+field does not depend on the camera: a camera move re-runs only the lookup.
 docs/DIFFUSION.md derives the transport and measures it; diffusion_reference.py is its numpy twin.
 
 Products: direct, indirect, albedo.
@@ -101,8 +100,7 @@ class DiffusionMethod(OneBounceMethod):
             self.far = None
         self.voxels = self.voxelizer.run()
         diffusion_cells.run(be, self.voxels, self.cells, self.grid)
-        config = self.diffusion_config
-        if config.far_field and max(grid.dims) >= diffusion_far_field.MIN_GRID_CELLS:
+        if self.diffusion_config.far_field and max(grid.dims) >= diffusion_far_field.MIN_GRID_CELLS:
             self._set_far_field()
 
     def _set_far_field(self) -> None:
