@@ -302,19 +302,21 @@ class DiffusionConfig(_Validated):
     max_steps: int = _num(512, 1, 8192, "cap on the steps of all bounces together")
     # On: each bounce is propagated once per emitter class (the sides whose normals share a dominant
     # signed axis) and a side takes in what every class but its own brought it, as lpv's emitter classes:
-    # a plane cannot light itself, but the transport carried light leaving a plane back onto it (a lit
-    # floor lit itself again; docs/DIFFUSION.md, "Emitter classes"). At 32 cells, 128 px, rel_rmse_8
-    # against Cycles, off -> on: window-room 1.155 -> 0.369 (two bounces 0.619 -> 0.169), thin-wall
-    # 0.232 -> 0.129, window-sky 0.550 -> 0.403, cornell 0.433 -> 0.410; emissive 0.328 -> 0.348 and
-    # cornell-area 0.262 -> 0.279 worse. Six propagations: a lights update 3-5x slower on llvmpipe.
-    emitter_class_passes: bool = field(default=True, metadata={
+    # a plane cannot light itself, but the single field carried light leaving a plane back onto it (a lit
+    # floor lit itself again; docs/DIFFUSION.md, "Emitter classes"). With the single field (cone_fields
+    # off), at 32 cells, 128 px, rel_rmse_8 against Cycles, off -> on: window-room 1.155 -> 0.369 (two
+    # bounces 0.619 -> 0.169), thin-wall 0.232 -> 0.129, cornell 0.433 -> 0.410. Off by default: the cone
+    # fields keep most of that self-lighting out at the same six propagations, and both on take 36.
+    emitter_class_passes: bool = field(default=False, metadata={
         "doc": "a side takes in no light from sides facing its way (six propagations per bounce)"})
     # On: the light heading through each cube face (the directions whose dominant signed axis is the
     # face's) is a field of its own, propagated apart (six propagations per bounce, times six with the
     # emitter classes) and never mixed with the others' in open space, so light rising past a wall is
     # not turned into it (cone_fields.py; docs/DIFFUSION.md, "Cone fields"). The transfer is then the
-    # directional partition within each cone (`transfer` unused).
-    cone_fields: bool = field(default=False, metadata={
+    # directional partition within each cone (`transfer` unused). At 32 cells, 128 px, against the single
+    # field with the emitter classes: rel_rmse_8 lower on 13 of the 15 benchmark scenes at one and at two
+    # bounces (cornell 0.422 -> 0.213); a sunlit room's one bounce worse (window-room 0.373 -> 0.505).
+    cone_fields: bool = field(default=True, metadata={
         "doc": "propagate the light heading through each cube face as its own field (six per bounce)"})
     # On: the grid runs only its first near_steps and hands the light still in flight to a grid of twice
     # the cell (its own voxels and cells, aligned to the fine voxels) for the rest of the bounce

@@ -114,13 +114,16 @@ METHODS: tuple[MethodSpec, ...] = (
         name="diffusion", summary="occupancy-aware SH diffusion through the voxels, re-emitted at surfaces (paper 000)",
         module="diffusion", class_name="DiffusionMethod", products=("direct", "indirect", "albedo"), max_bounces=8,
         reads=(*_IMAGE, "gi.bounces", *_LIGHT_VIEWS, "diffusion.*"),
-        # Three grids at the defaults (directional transfer, two spans of steps per bounce, emitter classes),
-        # one propagation for all sides, the paper's transfer at 32 cells with the default steps and with
-        # its own rule of one span, and the cone fields in place of the emitter classes (docs/DIFFUSION.md).
+        # Three grids at the defaults (cone fields, two spans of steps per bounce), the single field with
+        # the emitter classes (six propagations, as many as the cone fields) and without (one), and the
+        # paper's transfer at 32 cells with the emitter classes, with the default steps and with its own
+        # rule of one span (docs/DIFFUSION.md).
         bench=({"diffusion.grid_cells": 16}, {}, {"diffusion.grid_cells": 64},
-               {"diffusion.emitter_class_passes": False}, {"diffusion.transfer": "cone"},
-               {"diffusion.transfer": "cone", "diffusion.span_multiple": 1.0},
-               {"diffusion.cone_fields": True, "diffusion.emitter_class_passes": False})),
+               {"diffusion.cone_fields": False, "diffusion.emitter_class_passes": True},
+               {"diffusion.cone_fields": False},
+               {"diffusion.cone_fields": False, "diffusion.emitter_class_passes": True, "diffusion.transfer": "cone"},
+               {"diffusion.cone_fields": False, "diffusion.emitter_class_passes": True, "diffusion.transfer": "cone",
+                "diffusion.span_multiple": 1.0})),
     MethodSpec(
         name="gather", summary="distance-corrected final gather of the probes' cube maps as quad lights (paper 001)",
         module="gather", class_name="GatherMethod", products=("direct", "indirect", "albedo"), max_bounces=8,
