@@ -36,7 +36,8 @@ from diffusion_dark_pixels import diffusion_at_reference, parse_args  # noqa: E4
 
 from addon.engine.diffusion_reference import DIRECTIONS, lookup_corners  # noqa: E402
 
-ONE_PROPAGATION = ["diffusion.emitter_class_passes=false", "diffusion.far_field=false"]
+ONE_PROPAGATION = ["diffusion.cone_fields=false",
+                   "diffusion.emitter_class_passes=false", "diffusion.far_field=false"]
 
 
 def face_lookup(points_m: np.ndarray, normals: np.ndarray, origin_m, cell_m: float, block: np.ndarray,

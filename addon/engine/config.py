@@ -286,12 +286,13 @@ class DiffusionConfig(_Validated):
     """Volume diffusion (method `diffusion`, paper 000): docs/DIFFUSION.md derives the transport."""
 
     grid_cells: int = _num(32, 8, 256, "diffusion cells along the scene's longest side")
-    # cone: the paper's transfer, each face's flux arriving as the uniform cone of that face (normalised by
-    # 3 / (2 pi)); light forgets its direction at every cell and diffuses (cornell rel_rmse_8 1.06).
-    # directional: LPV's improved transfer (docs/LPV.md), light keeps its direction (0.57; docs/DIFFUSION.md,
-    # "Transfers").
-    transfer: str = _choice("directional", ("directional", "cone"), "face transfer: directional (LPV's improved: "
-                            "light keeps its direction) or cone (the paper's, normalised)")
+    # The single field's (cone_fields off). cone: the paper's transfer, each face's flux arriving as the
+    # uniform cone of that face (normalised by 3 / (2 pi)); light forgets its direction at every cell and
+    # diffuses (cornell rel_rmse_8 1.06). directional: LPV's improved transfer (docs/LPV.md), light keeps
+    # its direction (0.57; docs/DIFFUSION.md, "Transfers").
+    transfer: str = _choice("directional", ("directional", "cone"), "the single field's face transfer (cone fields "
+                            "off): directional (LPV's improved: light keeps its direction) or cone (the paper's, "
+                            "normalised)")
     # Light moves at most one cell per step, and this transport scatters it sideways at every cell, so
     # a bounce that crosses a room of Y cells needs several times Y steps to settle (docs/DIFFUSION.md,
     # "Steps"): what is still in flight after the last step is lost.

@@ -16,9 +16,9 @@ from addon.engine.transforms import look_along, perspective
 
 # Every shipped method; a later method joins the suite by joining config.METHODS.
 # Every method, rsm with its voxel visibility, lpv with emitter classes (LpvConfig.emitter_classes),
-# lpv's octree variant (LpvConfig.variant = "octree") and diffusion's cone fields in place of its
-# emitter classes (DiffusionConfig.cone_fields).
-ALL_METHODS = (*METHODS, "rsm+voxel", "lpv+classes", "lpv+octree", "diffusion+cones")
+# lpv's octree variant (LpvConfig.variant = "octree") and diffusion's single field with emitter classes
+# in place of its cone fields (DiffusionConfig.emitter_class_passes, cone_fields).
+ALL_METHODS = (*METHODS, "rsm+voxel", "lpv+classes", "lpv+octree", "diffusion+classes")
 
 # rsm without visibility lets one bounce through walls: a known property of the method (its
 # `--visibility voxel` option is the fix), marked here once so every leak test says so the same way.
@@ -103,18 +103,19 @@ def sun(direction, strength, color=(1, 1, 1)):
 def make(gl, name, rsm_res=128, vpl=64):
     """A method by name; "rsm+voxel" is the rsm method with voxel-traced visibility, "lpv+classes" lpv
     with emitter classes, "lpv+octree" lpv's octree variant, "vct+filtered" vct with filtered injection,
-    "diffusion+cellsN" diffusion on a grid of N cells, "diffusion+cones" diffusion's cone fields."""
+    "diffusion+cellsN" diffusion on a grid of N cells, "diffusion+classes" diffusion's single field with
+    emitter classes."""
     method, _, variant = name.partition("+")
     kw = {"resolution": rsm_res, "vpl_samples": vpl}
+    if variant == "classes" and method == "diffusion":
+        return methods.create(gl, {"gi": GIConfig(method=method), "rsm": RsmConfig(**kw),
+                                   "diffusion": DiffusionConfig(cone_fields=False, emitter_class_passes=True)})
     if variant == "classes":
         return methods.create(gl, {"gi": GIConfig(method=method), "rsm": RsmConfig(**kw),
                                    "lpv": LpvConfig(emitter_classes=True)})
     if variant == "octree":
         return methods.create(gl, {"gi": GIConfig(method=method), "rsm": RsmConfig(**kw),
                                    "lpv": LpvConfig(variant="octree")})
-    if variant == "cones":
-        return methods.create(gl, {"gi": GIConfig(method=method), "rsm": RsmConfig(**kw),
-                                   "diffusion": DiffusionConfig(cone_fields=True, emitter_class_passes=False)})
     if variant.startswith("cells"):
         return methods.create(gl, {"gi": GIConfig(method=method), "rsm": RsmConfig(**kw),
                                    "diffusion": DiffusionConfig(grid_cells=int(variant[len("cells"):]))})

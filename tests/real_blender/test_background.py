@@ -45,7 +45,7 @@ def test_bake_with_defaults_and_overlay_off(baked):
     assert result["openimageio_imported"] is False
 
 
-@pytest.mark.parametrize("method", [*METHODS, "diffusion-cone-fields"])
+@pytest.mark.parametrize("method", [*METHODS, "diffusion-single-field"])
 def test_every_method_bakes_light(baked, method):
     entry = baked[0]["methods"][method]
     assert entry["status"] == ["FINISHED"] and entry["vertex_colors_status"] == ["FINISHED"]

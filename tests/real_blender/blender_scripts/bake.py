@@ -31,13 +31,15 @@ def run(result):
     settings.lpv.grid_cells, settings.vct.voxel_cells, settings.vct.diffuse_cones = 16, 16, 6
     bake = _common.bounce("addon.bridge.bake")
     methods = {}
-    # Diffusion's cone fields first (their own shader programs, whose matrices come in as long
-    # #defines), so the last bake is the registry's last method's, whose images stay in the file.
-    runs = [("diffusion-cone-fields", "diffusion", True)]
-    runs += [(method, method, False) for method in _common.bounce("addon.engine.registry").NAMES]
+    # Diffusion's single field with emitter classes first (the transfer's and the classes' programs in
+    # place of the default cone fields'), so the last bake is the registry's last method's, whose images
+    # stay in the file.
+    runs = [("diffusion-single-field", "diffusion", False)]
+    runs += [(method, method, True) for method in _common.bounce("addon.engine.registry").NAMES]
     for key, method, cone_fields in runs:
         settings.gi.method = method
         settings.diffusion.cone_fields = cone_fields
+        settings.diffusion.emitter_class_passes = not cone_fields
         pass_name = "direct" if method == "direct" else "indirect"
         select(OBJECTS)
         status = bpy.ops.bounce.bake(size=32, pass_name=pass_name, target="image")
