@@ -43,7 +43,9 @@ def test_diffusion_on_cornell(tmp_path):
             method.set_scene(scene)
             errors[name, cells] = metrics.compare(method.run().images["indirect"], ref, ref[..., 3] > 0.5)
             print(f"diffusion {name} {cells} cells vs Cycles: {errors[name, cells]}")
-    # Measured (llvmpipe, 64 px): MEASURED
+    # Measured (llvmpipe, 64 px), rel_rmse_8 / bias at 16 and 32 cells: cone fields (the defaults) 0.159 /
+    # 0.969 and 0.186 / 0.923; the single field, directional 0.292 / 0.922 and 0.388 / 0.871; the paper's
+    # transfer 0.555 / 0.735 and 0.735 / 0.549. The default is held to the target itself.
     default = errors["cones", 32]
     assert default["rel_rmse_8"] <= 0.30
     assert 0.85 <= default["bias"] <= 1.15
