@@ -72,6 +72,34 @@ def _spp(results: dict) -> str:
             f"{results['ref_noise']:g})")
 
 
+def _older_defaults(method: str, config: dict) -> list[str]:
+    """The fields of `method`'s own settings group (config.GROUPS) whose value in a run's recorded
+    `config` ({group: {field: value}}) is not today's default, or which the run predates: a table that
+    says "at its defaults" names them, so a run older than a change of defaults cannot pass for a new one."""
+    from dataclasses import asdict
+
+    sys.path.insert(0, str(ROOT))
+    from addon.engine.config import GROUPS
+
+    if method not in GROUPS:
+        return []
+    recorded = config.get(method, {})
+    return [name for name, value in asdict(GROUPS[method]()).items() if name not in recorded or recorded[name] != value]
+
+
+def _older_line(configs: dict[str, dict]) -> list[str]:
+    """["", a sentence naming, per method, the fields _older_defaults finds in its recorded config
+    ({method: config}) and their values then ("not yet built" where the run predates the field)], or []."""
+    older = {m: _older_defaults(m, c) for m, c in configs.items()}
+    if not any(older.values()):
+        return []
+    def then(m, f):
+        return json.dumps(configs[m][m][f]) if f in configs[m].get(m, {}) else "not yet built"
+    return ["", "Runs older than today's defaults: " + "; ".join(
+        f"{m} (its settings then: " + ", ".join(f"`{f}` {then(m, f)}" for f in fields) + ")"
+        for m, fields in older.items() if fields) + "."]
+
+
 def _default_records(results: dict) -> list[dict]:
     """Each method's record at its default settings, in the run's order."""
     return [r for r in results["records"] if r["default"]]
@@ -115,6 +143,7 @@ def update_costs_block(results: dict) -> str:
         ratios = ", ".join(f"{100 * ms / lpv_ms:.0f} % on {scene}" for scene, ms, lpv_ms in pairs)
         met = all(ms <= lpv_ms for _, ms, lpv_ms in pairs)
         lines += ["", f"probes' light update costs {ratios} of lpv's (target <= 100 %: {'met' if met else 'not met'})."]
+    lines += _older_line({r["method"]: r["config"] for r in records if "config" in r})
     return "\n".join(lines) + "\n"
 
 
@@ -150,6 +179,7 @@ def accuracy_block(results: dict) -> str:
             cell = f"{r['rel_rmse_8']:.3f} / {r['bias']:.3f}"
             cells.append(cell + f" / {_speedup(r['speedup_oidn'])}" if oidn else cell)
         lines.append(f"| {scene} | " + " | ".join(cells) + " |")
+    lines += _older_line({r["method"]: r["config"] for r in records if "config" in r})
     return "\n".join(lines) + "\n"
 
 
@@ -189,6 +219,7 @@ def methods_block(results: dict) -> str:
 
         lines.append(f"| {method} | {f(err, '{:.3f}')} | {f(noise, '{:.3f}')} | {f(ms, '{:.0f}')} | "
                      f"{f(raw, '{:.2g}x')} | {f(oidn, '{:.2g}x')} |")
+    lines += _older_line({r["method"]: r["config"] for r in records if "config" in r})
     return "\n".join(lines) + "\n"
 
 
@@ -237,6 +268,7 @@ def headline_block(results: dict) -> str:
         lines.append(f"| {scene} | {best['method']} | {best['rel_rmse_8']:.3f} | {_seconds(best['total_ms'] / 1e3)} "
                      f"| {_cycles_time(best['speedup'])} | {_cycles_time(best.get('speedup_oidn'))} | {ev_cell} | "
                      f"{ratio} | {fast_cell} |")
+    lines += _older_line({r["method"]: r["config"] for r in records if "config" in r})
     return "\n".join(lines) + "\n"
 
 
@@ -320,8 +352,9 @@ GRID_COLUMNS = (
 def diffusion_block(*runs: dict) -> str:
     """Table: per scene and bounce count (one results.json per bounce count), lpv and diffusion at
     16, 32 and 64 cells: rel_rmse_8 and the benchmark's ms; then, per grid and bounce count, on how
-    many scenes diffusion's error is at most lpv's, and its time against lpv's (median ratio); and the
-    paper's cone transfer's error against the default directional one's."""
+    many scenes diffusion's error is at most lpv's, and its time against lpv's (median ratio); the default
+    cone fields' error against the single field's, and the paper's cone transfer's against the directional
+    one's."""
     lines = ["**diffusion beside lpv, grids of 16, 32 and 64 cells.**", ""]
     lines += [_produced_by(run) + f" {run['res']} px long side, {run['bounces']} bounce(s), Cycles reference "
               f"{_spp(run)}." for run in runs]
@@ -355,14 +388,18 @@ def diffusion_block(*runs: dict) -> str:
             parts.append(f"at {cells} cells on {len(wins)} of {len(pairs)} scenes"
                          + (f" ({', '.join(wins)})" if wins else "") + f", in {ratio:.2f}x lpv's time")
         lines.append(f"- {run['bounces']} bounce(s): diffusion's error is at most lpv's " + "; ".join(parts) + ".")
-        cone = [(pick(records, s, "diffusion", {"diffusion.transfer": "cone"}), pick(records, s, "diffusion", None))
-                for s in scenes]
-        ratios = [c["rel_rmse_8"] / d["rel_rmse_8"] for c, d in cone if c and d and c["rel_rmse_8"] is not None
-                  and d["rel_rmse_8"]]
-        if ratios:
-            lines.append(f"- {run['bounces']} bounce(s): the paper's cone transfer (32 cells) has a median "
-                         f"{_median(ratios):.2f}x the directional transfer's error, below it on "
-                         f"{sum(r < 1 for r in ratios)} of {len(ratios)} scenes.")
+        single = {"diffusion.cone_fields": False, "diffusion.emitter_class_passes": True}
+        for ours, theirs, what in ((None, single, "the cone fields (32 cells, the defaults) have a median {:.2f}x "
+                                                  "the single field's (with its emitter classes) error"),
+                                   ({**single, "diffusion.transfer": "cone"}, single,
+                                    "the paper's cone transfer (32 cells, the single field) has a median {:.2f}x the "
+                                    "directional transfer's error")):
+            pairs = [(pick(records, s, "diffusion", ours), pick(records, s, "diffusion", theirs)) for s in scenes]
+            ratios = [a["rel_rmse_8"] / b["rel_rmse_8"] for a, b in pairs
+                      if a and b and a["rel_rmse_8"] is not None and b["rel_rmse_8"]]
+            if ratios:
+                lines.append(f"- {run['bounces']} bounce(s): " + what.format(_median(ratios))
+                             + f", below it on {sum(r < 1 for r in ratios)} of {len(ratios)} scenes.")
     return "\n".join(lines) + "\n"
 
 
@@ -414,6 +451,7 @@ def gpu_block(*runs: dict) -> str:
             u = configs.get((scene, method), {}).get("update_ms")
             cells.append("–" if u is None else f"{u['lights']:.1f} / {u['camera']:.1f}")
         lines.append(f"| {method} | " + " | ".join(cells) + " |")
+    lines += _older_line({m: next(r["config"] for (_, label), r in configs.items() if label == m) for m in methods})
     shares = [(s, configs[(s, "vct")]) for s in GPU_SCENES if (s, "vct") in configs]
     if shares:
         lines += ["", "vct's denoise filter (GPU time) costs " + ", ".join(

@@ -192,3 +192,19 @@ def test_choice_block():
     assert "| 0.1 | 12 | 9 | 12 | 11 | 15 | 9.4 | 1.0-84 s |" in text
     assert "| 0.2 | 12 | 9 | 12 | 11 | 15 | 9.4 | – |" in text
     assert "100%, 96% with the check of each budget; the model's own prediction 59%." in text
+
+
+def test_a_run_older_than_a_methods_defaults_says_so():
+    # The recorded config of each method's own group against today's defaults: a changed value is named
+    # with its value then, a field the run predates as not yet built, and a run at today's defaults adds
+    # nothing.
+    from dataclasses import asdict
+
+    from addon.engine.config import DiffusionConfig, LpvConfig
+
+    today = {"diffusion": asdict(DiffusionConfig()), "lpv": asdict(LpvConfig())}
+    assert readme_figures._older_line({"lpv": today, "diffusion": today}) == []
+    then = {"diffusion": {k: v for k, v in today["diffusion"].items() if k != "far_field"} | {"grid_cells": 16}}
+    assert readme_figures._older_line({"diffusion": then, "lpv": today}) == [
+        "", "Runs older than today's defaults: diffusion (its settings then: `grid_cells` 16, `far_field` not yet "
+            "built)."]
