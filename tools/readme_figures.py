@@ -7,6 +7,8 @@ A block is the text between `<!-- figures:NAME:begin -->` and `<!-- figures:NAME
 outside the markers is left as it is. Each block is a function of one results.json (written by
 `python -m addon bench` beside its REPORT.md), so a README figure cannot drift from the run it quotes:
 tests/unit/test_readme_figures.py fails when a block was edited by hand or its results.json changed.
+A table at the methods' defaults also reads today's defaults (addon/engine/config.py): a run older than a
+change of them names the settings it ran with, so the check fails until the block is rewritten.
 """
 
 from __future__ import annotations
@@ -16,9 +18,14 @@ import json
 import re
 import sys
 from collections.abc import Callable
+from dataclasses import asdict
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from addon.engine.config import GROUPS  # noqa: E402
+
 README = ROOT / "README.md"
 UPDATES_JSON = ROOT / "benchmarks" / "updates" / "results.json"
 DEFAULTS_JSON = ROOT / "benchmarks" / "defaults" / "results.json"
@@ -76,11 +83,6 @@ def _older_defaults(method: str, config: dict) -> list[str]:
     """The fields of `method`'s own settings group (config.GROUPS) whose value in a run's recorded
     `config` ({group: {field: value}}) is not today's default, or which the run predates: a table that
     says "at its defaults" names them, so a run older than a change of defaults cannot pass for a new one."""
-    from dataclasses import asdict
-
-    sys.path.insert(0, str(ROOT))
-    from addon.engine.config import GROUPS
-
     if method not in GROUPS:
         return []
     recorded = config.get(method, {})
@@ -93,11 +95,18 @@ def _older_line(configs: dict[str, dict]) -> list[str]:
     older = {m: _older_defaults(m, c) for m, c in configs.items()}
     if not any(older.values()):
         return []
+
     def then(m, f):
         return json.dumps(configs[m][m][f]) if f in configs[m].get(m, {}) else "not yet built"
+
     return ["", "Runs older than today's defaults: " + "; ".join(
         f"{m} (its settings then: " + ", ".join(f"`{f}` {then(m, f)}" for f in fields) + ")"
         for m, fields in older.items() if fields) + "."]
+
+
+def _older_records(records: list[dict]) -> list[str]:
+    """_older_line of the methods' recorded configs in a run's default records."""
+    return _older_line({r["method"]: r["config"] for r in records if "config" in r})
 
 
 def _default_records(results: dict) -> list[dict]:
@@ -143,7 +152,7 @@ def update_costs_block(results: dict) -> str:
         ratios = ", ".join(f"{100 * ms / lpv_ms:.0f} % on {scene}" for scene, ms, lpv_ms in pairs)
         met = all(ms <= lpv_ms for _, ms, lpv_ms in pairs)
         lines += ["", f"probes' light update costs {ratios} of lpv's (target <= 100 %: {'met' if met else 'not met'})."]
-    lines += _older_line({r["method"]: r["config"] for r in records if "config" in r})
+    lines += _older_records(records)
     return "\n".join(lines) + "\n"
 
 
@@ -179,7 +188,7 @@ def accuracy_block(results: dict) -> str:
             cell = f"{r['rel_rmse_8']:.3f} / {r['bias']:.3f}"
             cells.append(cell + f" / {_speedup(r['speedup_oidn'])}" if oidn else cell)
         lines.append(f"| {scene} | " + " | ".join(cells) + " |")
-    lines += _older_line({r["method"]: r["config"] for r in records if "config" in r})
+    lines += _older_records(records)
     return "\n".join(lines) + "\n"
 
 
@@ -219,7 +228,7 @@ def methods_block(results: dict) -> str:
 
         lines.append(f"| {method} | {f(err, '{:.3f}')} | {f(noise, '{:.3f}')} | {f(ms, '{:.0f}')} | "
                      f"{f(raw, '{:.2g}x')} | {f(oidn, '{:.2g}x')} |")
-    lines += _older_line({r["method"]: r["config"] for r in records if "config" in r})
+    lines += _older_records(records)
     return "\n".join(lines) + "\n"
 
 
@@ -268,7 +277,7 @@ def headline_block(results: dict) -> str:
         lines.append(f"| {scene} | {best['method']} | {best['rel_rmse_8']:.3f} | {_seconds(best['total_ms'] / 1e3)} "
                      f"| {_cycles_time(best['speedup'])} | {_cycles_time(best.get('speedup_oidn'))} | {ev_cell} | "
                      f"{ratio} | {fast_cell} |")
-    lines += _older_line({r["method"]: r["config"] for r in records if "config" in r})
+    lines += _older_records(records)
     return "\n".join(lines) + "\n"
 
 
